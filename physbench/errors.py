@@ -1,0 +1,55 @@
+"""Typed errors. Every message names the bad value and what would be accepted."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+
+class PhysbenchError(Exception):
+    """Base class of every error physbench raises on purpose."""
+
+
+class UnknownNameError(PhysbenchError, KeyError):
+    """A name (scene, engine, estimator, parameter, ...) that is not registered."""
+
+    def __init__(self, kind: str, name: str, known: Iterable[str]) -> None:
+        self.kind, self.name, self.known = kind, name, sorted(known)
+        listed = ", ".join(self.known) or "(none registered)"
+        super().__init__(f"unknown {kind} {name!r}; known {kind}s: {listed}")
+
+    def __str__(self) -> str:  # KeyError would quote the whole message
+        return str(self.args[0])
+
+
+class SceneError(PhysbenchError, ValueError):
+    """A scene description that is invalid: names the key, the value and (for files) the line."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        key: str | None = None,
+        value: object = None,
+        source: str | None = None,
+        line: int | None = None,
+    ) -> None:
+        self.key, self.value, self.source, self.line, self.reason = key, value, source, line, message
+        where = ""
+        if source is not None:
+            where = f"{source}:{line}: " if line is not None else f"{source}: "
+        elif line is not None:
+            where = f"line {line}: "
+        what = f"{key} = {value!r}: " if key is not None else ""
+        super().__init__(f"{where}{what}{message}")
+
+
+class SimulationError(PhysbenchError, RuntimeError):
+    """A simulation that exploded: NaN state or a body far outside the world."""
+
+    def __init__(self, message: str, *, engine: str, frame: int, body: str | None = None) -> None:
+        self.engine, self.frame, self.body = engine, frame, body
+        super().__init__(f"[{engine}] frame {frame}" + (f", body {body!r}" if body else "") + f": {message}")
+
+
+class PluginError(PhysbenchError):
+    """Plugin registration problems (duplicate names, hooks that match no spec)."""

@@ -1,0 +1,424 @@
+"""The engine-neutral scene model: a scene is data that every simulator builds the same way.
+
+Units are SI (m, kg, s, rad); y points up, gravity is usually ``(0, -9.81)``; angles are
+counter-clockwise. A body's ``position`` is the centre of its shape; ``com_offset`` moves the centre
+of mass away from it (in the body frame). Contacts combine the two surfaces' elasticity and friction
+by multiplying them, in every engine.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+from physbench.errors import SceneError
+
+Vec = tuple[float, float]
+
+#: Physical parameters a body has, with the closed range each must lie in.
+BODY_PARAMS: dict[str, tuple[float, float]] = {
+    "mass": (0.0, math.inf),  # exclusive lower bound
+    "elasticity": (0.0, 1.0),
+    "friction": (0.0, math.inf),
+    "moment": (0.0, math.inf),  # exclusive lower bound; None means "from shape and mass"
+}
+
+
+@dataclass(frozen=True)
+class Circle:
+    radius: float
+    kind: Literal["circle"] = "circle"
+
+    def area(self) -> float:
+        return math.pi * self.radius**2
+
+    def moment(self, mass: float) -> float:
+        return 0.5 * mass * self.radius**2
+
+    def extent(self) -> float:
+        """Radius of the smallest circle around the shape centre that holds the shape."""
+        return self.radius
+
+
+@dataclass(frozen=True)
+class Box:
+    width: float
+    height: float
+    kind: Literal["box"] = "box"
+
+    def vertices(self) -> tuple[Vec, ...]:
+        w, h = self.width / 2, self.height / 2
+        return ((-w, -h), (w, -h), (w, h), (-w, h))
+
+    def area(self) -> float:
+        return self.width * self.height
+
+    def moment(self, mass: float) -> float:
+        return mass * (self.width**2 + self.height**2) / 12.0
+
+    def extent(self) -> float:
+        return math.hypot(self.width, self.height) / 2
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A convex polygon, vertices counter-clockwise around the shape centre (body frame)."""
+
+    points: tuple[Vec, ...]
+    kind: Literal["polygon"] = "polygon"
+
+    def vertices(self) -> tuple[Vec, ...]:
+        return self.points
+
+    def area(self) -> float:
+        return abs(_signed_area(self.points))
+
+    def moment(self, mass: float) -> float:
+        # Polygon moment about the origin of its vertex frame (uniform density).
+        num = den = 0.0
+        pts = self.points
+        for i in range(len(pts)):
+            (x0, y0), (x1, y1) = pts[i], pts[(i + 1) % len(pts)]
+            cross = abs(x0 * y1 - x1 * y0)
+            num += cross * (x0 * x0 + x0 * x1 + x1 * x1 + y0 * y0 + y0 * y1 + y1 * y1)
+            den += cross
+        return mass * num / (6.0 * den)
+
+    def extent(self) -> float:
+        return max(math.hypot(x, y) for x, y in self.points)
+
+
+Shape = Circle | Box | Polygon
+SHAPE_KINDS = ("circle", "box", "polygon")
+
+
+@dataclass(frozen=True)
+class Body:
+    """A dynamic body. Its parameters are the ones an estimator may be asked to identify."""
+
+    name: str
+    shape: Shape
+    position: Vec
+    angle: float = 0.0
+    velocity: Vec = (0.0, 0.0)
+    angular_velocity: float = 0.0
+    mass: float = 1.0
+    elasticity: float = 0.5
+    friction: float = 0.5
+    moment: float | None = None
+    com_offset: Vec = (0.0, 0.0)
+
+    def inertia(self) -> float:
+        """Moment of inertia about the centre of mass (uniform density unless ``moment`` is set)."""
+        return self.moment if self.moment is not None else self.shape.moment(self.mass)
+
+
+@dataclass(frozen=True)
+class Segment:
+    """Static line segment (a wall, a floor), optionally thickened by ``radius``."""
+
+    a: Vec
+    b: Vec
+    radius: float = 0.0
+    elasticity: float = 1.0
+    friction: float = 1.0
+    kind: Literal["segment"] = "segment"
+
+
+@dataclass(frozen=True)
+class StaticPolygon:
+    """Static convex polygon in world coordinates, counter-clockwise."""
+
+    points: tuple[Vec, ...]
+    elasticity: float = 1.0
+    friction: float = 1.0
+    kind: Literal["polygon"] = "polygon"
+
+
+Static = Segment | StaticPolygon
+
+
+@dataclass(frozen=True)
+class Force:
+    """A force (N) applied at a body's centre of mass from ``start`` to ``end`` (s), or an
+    impulse (N·s) applied once at ``start``."""
+
+    body: str
+    vector: Vec
+    start: float = 0.0
+    end: float = 0.0
+    kind: Literal["force", "impulse"] = "force"
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A pivot: ``a`` and ``b`` (``None`` = the world) share the point ``anchor`` (world
+    coordinates at t=0) and may rotate about it."""
+
+    a: str
+    anchor: Vec
+    b: str | None = None
+    kind: Literal["pivot"] = "pivot"
+
+
+@dataclass(frozen=True)
+class Unknown:
+    """A parameter that may be unknown: ``body.param`` lies somewhere in ``[low, high]``."""
+
+    body: str
+    param: str
+    low: float
+    high: float
+
+    @property
+    def key(self) -> str:
+        return f"{self.body}.{self.param}"
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A complete, engine-neutral description of one experiment."""
+
+    name: str
+    bodies: tuple[Body, ...]
+    bounds: tuple[float, float, float, float] = (0.0, 0.0, 4.0, 4.0)  # xmin, ymin, xmax, ymax
+    gravity: Vec = (0.0, -9.81)
+    fps: float = 30.0
+    frames: int = 30
+    substeps: int = 10
+    statics: tuple[Static, ...] = ()
+    forces: tuple[Force, ...] = ()
+    joints: tuple[Joint, ...] = ()
+    unknowns: tuple[Unknown, ...] = ()
+    test_body: str | None = None
+    description: str = ""
+    meta: Mapping[str, object] = field(default_factory=dict, compare=True)
+
+    @property
+    def dt(self) -> float:
+        """Seconds between two recorded frames."""
+        return 1.0 / self.fps
+
+    @property
+    def body_names(self) -> tuple[str, ...]:
+        return tuple(b.name for b in self.bodies)
+
+    def body_index(self, name: str) -> int:
+        for i, b in enumerate(self.bodies):
+            if b.name == name:
+                return i
+        from physbench.errors import UnknownNameError
+
+        raise UnknownNameError("body", name, self.body_names)
+
+    def unknown(self, key: str) -> Unknown:
+        for u in self.unknowns:
+            if u.key == key:
+                return u
+        from physbench.errors import UnknownNameError
+
+        raise UnknownNameError("unknown parameter", key, [u.key for u in self.unknowns])
+
+    def with_params(self, params: Mapping[str, float]) -> Scene:
+        """A copy with ``{"body.param": value}`` applied. Called once per simulation."""
+        if not params:
+            return self
+        changes: dict[str, dict[str, float]] = {}
+        for key, value in params.items():
+            body, _, param = key.rpartition(".")
+            if param not in BODY_PARAMS:
+                raise SceneError(
+                    f"unknown body parameter; known: {', '.join(BODY_PARAMS)}", key=key, value=value
+                )
+            changes.setdefault(body, {})[param] = float(value)
+        names = set(self.body_names)
+        for body in changes:
+            if body not in names:
+                from physbench.errors import UnknownNameError
+
+                raise UnknownNameError("body", body, names)
+        bodies = tuple(replace(b, **changes[b.name]) if b.name in changes else b for b in self.bodies)
+        return replace(self, bodies=bodies)
+
+    def validate(self) -> Scene:
+        """Check every value; raise :class:`SceneError` naming the first bad key. Returns self."""
+        validate_scene(self)
+        return self
+
+
+# --------------------------------------------------------------------------- validation
+
+
+def _signed_area(points: tuple[Vec, ...]) -> float:
+    s = 0.0
+    for i in range(len(points)):
+        (x0, y0), (x1, y1) = points[i], points[(i + 1) % len(points)]
+        s += x0 * y1 - x1 * y0
+    return s / 2
+
+
+def _is_convex_ccw(points: tuple[Vec, ...]) -> bool:
+    n = len(points)
+    if n < 3 or _signed_area(points) <= 0:
+        return False
+    for i in range(n):
+        (x0, y0), (x1, y1), (x2, y2) = points[i], points[(i + 1) % n], points[(i + 2) % n]
+        if (x1 - x0) * (y2 - y1) - (y1 - y0) * (x2 - x1) < -1e-12:
+            return False
+    return True
+
+
+def _finite(key: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise SceneError("must be a finite number", key=key, value=value)
+    return float(value)
+
+
+def _vec(key: str, value: object) -> Vec:
+    if not isinstance(value, tuple | list) or len(value) != 2:
+        raise SceneError("must be a pair of numbers [x, y]", key=key, value=value)
+    return (_finite(f"{key}[0]", value[0]), _finite(f"{key}[1]", value[1]))
+
+
+def _check_param(key: str, param: str, value: float) -> None:
+    lo, hi = BODY_PARAMS[param]
+    value = _finite(key, value)
+    if param in ("mass", "moment"):
+        if value <= 0:
+            raise SceneError(f"{param} must be > 0", key=key, value=value)
+    elif not lo <= value <= hi:
+        raise SceneError(f"{param} must lie in [{lo}, {hi}]", key=key, value=value)
+
+
+def validate_scene(scene: Scene) -> None:
+    if not scene.name or not isinstance(scene.name, str):
+        raise SceneError("must be a non-empty string", key="name", value=scene.name)
+    xmin, ymin, xmax, ymax = (_finite(f"bounds[{i}]", v) for i, v in enumerate(scene.bounds))
+    if not (xmin < xmax and ymin < ymax):
+        raise SceneError("bounds must be [xmin, ymin, xmax, ymax] with min < max", key="bounds", value=scene.bounds)
+    _vec("gravity", scene.gravity)
+    if _finite("fps", scene.fps) <= 0:
+        raise SceneError("must be > 0", key="fps", value=scene.fps)
+    for key in ("frames", "substeps"):
+        v = getattr(scene, key)
+        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            raise SceneError("must be a whole number >= 1", key=key, value=v)
+    if not scene.bodies:
+        raise SceneError("a scene needs at least one dynamic body", key="bodies", value=[])
+
+    seen: set[str] = set()
+    for i, b in enumerate(scene.bodies):
+        k = f"bodies[{i}]"
+        if not isinstance(b.name, str) or not b.name or "." in b.name or b.name == "world":
+            raise SceneError("must be a non-empty name without '.', not 'world'", key=f"{k}.name", value=b.name)
+        if b.name in seen:
+            raise SceneError("duplicate body name", key=f"{k}.name", value=b.name)
+        seen.add(b.name)
+        _check_shape(f"{k}.shape", b.shape)
+        x, y = _vec(f"{k}.position", b.position)
+        r = b.shape.extent()
+        if not (xmin + r <= x <= xmax - r and ymin + r <= y <= ymax - r):
+            raise SceneError(
+                f"body (extent {r:g} m) must lie inside the world bounds {tuple(scene.bounds)}",
+                key=f"{k}.position",
+                value=b.position,
+            )
+        _finite(f"{k}.angle", b.angle)
+        _vec(f"{k}.velocity", b.velocity)
+        _finite(f"{k}.angular_velocity", b.angular_velocity)
+        _vec(f"{k}.com_offset", b.com_offset)
+        for p in ("mass", "elasticity", "friction"):
+            _check_param(f"{k}.{p}", p, getattr(b, p))
+        if b.moment is not None:
+            _check_param(f"{k}.moment", "moment", b.moment)
+
+    for i, s in enumerate(scene.statics):
+        k = f"statics[{i}]"
+        if isinstance(s, Segment):
+            a, bb = _vec(f"{k}.a", s.a), _vec(f"{k}.b", s.b)
+            if a == bb:
+                raise SceneError("segment end points must differ", key=f"{k}.b", value=s.b)
+            if _finite(f"{k}.radius", s.radius) < 0:
+                raise SceneError("must be >= 0", key=f"{k}.radius", value=s.radius)
+        elif isinstance(s, StaticPolygon):
+            _check_points(f"{k}.points", s.points)
+        else:
+            raise SceneError("unknown static kind; known: segment, polygon", key=k, value=s)
+        _check_param(f"{k}.elasticity", "elasticity", s.elasticity)
+        _check_param(f"{k}.friction", "friction", s.friction)
+
+    for i, f in enumerate(scene.forces):
+        k = f"forces[{i}]"
+        if f.body not in seen:
+            raise SceneError(f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=f.body)
+        if f.kind not in ("force", "impulse"):
+            raise SceneError("unknown force kind; known: force, impulse", key=f"{k}.kind", value=f.kind)
+        _vec(f"{k}.vector", f.vector)
+        start, end = _finite(f"{k}.start", f.start), _finite(f"{k}.end", f.end)
+        if start < 0:
+            raise SceneError("must be >= 0", key=f"{k}.start", value=f.start)
+        if f.kind == "force" and end <= start:
+            raise SceneError("a force window needs end > start", key=f"{k}.end", value=f.end)
+
+    for i, j in enumerate(scene.joints):
+        k = f"joints[{i}]"
+        if j.kind != "pivot":
+            raise SceneError("unknown joint kind; known: pivot", key=f"{k}.kind", value=j.kind)
+        for side in ("a", "b"):
+            name = getattr(j, side)
+            if name is None and side == "b":
+                continue
+            if name not in seen:
+                raise SceneError(
+                    f"no such body; bodies: {', '.join(sorted(seen))} (or 'world' for b)",
+                    key=f"{k}.{side}",
+                    value=name,
+                )
+        if j.a == j.b:
+            raise SceneError("a joint needs two different bodies", key=f"{k}.b", value=j.b)
+        _vec(f"{k}.anchor", j.anchor)
+
+    keys: set[str] = set()
+    for i, u in enumerate(scene.unknowns):
+        k = f"unknowns[{i}]"
+        if u.body not in seen:
+            raise SceneError(f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=u.body)
+        if u.param not in BODY_PARAMS:
+            raise SceneError(f"unknown parameter; known: {', '.join(BODY_PARAMS)}", key=f"{k}.param", value=u.param)
+        lo, hi = _finite(f"{k}.range[0]", u.low), _finite(f"{k}.range[1]", u.high)
+        if not lo < hi:
+            raise SceneError("range must be [low, high] with low < high", key=f"{k}.range", value=[u.low, u.high])
+        _check_param(f"{k}.range[0]", u.param, lo)
+        _check_param(f"{k}.range[1]", u.param, hi)
+        if u.key in keys:
+            raise SceneError("parameter declared unknown twice", key=f"{k}.param", value=u.param)
+        keys.add(u.key)
+        if u.body == scene.test_body:
+            raise SceneError("the test body's parameters are fixed by definition", key=f"{k}.body", value=u.body)
+
+    if scene.test_body is not None and scene.test_body not in seen:
+        raise SceneError(f"no such body; bodies: {', '.join(sorted(seen))}", key="test_body", value=scene.test_body)
+
+
+def _check_shape(key: str, shape: object) -> None:
+    if isinstance(shape, Circle):
+        if _finite(f"{key}.radius", shape.radius) <= 0:
+            raise SceneError("must be > 0", key=f"{key}.radius", value=shape.radius)
+    elif isinstance(shape, Box):
+        for d in ("width", "height"):
+            if _finite(f"{key}.{d}", getattr(shape, d)) <= 0:
+                raise SceneError("must be > 0", key=f"{key}.{d}", value=getattr(shape, d))
+    elif isinstance(shape, Polygon):
+        _check_points(f"{key}.points", shape.points)
+    else:
+        raise SceneError(f"unknown shape; known: {', '.join(SHAPE_KINDS)}", key=key, value=shape)
+
+
+def _check_points(key: str, points: object) -> None:
+    if not isinstance(points, tuple | list) or len(points) < 3:
+        raise SceneError("a polygon needs at least 3 points", key=key, value=points)
+    pts = tuple(_vec(f"{key}[{i}]", p) for i, p in enumerate(points))
+    if not _is_convex_ccw(pts):
+        raise SceneError("polygon must be convex with counter-clockwise points", key=key, value=points)
