@@ -1,0 +1,35 @@
+"""``physbench scenes``: the registered scenes and their unknowns."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--seed", type=int, default=0, help="instance to describe (default 0)")
+    p.add_argument("--toml", metavar="NAME", help="print one scene's instance as TOML and exit")
+
+
+def main(args: argparse.Namespace) -> int:
+    from physbench.plugins import get_registry
+    from physbench.scene_toml import dumps_scene
+
+    reg = get_registry()
+    if args.toml:
+        print(dumps_scene(reg.get("scene", args.toml)(args.seed)), end="")
+        return 0
+    for name in reg.names("scene"):
+        gen = reg.get("scene", name)
+        scene = gen(args.seed)
+        print(f"{name}  ({reg.info('scene', name).package})")
+        print(f"    {getattr(gen, 'description', '')}")
+        bodies = ", ".join(scene.body_names)
+        print(f"    bodies: {bodies}" + (f"; test body: {scene.test_body}" if scene.test_body else ""))
+        by_param: dict[str, list[str]] = {}
+        for u in scene.unknowns:
+            by_param.setdefault(u.param, []).append(f"{u.body} [{u.low:g}, {u.high:g}]")
+        for param, items in by_param.items():
+            print(f"    unknown {param}: {', '.join(items)}")
+        if not scene.unknowns:
+            print("    unknowns: none")
+    return 0

@@ -1,0 +1,140 @@
+"""Plugin discovery through real entry points: a throwaway distribution is written to a temp
+folder on sys.path, exactly as pip would install one."""
+
+from __future__ import annotations
+
+import importlib
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from physbench import hookspecs
+from physbench.errors import PluginError, UnknownNameError
+from physbench.plugins import KINDS, discover
+
+GOOD = '''
+from physbench.hookspecs import hookimpl
+
+class EchoEstimator:
+    name = "echo_{tag}"
+    per_object = False
+    def start(self, task, *, seed):
+        self.initial = task.initial
+    def propose(self, step):
+        return dict(step.params)
+
+@hookimpl
+def register_estimators():
+    return [EchoEstimator]
+'''
+
+
+def make_dist(root: Path, dist: str, version: str, entry_points: dict[str, str], modules: dict[str, str]) -> None:
+    """Write an installed-looking distribution (dist-info + modules) under ``root``."""
+    info = root / f"{dist.replace('-', '_')}-{version}.dist-info"
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: {version}\n")
+    eps = "\n".join(f"{k} = {v}" for k, v in entry_points.items())
+    (info / "entry_points.txt").write_text(f"[physbench]\n{eps}\n")
+    for name, src in modules.items():
+        (root / f"{name}.py").write_text(textwrap.dedent(src))
+
+
+@pytest.fixture
+def site(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.syspath_prepend(str(tmp_path))
+    importlib.invalidate_caches()
+    yield tmp_path
+    for mod in list(sys.modules):
+        if mod.startswith("pbtest_"):
+            del sys.modules[mod]
+
+
+def test_builtins_register_through_entry_points() -> None:
+    reg = discover(env=False)
+    assert not reg.failed, reg.failed
+    assert {"pymunk", "box2d"} <= set(reg.names("simulator"))
+    assert "raster" in reg.names("renderer")
+    assert {"three_circles", "second_order", "stacked_boxes", "bouncing_balls", "pendulum", "ball_drop"} <= set(
+        reg.names("scene")
+    )
+    info = reg.info("simulator", "pymunk")
+    assert info.package == "physbench" and info.plugin == "pymunk"
+
+
+def test_third_party_plugin_is_discovered_with_its_package(site: Path) -> None:
+    make_dist(site, "pbtest-good", "1.2.3", {"good": "pbtest_good"}, {"pbtest_good": GOOD.format(tag="good")})
+    reg = discover(env=False)
+    comp = reg.info("estimator", "echo_good")
+    assert (comp.package, comp.version, comp.plugin) == ("pbtest-good", "1.2.3", "good")
+    assert comp.obj.__name__ == "EchoEstimator"
+
+
+def test_plugin_failing_to_import_is_reported_and_skipped(site: Path) -> None:
+    make_dist(site, "pbtest-broken", "0.1", {"broken": "pbtest_broken"}, {"pbtest_broken": "raise RuntimeError('boom at import')\n"})
+    make_dist(site, "pbtest-good", "1.0", {"good": "pbtest_good"}, {"pbtest_good": GOOD.format(tag="ok")})
+    reg = discover(env=False)
+    failed = {f.plugin: f for f in reg.failed}
+    assert "broken" in failed
+    assert failed["broken"].package == "pbtest-broken"
+    assert "boom at import" in failed["broken"].error
+    assert "echo_ok" in reg.names("estimator")  # the rest still loads
+    assert "pymunk" in reg.names("simulator")
+
+
+def test_hook_that_matches_no_spec_is_reported(site: Path) -> None:
+    src = "from physbench.hookspecs import hookimpl\n@hookimpl\ndef register_simulator():\n    return []\n"
+    make_dist(site, "pbtest-typo", "0.1", {"typo": "pbtest_typo"}, {"pbtest_typo": src})
+    reg = discover(env=False)
+    err = {f.plugin: f.error for f in reg.failed}["typo"]
+    assert "register_simulator" in err
+
+
+def test_hook_that_raises_is_reported(site: Path) -> None:
+    src = "from physbench.hookspecs import hookimpl\n@hookimpl\ndef register_estimators():\n    raise ValueError('bad hook')\n"
+    make_dist(site, "pbtest-raise", "0.1", {"raiser": "pbtest_raise"}, {"pbtest_raise": src})
+    reg = discover(env=False)
+    assert "bad hook" in {f.plugin: f.error for f in reg.failed}["raiser"]
+
+
+def test_duplicate_component_name_fails_loudly(site: Path) -> None:
+    src = "from physbench.hookspecs import hookimpl\nclass S:\n    name = 'pymunk'\n@hookimpl\ndef register_simulators():\n    return [S]\n"
+    make_dist(site, "pbtest-dup", "0.1", {"dup": "pbtest_dup"}, {"pbtest_dup": src})
+    with pytest.raises(PluginError, match=r"duplicate simulator name 'pymunk'.*pbtest-dup"):
+        discover(env=False)
+
+
+def test_explicit_module_fallback_via_environment(site: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (site / "pbtest_env.py").write_text(textwrap.dedent(GOOD.format(tag="env")))
+    monkeypatch.setenv("PHYSBENCH_PLUGINS", "pbtest_env, pbtest_missing_module")
+    reg = discover()
+    assert reg.info("estimator", "echo_env").package == "PHYSBENCH_PLUGINS"
+    assert any(f.plugin == "pbtest_missing_module" for f in reg.failed)
+
+
+def test_unknown_name_lists_known_ones() -> None:
+    reg = discover(env=False)
+    with pytest.raises(UnknownNameError, match="unknown simulator 'bullet'; known simulators: box2d, pymunk"):
+        reg.get("simulator", "bullet")
+
+
+def test_every_hookspec_is_documented_and_mapped_to_a_kind() -> None:
+    specs = [n for n in dir(hookspecs) if n.startswith("register_")]
+    assert sorted(specs) == sorted(KINDS)
+    for name in specs:
+        doc = getattr(hookspecs, name).__doc__ or ""
+        assert "Called" in doc, f"hookspec {name} must say when it is called"
+
+
+def test_plugins_command_lists_components_and_failures(site: Path) -> None:
+    make_dist(site, "pbtest-broken", "0.1", {"broken": "pbtest_broken"}, {"pbtest_broken": "import not_a_module_xyz\n"})
+    out = subprocess.run(
+        [sys.executable, "-m", "physbench.cli", "plugins"],
+        capture_output=True, text=True, check=True,
+        env={**__import__("os").environ, "PYTHONPATH": str(site)},
+    ).stdout
+    assert "simulator  pymunk" in out and "physbench" in out
+    assert "Failed to load" in out and "pbtest-broken" in out and "not_a_module_xyz" in out
