@@ -12,10 +12,11 @@ class PhysbenchError(Exception):
 class UnknownNameError(PhysbenchError, KeyError):
     """A name (scene, engine, estimator, parameter, ...) that is not registered."""
 
-    def __init__(self, kind: str, name: str, known: Iterable[str]) -> None:
+    def __init__(self, kind: str, name: str, known: Iterable[str], *, where: str = "") -> None:
         self.kind, self.name, self.known = kind, name, sorted(known)
         listed = ", ".join(self.known) or "(none registered)"
-        super().__init__(f"unknown {kind} {name!r}; known {kind}s: {listed}")
+        at = f" {where}" if where else ""
+        super().__init__(f"unknown {kind} {name!r}{at}; known {kind}s{at}: {listed}")
 
     def __str__(self) -> str:  # KeyError would quote the whole message
         return str(self.args[0])

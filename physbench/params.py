@@ -43,14 +43,14 @@ class ParamSpace:
             known = sorted({u.param for u in unknowns})
             for p in params:
                 if p not in known:
-                    raise UnknownNameError(f"parameter of scene {scene.name!r}", p, known)
+                    raise UnknownNameError("parameter", p, known, where=f"of scene {scene.name!r}")
             unknowns = [u for u in unknowns if u.param in params]
         if bodies is not None:
             bodies = list(bodies)
             known = sorted({u.body for u in unknowns})
             for b in bodies:
                 if b not in known:
-                    raise UnknownNameError(f"unknown body of scene {scene.name!r}", b, known)
+                    raise UnknownNameError("body", b, known, where=f"with unknowns in scene {scene.name!r}")
             unknowns = [u for u in unknowns if u.body in bodies]
         return cls(tuple(unknowns))
 

@@ -41,6 +41,10 @@ class Circle:
         """Radius of the smallest circle around the shape centre that holds the shape."""
         return self.radius
 
+    def half_extents(self, angle: float) -> Vec:
+        """Half width and half height of the axis-aligned box around the shape at ``angle``."""
+        return (self.radius, self.radius)
+
 
 @dataclass(frozen=True)
 class Box:
@@ -60,6 +64,11 @@ class Box:
 
     def extent(self) -> float:
         return math.hypot(self.width, self.height) / 2
+
+    def half_extents(self, angle: float) -> Vec:
+        c, s = math.cos(angle), math.sin(angle)
+        pts = self.vertices()
+        return (max(abs(c * x - s * y) for x, y in pts), max(abs(s * x + c * y) for x, y in pts))
 
 
 @dataclass(frozen=True)
@@ -88,6 +97,11 @@ class Polygon:
 
     def extent(self) -> float:
         return max(math.hypot(x, y) for x, y in self.points)
+
+    def half_extents(self, angle: float) -> Vec:
+        c, s = math.cos(angle), math.sin(angle)
+        pts = self.vertices()
+        return (max(abs(c * x - s * y) for x, y in pts), max(abs(s * x + c * y) for x, y in pts))
 
 
 Shape = Circle | Box | Polygon
@@ -219,7 +233,7 @@ class Scene:
                 return u
         from physbench.errors import UnknownNameError
 
-        raise UnknownNameError("unknown parameter", key, [u.key for u in self.unknowns])
+        raise UnknownNameError("unknown parameter", key, [u.key for u in self.unknowns], where=f"of scene {self.name!r}")
 
     def with_params(self, params: Mapping[str, float]) -> Scene:
         """A copy with ``{"body.param": value}`` applied. Called once per simulation."""
@@ -318,10 +332,11 @@ def validate_scene(scene: Scene) -> None:
         seen.add(b.name)
         _check_shape(f"{k}.shape", b.shape)
         x, y = _vec(f"{k}.position", b.position)
-        r = b.shape.extent()
-        if not (xmin + r <= x <= xmax - r and ymin + r <= y <= ymax - r):
+        hx, hy = b.shape.half_extents(_finite(f"{k}.angle", b.angle))
+        eps = 1e-9
+        if not (xmin + hx - eps <= x <= xmax - hx + eps and ymin + hy - eps <= y <= ymax - hy + eps):
             raise SceneError(
-                f"body (extent {r:g} m) must lie inside the world bounds {tuple(scene.bounds)}",
+                f"body (half size {hx:g} x {hy:g} m) must lie inside the world bounds {tuple(scene.bounds)}",
                 key=f"{k}.position",
                 value=b.position,
             )

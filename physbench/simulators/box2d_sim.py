@@ -2,19 +2,35 @@
 
 Box2D mixes contact materials as max(restitution) and sqrt(friction product); a contact listener
 resets both to the product, physbench's convention, when a contact begins.
-Known divergence kept (documented in README): Box2D treats impacts slower than 1 m/s as
-inelastic (``b2_velocityThreshold``, compiled in).
+
+Box2D gives every polygon and edge a 1 cm "skin" (``b2_polygonRadius``; edge-vs-polygon contacts
+hard-code 2 cm), so boxes would rest 1-2 cm above a floor where pymunk has them touching. Shapes
+are built so that the contact surface is the scene's: a dynamic polygon's core is inset by its
+skin (its corners are rounded by 1 cm; the skin stays, continuous collision needs it), static
+polygons have no skin, and segments become thin static boxes without skin (plus end circles for a
+thick segment: the capsule pymunk builds). See ``docs/engines.md``.
+
+Divergence kept (compiled-in constants): impacts slower than ``b2_velocityThreshold`` (1 m/s) are
+inelastic; a body moves at most ``b2_maxTranslation`` (2 m) and turns at most ``b2_maxRotation``
+(π/2) per step, which the stepping loop reports as an explosion.
 """
 
 from __future__ import annotations
 
+import functools
+import math
 from typing import Any, ClassVar
 
+from physbench.errors import SimulationError
 from physbench.hookspecs import hookimpl
-from physbench.scene import Box, Circle, Scene, Segment
+from physbench.scene import Body, Box, Circle, Scene, Segment
 from physbench.simulators.stepping import SteppingSimulator, initial_com_state
 
+#: Half thickness (m) of the static box that stands in for a segment of radius 0.
+SEGMENT_HALF_THICKNESS = 1e-4
 
+
+@functools.cache
 def _listener_class() -> Any:
     import Box2D
 
@@ -27,6 +43,99 @@ def _listener_class() -> Any:
     return ProductMixing
 
 
+def _polygon(points: Any) -> Any:
+    import Box2D
+
+    shape = Box2D.b2PolygonShape(vertices=list(points))
+    shape.radius = 0.0
+    return shape
+
+
+def _inset(points: tuple[tuple[float, float], ...], r: float) -> list[tuple[float, float]] | None:
+    """The convex CCW polygon whose edges lie ``r`` inside ``points``' edges, or None if too small."""
+    n = len(points)
+    lines = []
+    for i in range(n):
+        (x0, y0), (x1, y1) = points[i], points[(i + 1) % n]
+        ln = math.hypot(x1 - x0, y1 - y0)
+        nx, ny = (y1 - y0) / ln, (x0 - x1) / ln  # outward normal
+        lines.append((nx, ny, nx * x0 + ny * y0 - r))
+    out = []
+    for i in range(n):
+        (ax, ay, ac), (bx, by, bc) = lines[i - 1], lines[i]
+        det = ax * by - ay * bx
+        if abs(det) < 1e-12:
+            return None
+        out.append(((ac * by - ay * bc) / det, (ax * bc - ac * bx) / det))
+    for i in range(n):  # every edge must keep its direction, else the polygon was thinner than 2r
+        (x0, y0), (x1, y1) = points[i], points[(i + 1) % n]
+        (u0, v0), (u1, v1) = out[i], out[(i + 1) % n]
+        if (x1 - x0) * (u1 - u0) + (y1 - y0) * (v1 - v0) <= 0:
+            return None
+    return out
+
+
+def _dynamic_polygon(points: tuple[tuple[float, float], ...]) -> Any:
+    """A dynamic polygon whose outer surface (core plus skin) is ``points``. Box2D needs the skin on
+    moving polygons: without it a fast box reaches a wall without a contact and tunnels."""
+    import Box2D
+
+    r = Box2D.b2_polygonRadius
+    core = _inset(points, r)
+    if core is None:  # too small for the skin: a sharp polygon (continuous collision is weaker)
+        return _polygon(points)
+    shape = Box2D.b2PolygonShape(vertices=core)
+    shape.radius = r
+    return shape
+
+
+def _segment_shapes(s: Segment) -> list[Any]:
+    """A segment as Box2D shapes without skin: a thin box, and end circles when it is thick."""
+    import Box2D
+
+    (ax, ay), (bx, by) = s.a, s.b
+    box = Box2D.b2PolygonShape()
+    box.SetAsBox(
+        math.hypot(bx - ax, by - ay) / 2,
+        max(s.radius, SEGMENT_HALF_THICKNESS),
+        ((ax + bx) / 2, (ay + by) / 2),
+        math.atan2(by - ay, bx - ax),
+    )
+    box.radius = 0.0
+    if s.radius <= 0:
+        return [box]
+    return [box, *(Box2D.b2CircleShape(radius=s.radius, pos=p) for p in (s.a, s.b))]
+
+
+def _add_body(world: Any, b: Body, v: tuple[float, float], w: float) -> Any:
+    """Create ``b`` with CoM velocity ``v`` and angular velocity ``w``."""
+    import Box2D
+
+    dx, dy = b.com_offset
+    # The Box2D body origin is the shape centre; the CoM is set through the mass data.
+    # allowSleep=False: pybox2d bodies fall asleep even in a world with allowSleeping off.
+    body = world.CreateDynamicBody(position=b.position, angle=b.angle, bullet=True, allowSleep=False)
+    if isinstance(b.shape, Circle):
+        shape = Box2D.b2CircleShape(radius=b.shape.radius)
+    else:
+        shape = _dynamic_polygon(b.shape.vertices() if isinstance(b.shape, Box) else b.shape.points)
+    body.CreateFixture(shape=shape, density=1.0, restitution=b.elasticity, friction=b.friction)
+    md = Box2D.b2MassData()
+    md.mass, md.center = b.mass, (dx, dy)
+    md.I = b.inertia() + b.mass * (dx * dx + dy * dy)  # Box2D wants I about the body origin
+    body.massData = md
+    # Box2D stores float32 and silently turns a mass it cannot hold into 1 kg.
+    if not (math.isclose(body.mass, b.mass, rel_tol=1e-5) and math.isclose(body.inertia, md.I, rel_tol=1e-5)):
+        raise SimulationError(
+            f"mass {b.mass:g} kg / moment {md.I:g} kg·m² is outside Box2D's float32 range",
+            engine="box2d",
+            frame=0,
+            body=b.name,
+        )
+    body.linearVelocity, body.angularVelocity = v, w
+    return body
+
+
 class Box2DWorld:
     def __init__(self, scene: Scene, velocity_iterations: int, position_iterations: int) -> None:
         import Box2D
@@ -36,36 +145,26 @@ class Box2DWorld:
         self._listener = listener  # keep alive: Box2D holds only a raw pointer
         ground = world.CreateStaticBody()
         for s in scene.statics:
-            if isinstance(s, Segment):
-                shape = Box2D.b2EdgeShape(vertices=[s.a, s.b])
-                if s.radius > 0:
-                    shape.radius = s.radius
-            else:
-                shape = Box2D.b2PolygonShape(vertices=list(s.points))
-            ground.CreateFixture(shape=shape, restitution=s.elasticity, friction=s.friction)
+            for shape in _segment_shapes(s) if isinstance(s, Segment) else [_polygon(s.points)]:
+                ground.CreateFixture(shape=shape, restitution=s.elasticity, friction=s.friction)
         self.bodies: list[Any] = []
-        for b, (x, y, a, vx, vy, w) in zip(scene.bodies, initial_com_state(scene), strict=True):
-            dx, dy = b.com_offset
-            # Box2D bodies have their origin at the shape centre; the CoM is set through mass data.
-            ox, oy = b.position
-            body = world.CreateDynamicBody(position=(ox, oy), angle=a, bullet=True)
-            if isinstance(b.shape, Circle):
-                shape = Box2D.b2CircleShape(radius=b.shape.radius)
-            else:
-                verts = b.shape.vertices() if isinstance(b.shape, Box) else b.shape.points
-                shape = Box2D.b2PolygonShape(vertices=list(verts))
-            body.CreateFixture(shape=shape, density=1.0, restitution=b.elasticity, friction=b.friction)
-            md = Box2D.b2MassData()
-            md.mass, md.center = b.mass, (dx, dy)
-            md.I = b.inertia() + b.mass * (dx * dx + dy * dy)  # Box2D wants I about the body origin
-            body.massData = md
-            body.linearVelocity, body.angularVelocity = (vx, vy), w
-            self.bodies.append(body)
+        for b, (*_, vx, vy, w) in zip(scene.bodies, initial_com_state(scene), strict=True):
+            try:
+                self.bodies.append(_add_body(world, b, (vx, vy), w))
+            except SimulationError:
+                raise
+            except Exception as exc:  # e.g. more vertices than Box2D's b2_maxPolygonVertices
+                raise SimulationError(
+                    f"cannot build the body: {type(exc).__name__}: {exc}", engine="box2d", frame=0, body=b.name
+                ) from exc
         index = {b.name: body for b, body in zip(scene.bodies, self.bodies, strict=True)}
         for j in scene.joints:
             world.CreateRevoluteJoint(bodyA=index[j.a], bodyB=index[j.b] if j.b else ground, anchor=j.anchor)
         self.world = world
         self.vi, self.pi = velocity_iterations, position_iterations
+        h = scene.dt / scene.substeps
+        self.max_speed = Box2D.b2_maxTranslation / h
+        self.max_angular_speed = Box2D.b2_maxRotation / h
 
     def step(self, h: float) -> None:
         self.world.Step(h, self.vi, self.pi)

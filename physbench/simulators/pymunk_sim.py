@@ -1,7 +1,17 @@
-"""The pymunk (Chipmunk2D) simulator."""
+"""The pymunk (Chipmunk2D) simulator.
+
+Chipmunk steps positions *before* velocities (x += h v_old; v += h a), Box2D after (v += h a;
+x += h v_new): left alone, a falling body in pymunk would sit g·h·t above Box2D's (3 cm after 1 s
+at 300 Hz). The two orders are the same sequence of operations shifted by half a step, so this
+adapter reports Chipmunk's state the Box2D way: the position reported is the one Chipmunk will
+integrate to at the start of the next step, ``x + h v``. Both engines then collide at, and report,
+the same positions (see ``docs/engines.md``).
+"""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 from physbench.hookspecs import hookimpl
@@ -13,9 +23,13 @@ COLLISION_SLOP = 0.005
 
 
 class PymunkWorld:
-    def __init__(self, scene: Scene, iterations: int) -> None:
+    max_speed = math.inf  # Chipmunk never clamps motion
+    max_angular_speed = math.inf
+
+    def __init__(self, scene: Scene, iterations: int, velocity_threshold: float = 0.0) -> None:
         import pymunk
 
+        h = self.h = scene.dt / scene.substeps
         space = pymunk.Space()
         space.gravity = scene.gravity
         space.iterations = iterations
@@ -30,9 +44,12 @@ class PymunkWorld:
             sh.elasticity, sh.friction = s.elasticity, s.friction
             shapes.append(sh)
         self.bodies: list[Any] = []
-        for b, (x, y, a, vx, vy, w) in zip(scene.bodies, initial_com_state(scene), strict=True):
-            body = pymunk.Body(b.mass, b.inertia())
-            body.position, body.angle, body.velocity, body.angular_velocity = (x, y), a, (vx, vy), w
+        com = initial_com_state(scene)
+        for b, (x, y, a, vx, vy, w) in zip(scene.bodies, com, strict=True):
+            body = pymunk.Body(b.mass, b.inertia())  # mass set on the body: shapes carry none
+            # Half a step back, so that the first position update lands on the scene's pose.
+            body.position, body.angle = (x - h * vx, y - h * vy), a - h * w
+            body.velocity, body.angular_velocity = (vx, vy), w
             dx, dy = b.com_offset
             if isinstance(b.shape, Circle):
                 sh = pymunk.Circle(body, b.shape.radius, (-dx, -dy))
@@ -40,25 +57,34 @@ class PymunkWorld:
                 verts = b.shape.vertices() if isinstance(b.shape, Box) else b.shape.points
                 sh = pymunk.Poly(body, [(px - dx, py - dy) for px, py in verts])
             sh.elasticity, sh.friction = b.elasticity, b.friction
-            # pymunk would recompute mass from shapes only when density is set; we set it on the body.
             self.bodies.append(body)
             shapes.extend([body, sh])
         space.add(*shapes)
-        index = {b.name: body for b, body in zip(scene.bodies, self.bodies, strict=True)}
+        index = {b.name: i for i, b in enumerate(scene.bodies)}
         for j in scene.joints:
-            joint = pymunk.PivotJoint(index[j.a], index[j.b] if j.b else static, j.anchor)
+            # Anchors in body coordinates from the scene's pose (the bodies sit half a step back).
+            ia, ib = index[j.a], (index[j.b] if j.b else None)
+            joint = pymunk.PivotJoint(
+                self.bodies[ia],
+                self.bodies[ib] if ib is not None else static,
+                _local(com[ia], j.anchor),
+                _local(com[ib], j.anchor) if ib is not None else j.anchor,
+            )
             joint.collide_bodies = False  # as Box2D's default for joined bodies
             space.add(joint)
+        if velocity_threshold > 0:
+            space.on_collision(begin=_inelastic_below(velocity_threshold))
         self.space = space
 
     def step(self, h: float) -> None:
         self.space.step(h)
 
     def read(self) -> list[float]:
+        h = self.h
         out: list[float] = []
         for b in self.bodies:
-            p, v = b.position, b.velocity
-            out += (p.x, p.y, b.angle, v.x, v.y, b.angular_velocity)
+            (px, py), (vx, vy), w = b.position, b.velocity, b.angular_velocity
+            out += (px + h * vx, py + h * vy, b.angle + h * w, vx, vy, w)
         return out
 
     def apply_force(self, i: int, fx: float, fy: float) -> None:
@@ -69,20 +95,52 @@ class PymunkWorld:
         self.bodies[i].torque += tau
 
     def apply_impulse(self, i: int, jx: float, jy: float) -> None:
-        b = self.bodies[i]
-        b.apply_impulse_at_world_point((jx, jy), b.position)
+        # The velocity change must not move the already-reported position x + h v.
+        b, h = self.bodies[i], self.h
+        dvx, dvy = jx / b.mass, jy / b.mass
+        b.velocity = (b.velocity.x + dvx, b.velocity.y + dvy)
+        b.position = (b.position.x - h * dvx, b.position.y - h * dvy)
+
+
+def _inelastic_below(threshold: float) -> Callable[[Any, Any, Any], None]:
+    """A ``begin`` handler that makes a contact inelastic when its bodies first meet slower than
+    ``threshold`` m/s along the normal, as Box2D's ``b2_velocityThreshold`` does."""
+
+    def begin(arbiter: Any, space: Any, data: Any) -> None:
+        points = arbiter.contact_point_set.points
+        if not points:
+            return
+        a, b = arbiter.bodies
+        p = points[0].point_a
+        if (b.velocity_at_world_point(p) - a.velocity_at_world_point(p)).dot(arbiter.normal) > -threshold:
+            arbiter.restitution = 0.0
+
+    return begin
+
+
+def _local(pose: tuple[float, ...], point: tuple[float, float]) -> tuple[float, float]:
+    """``point`` (world) in the frame of a body whose CoM pose is ``(x, y, angle, ...)``."""
+    x, y, a = pose[0], pose[1], pose[2]
+    c, s = math.cos(a), math.sin(a)
+    dx, dy = point[0] - x, point[1] - y
+    return (c * dx + s * dy, -s * dx + c * dy)
 
 
 class PymunkSimulator(SteppingSimulator):
-    """Chipmunk2D through pymunk: iterative impulse solver, ``iterations`` per step."""
+    """Chipmunk2D through pymunk: iterative impulse solver, ``iterations`` per step.
+
+    ``velocity_threshold`` (m/s, default 0: off) makes contacts that begin slower than it
+    inelastic, mimicking Box2D's compiled-in 1 m/s; it costs a Python call per new contact.
+    """
 
     name: ClassVar[str] = "pymunk"
 
-    def __init__(self, iterations: int = 10) -> None:
+    def __init__(self, iterations: int = 10, velocity_threshold: float = 0.0) -> None:
         self.iterations = iterations
+        self.velocity_threshold = velocity_threshold
 
     def build(self, scene: Scene) -> PymunkWorld:
-        return PymunkWorld(scene, self.iterations)
+        return PymunkWorld(scene, self.iterations, self.velocity_threshold)
 
 
 @hookimpl

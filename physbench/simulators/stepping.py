@@ -21,10 +21,17 @@ from physbench.trajectory import Trajectory
 
 #: A body that leaves the world bounds by more than this many world sizes has exploded.
 ESCAPE_MARGIN = 1.0
+#: A body at this fraction of an engine's speed limit has been clamped by the engine.
+SPEED_LIMIT_FRACTION = 0.99
 
 
 class EngineWorld(Protocol):
     """One built scene inside a concrete engine. Body order is ``scene.bodies`` order."""
+
+    #: Largest speed (m/s) and angular speed (rad/s) the engine lets a body reach at this step
+    #: size (``math.inf`` when it never clamps; may be left out). A body at the limit has exploded.
+    max_speed: float
+    max_angular_speed: float
 
     def step(self, h: float) -> None: ...
 
@@ -58,25 +65,32 @@ def initial_com_state(scene: Scene) -> list[tuple[float, float, float, float, fl
     return out
 
 
-def _schedule(scene: Scene, h: float, n_sub: int) -> dict[int, list[tuple[str, int, float, float]]]:
-    """Substep index -> [(kind, body index, x, y)] for every force or impulse acting then."""
-    sched: dict[int, list[tuple[str, int, float, float]]] = {}
+Action = tuple[bool, int, float, float]  # (is impulse, body index, x, y)
+
+
+def _schedule(scene: Scene, h: float, n_sub: int) -> dict[int, list[Action]]:
+    """Substep index -> actions applied just before that substep."""
+    sched: dict[int, list[Action]] = {}
     index = {b.name: i for i, b in enumerate(scene.bodies)}
     for f in scene.forces:
         i = index[f.body]
         if f.kind == "impulse":
             k = max(0, math.ceil(f.start / h - 1e-9))
             if k < n_sub:
-                sched.setdefault(k, []).append(("impulse", i, *f.vector))
+                sched.setdefault(k, []).append((True, i, *f.vector))
         else:
             # A substep [k h, (k+1) h) feels the force by the fraction of it inside the window,
-            # so short windows act the same whatever the substep count.
-            k0, k1 = int(math.floor(f.start / h)), min(n_sub, math.ceil(f.end / h))
+            # so Δv = F (end - start) / m exactly, whatever the substep count.
+            k0, k1 = math.floor(f.start / h), min(n_sub, math.ceil(f.end / h))
             for k in range(max(0, k0), k1):
                 frac = (min(f.end, (k + 1) * h) - max(f.start, k * h)) / h
                 if frac > 1e-12:
-                    sched.setdefault(k, []).append(("force", i, f.vector[0] * frac, f.vector[1] * frac))
+                    sched.setdefault(k, []).append((False, i, f.vector[0] * frac, f.vector[1] * frac))
     return sched
+
+
+class _EffectFailed(Exception):
+    """Carries an effect's own exception through the engine-error handler unchanged."""
 
 
 class SteppingSimulator:
@@ -97,33 +111,53 @@ class SteppingSimulator:
     ) -> Trajectory:
         if params:
             scene = scene.with_params(params)
-        world = self.build(scene)
+        try:
+            world = self.build(scene)
+        except SimulationError:
+            raise
+        except Exception as exc:  # engines reject absurd values with assorted exception types
+            raise SimulationError(
+                f"engine cannot build the scene: {type(exc).__name__}: {exc}", engine=self.name, frame=0
+            ) from exc
         T, n_sub = scene.frames, scene.substeps
         h = scene.dt / n_sub
         sched = _schedule(scene, h, (T - 1) * n_sub)
+        vmax = getattr(world, "max_speed", math.inf)  # optional for third-party worlds
+        if math.isfinite(vmax):
+            self._check_actions(scene, sched, vmax, h, n_sub)
+        busy = {k // n_sub for k in sched}  # frames (0-based intervals) with forces or impulses
         n = len(scene.bodies)
-        rows = [world.read()]
-        k = 0
-        for _ in range(T - 1):
-            for _ in range(n_sub):
-                acts = sched.get(k)
-                if acts:
-                    for kind, i, x, y in acts:
-                        (world.apply_impulse if kind == "impulse" else world.apply_force)(i, x, y)
-                if effects:
-                    state = np.asarray(world.read()).reshape(n, 6)
-                    for eff in effects:
-                        fxy, tau = eff.forces(k * h, state)
-                        for i in range(n):
-                            if fxy[i, 0] or fxy[i, 1]:
-                                world.apply_force(i, float(fxy[i, 0]), float(fxy[i, 1]))
-                            if tau[i]:
-                                world.apply_torque(i, float(tau[i]))
-                world.step(h)
-                k += 1
-            rows.append(world.read())
-        states = np.asarray(rows, dtype=float).reshape(T, n, 6)
-        self._check(scene, states)
+        step, read = world.step, world.read
+        rows = [read()]
+        frame, culprit = 0, None
+        try:
+            for frame in range(1, T):
+                if not effects and frame - 1 not in busy:
+                    for _ in range(n_sub):
+                        step(h)
+                else:
+                    for k in range((frame - 1) * n_sub, frame * n_sub):
+                        for impulse, culprit, x, y in sched.get(k, ()):
+                            (world.apply_impulse if impulse else world.apply_force)(culprit, x, y)
+                        culprit = None
+                        if effects:
+                            self._apply_effects(world, effects, k * h, n)
+                        step(h)
+                row = read()
+                rows.append(row)
+                if not math.isfinite(sum(row)):  # stop early: NaN only spreads (and can stall engines)
+                    break
+        except _EffectFailed as exc:
+            raise exc.__cause__ from None  # type: ignore[misc]
+        except Exception as exc:
+            body = scene.bodies[culprit].name if culprit is not None else None
+            raise SimulationError(
+                f"engine failed: {type(exc).__name__}: {exc}", engine=self.name, frame=frame, body=body
+            ) from exc
+        states = np.asarray(rows, dtype=float).reshape(len(rows), n, 6)
+        self._check(scene, states, world)
+        if len(rows) < T:  # the sum overflowed although every value is finite: still an explosion
+            raise SimulationError("state overflowed", engine=self.name, frame=len(rows) - 1)
         if any(b.com_offset != (0.0, 0.0) for b in scene.bodies):
             r = com_offsets_world(scene, states[:, :, 2])  # centre -> CoM
             w = states[:, :, 5]
@@ -132,20 +166,66 @@ class SteppingSimulator:
             states[:, :, 4] -= w * r[:, :, 0]
         return Trajectory(scene.body_names, np.arange(T) / scene.fps, states, engine=self.name)
 
-    def _check(self, scene: Scene, states: np.ndarray) -> None:
-        bad = ~np.isfinite(states).all(axis=2)
-        if bad.any():
-            t, i = np.argwhere(bad)[0]
-            raise SimulationError("state became NaN/inf", engine=self.name, frame=int(t), body=scene.bodies[i].name)
+    def _check_actions(
+        self, scene: Scene, sched: dict[int, list[Action]], vmax: float, h: float, n_sub: int
+    ) -> None:
+        """Raise for a force or impulse that alone would push a body past the engine's speed limit
+        within one step (the engine would clamp it silently, possibly between two frames)."""
+        for k, acts in sched.items():
+            for impulse, i, x, y in acts:
+                body = scene.bodies[i]
+                dv = math.hypot(x, y) / body.mass * (1.0 if impulse else h)
+                if dv >= SPEED_LIMIT_FRACTION * vmax:
+                    raise SimulationError(
+                        f"{'impulse' if impulse else 'force'} changes the speed by {dv:.3g} m/s in one step; "
+                        f"the engine clamps speeds above {vmax:.3g} m/s at this step size",
+                        engine=self.name,
+                        frame=k // n_sub + 1,
+                        body=body.name,
+                    )
+
+    @staticmethod
+    def _apply_effects(world: EngineWorld, effects: Sequence[Effect], t: float, n: int) -> None:
+        state = np.asarray(world.read()).reshape(n, 6)
+        for eff in effects:
+            try:
+                fxy, tau = eff.forces(t, state)
+            except Exception as exc:
+                raise _EffectFailed from exc
+            for i in range(n):
+                if fxy[i, 0] or fxy[i, 1]:
+                    world.apply_force(i, float(fxy[i, 0]), float(fxy[i, 1]))
+                if tau[i]:
+                    world.apply_torque(i, float(tau[i]))
+
+    def _check(self, scene: Scene, states: np.ndarray, world: EngineWorld) -> None:
+        """Raise for the earliest frame where a body is NaN, far outside the world, or at the
+        engine's speed limit."""
         xmin, ymin, xmax, ymax = scene.bounds
         mx, my = ESCAPE_MARGIN * (xmax - xmin), ESCAPE_MARGIN * (ymax - ymin)
         x, y = states[:, :, 0], states[:, :, 1]
+        nan = ~np.isfinite(states).all(axis=2)
         out = (x < xmin - mx) | (x > xmax + mx) | (y < ymin - my) | (y > ymax + my)
-        if out.any():
-            t, i = np.argwhere(out)[0]
-            raise SimulationError(
-                f"body left the world {tuple(scene.bounds)} (at x={x[t, i]:.3g}, y={y[t, i]:.3g})",
-                engine=self.name,
-                frame=int(t),
-                body=scene.bodies[i].name,
+        fast = np.zeros_like(out)
+        vmax, wmax = getattr(world, "max_speed", math.inf), getattr(world, "max_angular_speed", math.inf)
+        if math.isfinite(vmax):
+            with np.errstate(invalid="ignore", over="ignore"):
+                fast |= np.hypot(states[:, :, 3], states[:, :, 4]) >= SPEED_LIMIT_FRACTION * vmax
+        if math.isfinite(wmax):
+            with np.errstate(invalid="ignore"):
+                fast |= np.abs(states[:, :, 5]) >= SPEED_LIMIT_FRACTION * wmax
+        bad = nan | out | fast
+        if not bad.any():
+            return
+        t, i = np.unravel_index(int(np.argmax(bad)), bad.shape)  # earliest frame, then first body
+        if nan[t, i]:
+            why = "state became NaN/inf"
+        elif out[t, i]:
+            why = f"body left the world {tuple(scene.bounds)} (at x={x[t, i]:.3g}, y={y[t, i]:.3g})"
+        else:
+            why = (
+                f"speed reached the engine's limit ({vmax:.3g} m/s, {wmax:.3g} rad/s at this step size; "
+                f"v={math.hypot(states[t, i, 3], states[t, i, 4]):.3g} m/s, ω={states[t, i, 5]:.3g} rad/s): "
+                "the engine clamped it; more substeps raise the limit"
             )
+        raise SimulationError(why, engine=self.name, frame=int(t), body=scene.bodies[i].name)

@@ -1,0 +1,198 @@
+"""``physbench run``: the correction loop on a simulated (or given) observation.
+
+By default the observation is simulated: for ``--seed`` the scene instance, random true
+parameters and a random initial guess all derive from that seed. ``--observation FILE`` uses
+a user's frames instead (format: :mod:`physbench.observation`); there is no truth then, so only
+image MSE is reported.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--estimator", default="tpe", metavar="NAME", help="correction estimator (default: tpe; see `physbench plugins`)")
+    p.add_argument(
+        "-o", "--option", action="append", default=[], metavar="KEY=VALUE",
+        help="estimator option, repeatable, e.g. -o startup=5 or -o sampler=cmaes (values parse as JSON, else text)",
+    )
+    p.add_argument("--scene", default="three_circles", metavar="NAME|FILE", help="registered scene or scene TOML (default: three_circles)")
+    p.add_argument(
+        "--params", nargs="+", default=["mass"], metavar="PARAM",
+        help="unknown parameters to identify, e.g. mass or mass elasticity (commas work too; default: mass)",
+    )
+    p.add_argument("--bodies", nargs="+", default=None, metavar="BODY", help="only these bodies' unknowns (default: all)")
+    p.add_argument("--iterations", type=int, default=11, metavar="N", help="simulations = propose calls (default: 11, as in the paper)")
+    p.add_argument("--seed", type=int, default=0, help="scene instance, truth, initial guess and estimator seed (default: 0)")
+    p.add_argument("--engine", default="pymunk", metavar="NAME", help="simulator of the model (default: pymunk)")
+    p.add_argument(
+        "--observe-engine", default=None, metavar="NAME",
+        help="simulator that makes the observation (default: --engine); another engine gives a sim-to-sim reality gap",
+    )
+    p.add_argument("--resolution", type=int, default=64, metavar="PX", help="frame width in pixels (default: 64)")
+    p.add_argument("--render-mode", default="mark", choices=("mark", "instance", "mask"), help="raster channels (default: mark)")
+    p.add_argument("--blur", type=float, default=0.0, metavar="SIGMA", help="Gaussian blur (pixels) of the observation only; the model stays sharp")
+    p.add_argument("--noise", type=float, default=0.0, metavar="SIGMA", help="Gaussian pixel noise of the observation only")
+    p.add_argument("--observation", default=None, metavar="FILE", help="observed frames (.npz with key 'frames', (T, C, H, W) in [0, 1])")
+    p.add_argument("--save-observation", default=None, metavar="FILE", help="write the observation used to FILE (.npz)")
+    p.add_argument("--json", action="store_true", help="print the history as JSON instead of the table")
+    p.add_argument("--plot", default=None, metavar="FILE", help="convergence plot (best-so-far errors per iteration), e.g. out.png")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress display or table: only the final line (or the JSON)")
+
+
+def parse_options(items: list[str]) -> dict[str, Any]:
+    """``["startup=5", "sampler=cmaes"]`` -> ``{"startup": 5, "sampler": "cmaes"}``."""
+    from physbench.errors import PhysbenchError
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        if not sep or not key.strip():
+            raise PhysbenchError(f"--option {item!r}: expected KEY=VALUE, e.g. startup=5")
+        try:
+            value = json.loads(raw)
+        except ValueError:
+            value = raw
+        out[key.strip()] = value
+    return out
+
+
+def _estimator(name: str, options: dict[str, Any]) -> Any:
+    import inspect
+
+    from physbench.errors import PhysbenchError
+    from physbench.plugins import get_registry
+
+    cls = get_registry().get("estimator", name)
+    try:
+        return cls(**options)
+    except TypeError as exc:
+        try:
+            accepted = [q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")]
+        except (TypeError, ValueError):
+            accepted = []
+        raise PhysbenchError(
+            f"estimator {name!r} does not take options {options}: {exc}; its options: {', '.join(accepted) or 'none'}"
+        ) from None
+
+
+def _fmt(v: float | None) -> str:
+    return "-" if v is None else f"{v:.3e}"
+
+
+def print_table(history: Any, out: Any = sys.stdout) -> None:
+    """The per-iteration table: parameters, image MSE, normalized MSE, best-so-far, timings (ms)."""
+    keys = list(history.keys)
+    has_truth = history.truth is not None
+    head = ["iter", *keys, "image MSE"] + (["norm MSE"] if has_truth else []) + ["best", "best image"]
+    head += (["best norm"] if has_truth else []) + ["sim ms", "render ms", "est ms"]
+    rows = []
+    for r in history.records:
+        row = [str(r.iteration), *(f"{r.params[k]:.4g}" for k in keys), _fmt(r.loss)]
+        row += [_fmt(r.nmse)] if has_truth else []
+        row += [str(r.best_iteration), _fmt(r.best_loss)] + ([_fmt(r.best_nmse)] if has_truth else [])
+        row += [f"{1e3 * r.t_simulate:.2f}", f"{1e3 * r.t_render:.2f}", f"{1e3 * r.t_estimator:.2f}"]
+        if r.failed:
+            row[-1] += f"  (simulation failed: {r.failed})"
+        rows.append(row)
+    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(head)]
+    print("  ".join(h.rjust(w) for h, w in zip(head, widths, strict=True)), file=out)
+    for row in rows:
+        print("  ".join(c.rjust(w) for c, w in zip(row, widths, strict=False)) + "".join(row[len(widths):]), file=out)
+
+
+def main(args: argparse.Namespace) -> int:
+    from physbench.errors import PhysbenchError
+
+    if args.iterations < 1:
+        raise PhysbenchError(f"--iterations {args.iterations}: expected a whole number >= 1")
+    if args.seed < 0:
+        raise PhysbenchError(f"--seed {args.seed}: expected a whole number >= 0")
+    if args.observation and (args.observe_engine or args.blur or args.noise):
+        raise PhysbenchError(
+            "--observe-engine, --blur and --noise shape a simulated observation; they cannot apply to --observation frames"
+        )
+
+    from physbench.loop import draw_problem, refine
+    from physbench.observation import load_observation, save_observation, simulate_observation
+    from physbench.params import ParamSpace
+    from physbench.plugins import create
+    from physbench.scenes import resolve_scene
+
+    scene = resolve_scene(args.scene, args.seed)
+    params = [q for item in args.params for q in item.split(",") if q]
+    bodies = None if args.bodies is None else [b for item in args.bodies for b in item.split(",") if b]
+    space = ParamSpace.from_scene(scene, params, bodies)
+    estimator = _estimator(args.estimator, parse_options(args.option))
+    simulator = create("simulator", args.engine)
+    model_renderer = create("renderer", "raster", resolution=args.resolution, mode=args.render_mode)
+    per_object = bool(getattr(estimator, "per_object", False))
+    truth, initial = draw_problem(space, args.seed)
+    if args.observation:
+        obs = load_observation(args.observation)
+    else:
+        observer = create("simulator", args.observe_engine or args.engine)
+        obs_renderer = create(
+            "renderer", "raster", resolution=args.resolution, mode=args.render_mode,
+            blur=args.blur, noise=args.noise, seed=args.seed,
+        )
+        obs = simulate_observation(scene, truth, observer, obs_renderer, marked=space.bodies if per_object else ())
+    if args.save_observation:
+        save_observation(args.save_observation, obs)
+
+    from tqdm import tqdm
+
+    bar = tqdm(total=args.iterations, desc=f"{args.estimator} on {scene.name}", unit="it", file=sys.stderr,
+               disable=True if args.quiet else None, leave=False)
+
+    def progress(rec: Any) -> None:
+        post = {"best image": f"{rec.best_loss:.2e}"}
+        if rec.best_nmse is not None:
+            post["best norm"] = f"{rec.best_nmse:.2e}"
+        bar.set_postfix(post, refresh=False)
+        bar.update(1)
+
+    try:
+        history = refine(
+            obs, scene, space, simulator, model_renderer, estimator,
+            iterations=args.iterations, seed=args.seed, initial=initial, callback=progress,
+        )
+    finally:
+        bar.close()
+    history.meta.update(
+        observe_engine=None if args.observation else (args.observe_engine or args.engine),
+        blur=args.blur, noise=args.noise, resolution=args.resolution, render_mode=args.render_mode,
+    )
+
+    if args.plot:
+        from physbench.plotting.convergence import plot_convergence
+
+        plot_convergence({f"{history.estimator}": [history]}, args.plot, title=f"{scene.name}: {', '.join(space.keys)}")
+
+    if args.json:
+        print(history.to_json(indent=1))
+        return 0
+    n = len(history)
+    if not args.quiet:
+        print_table(history)
+        t = history.timings()
+        print(
+            f"per iteration: simulate {1e3 * t['simulate']:.2f} ms, render {1e3 * t['render']:.2f} ms, "
+            f"estimator {1e3 * t['estimator']:.2f} ms"
+        )
+        best = history.best
+        if history.truth is not None:
+            print("truth:   " + "  ".join(f"{k}={v:.4g}" for k, v in history.truth.items()))
+        print(f"best (iteration {best.iteration}, by image MSE): " + "  ".join(f"{k}={v:.4g}" for k, v in best.params.items()))
+    if history.min_nmse is not None:
+        print(
+            f"normalized min MSE after {n} iterations: {history.min_nmse:.3e} "
+            f"(initial guess {history.initial_nmse:.3e}; min image MSE {history.min_loss:.3e})"
+        )
+    else:
+        print(f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation from {args.observation})")
+    return 0

@@ -1,0 +1,84 @@
+"""Built-in model extensions (:class:`~physbench.protocols.Effect` plugins).
+
+Each adds named parameters and acts through forces and torques that both engines apply the same
+way every substep. Measurement effects (:class:`SensorOffset`, :class:`ClockScale`) apply no forces
+and change the simulated trajectory through ``measure`` instead; :func:`apply_measurements` is what
+the framework calls on every simulated trajectory before comparing it with data.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from physbench.effects.base import (
+    EffectBase,
+    EffectError,
+    MeasurementEffect,
+    smooth_sign,
+    smooth_unit,
+)
+from physbench.effects.contact import VelocityDependentRestitution, restitution_law
+from physbench.effects.drag import LinearDrag, QuadraticDrag
+from physbench.effects.forces import ConstantForce, TableTilt
+from physbench.effects.joints import (
+    JointCoulombFriction,
+    JointQuadraticDamping,
+    JointViscousDamping,
+)
+from physbench.effects.measurement import ClockScale, SensorOffset
+from physbench.effects.surface import RollingResistance
+from physbench.hookspecs import hookimpl
+from physbench.trajectory import Trajectory
+
+#: Every built-in effect class, in registration order.
+BUILTIN_EFFECTS: tuple[type[EffectBase], ...] = (
+    LinearDrag,
+    QuadraticDrag,
+    RollingResistance,
+    ConstantForce,
+    TableTilt,
+    JointViscousDamping,
+    JointCoulombFriction,
+    JointQuadraticDamping,
+    VelocityDependentRestitution,
+    SensorOffset,
+    ClockScale,
+)
+
+
+def apply_measurements(traj: Trajectory, effects: Iterable[Any]) -> Trajectory:
+    """Called after every simulation: ``traj`` passed through the ``measure`` of each effect that
+    has one, in order. Effects without ``measure`` are skipped."""
+    for eff in effects:
+        if isinstance(eff, MeasurementEffect):
+            traj = eff.measure(traj)
+    return traj
+
+
+@hookimpl
+def register_effects() -> list[type[Any]]:
+    return list(BUILTIN_EFFECTS)
+
+
+__all__ = [
+    "BUILTIN_EFFECTS",
+    "ClockScale",
+    "ConstantForce",
+    "EffectBase",
+    "EffectError",
+    "JointCoulombFriction",
+    "JointQuadraticDamping",
+    "JointViscousDamping",
+    "LinearDrag",
+    "MeasurementEffect",
+    "QuadraticDrag",
+    "RollingResistance",
+    "SensorOffset",
+    "TableTilt",
+    "VelocityDependentRestitution",
+    "apply_measurements",
+    "restitution_law",
+    "smooth_sign",
+    "smooth_unit",
+]

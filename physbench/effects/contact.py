@@ -1,0 +1,52 @@
+"""Contact laws that replace the scene's constant restitution.
+
+These need a per-contact engine hook that the simulators do not offer yet (see
+:meth:`VelocityDependentRestitution.restitution`); until then the effect applies no forces.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from physbench.effects.base import EffectBase
+from physbench.protocols import EffectParam
+
+
+def restitution_law(normal_speed: float | np.ndarray, e0: float, k: float) -> float | np.ndarray:
+    """``e(v) = clip(e0 - k·|v|, 0, 1)``: restitution falling linearly with normal impact speed."""
+    e = np.clip(e0 - k * np.abs(normal_speed), 0.0, 1.0)
+    return float(e) if np.ndim(e) == 0 else e
+
+
+class VelocityDependentRestitution(EffectBase):
+    """Coefficient of restitution ``e(v) = clip(e0 - k·v, 0, 1)`` for impacts at normal speed ``v``
+    (m/s), replacing the product of the two materials' elasticities.
+
+    ``statics_only`` restricts the law to contacts with static geometry (cushions, walls);
+    ``bodies`` restricts it to contacts involving the selected bodies.
+    """
+
+    name: ClassVar[str] = "velocity_dependent_restitution"
+    params: ClassVar[tuple[EffectParam, ...]] = (
+        EffectParam("e0", 0.9, 0.0, 1.0, "", "restitution of a very slow impact"),
+        EffectParam("k", 0.0, 0.0, 1.0, "s/m", "restitution lost per m/s of normal impact speed"),
+    )
+
+    def __init__(self, *, statics_only: bool = False, **kw: object) -> None:
+        super().__init__(**kw)  # type: ignore[arg-type]
+        self.statics_only = bool(statics_only)
+
+    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.zeros(states.shape[0])
+
+    def restitution(self, normal_speed: float, a: int, b: int | None) -> float | None:
+        """To be called by an engine when a new contact starts between body ``a`` and body ``b``
+        (``None``: static geometry), before the solver runs, with the approach speed along the
+        contact normal (>= 0). Returns the restitution to use, or ``None`` to keep the scene's."""
+        if self.statics_only and b is not None:
+            return None
+        if self.bodies is not None and not (self.mask[a] or (b is not None and self.mask[b])):
+            return None
+        return float(restitution_law(normal_speed, self.values["e0"], self.values["k"]))

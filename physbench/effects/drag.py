@@ -1,0 +1,45 @@
+"""Fluid drag on the translation of bodies: linear (Stokes) and quadratic (Newton) laws."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from physbench.effects.base import EffectBase
+from physbench.protocols import EffectParam
+
+
+class LinearDrag(EffectBase):
+    """``F = -c v`` on the centre of mass of each selected body (default: all)."""
+
+    name: ClassVar[str] = "linear_drag"
+    params: ClassVar[tuple[EffectParam, ...]] = (
+        EffectParam("c", 0.0, 0.0, 10.0, "N·s/m", "drag force per unit speed"),
+    )
+
+    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        self._require_setup(states)
+        f, tau = self.zeros(states.shape[0])
+        f[self.mask] = -self.values["c"] * states[self.mask, 3:5]
+        return f, tau
+
+
+class QuadraticDrag(EffectBase):
+    """``F = -c |v| v`` on the centre of mass of each selected body (default: all).
+
+    ``c = ½ ρ C_d A``; a body of mass ``m`` falling under ``g`` tends to ``sqrt(m g / c)``.
+    """
+
+    name: ClassVar[str] = "quadratic_drag"
+    params: ClassVar[tuple[EffectParam, ...]] = (
+        EffectParam("c", 0.0, 0.0, 1.0, "kg/m", "drag force per unit squared speed"),
+    )
+
+    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        self._require_setup(states)
+        f, tau = self.zeros(states.shape[0])
+        v = states[self.mask, 3:5]
+        speed = np.sqrt((v * v).sum(axis=1, keepdims=True))
+        f[self.mask] = -self.values["c"] * speed * v
+        return f, tau

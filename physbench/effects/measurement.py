@@ -1,0 +1,71 @@
+"""Measurement effects: they change what the sensor reports, not the motion.
+
+They return zero forces. The framework must call :meth:`measure` on every simulated trajectory
+(after simulating, before comparing with a recording or rendering the observation);
+:func:`physbench.effects.apply_measurements` does it for a list of effects.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from physbench.effects.base import EffectBase, EffectError
+from physbench.protocols import EffectParam
+from physbench.trajectory import Trajectory
+
+
+class _Measurement(EffectBase):
+    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.zeros(states.shape[0])
+
+    def _body_mask(self, traj: Trajectory) -> np.ndarray:
+        if self.bodies is None:
+            return np.ones(len(traj.bodies), dtype=bool)
+        missing = [b for b in self.bodies if b not in traj.bodies]
+        if missing:
+            raise EffectError(f"{self.name}: bodies {missing} are not in the trajectory (bodies: {list(traj.bodies)})")
+        return np.array([b in self.bodies for b in traj.bodies], dtype=bool)
+
+
+class SensorOffset(_Measurement):
+    """A constant bias added to the tracked ``x``, ``y`` and ``angle`` of each selected body
+    (default: all), e.g. an encoder zero that is not the rest angle."""
+
+    name: ClassVar[str] = "sensor_offset"
+    params: ClassVar[tuple[EffectParam, ...]] = (
+        EffectParam("dx", 0.0, -0.5, 0.5, "m", "bias of the tracked x"),
+        EffectParam("dy", 0.0, -0.5, 0.5, "m", "bias of the tracked y"),
+        EffectParam("dangle", 0.0, -0.5, 0.5, "rad", "bias of the tracked angle"),
+    )
+
+    def measure(self, traj: Trajectory) -> Trajectory:
+        """Called after every simulation: the trajectory shifted by the biases."""
+        states = traj.states.copy()
+        sel = self._body_mask(traj)
+        states[:, sel, 0] += self.values["dx"]
+        states[:, sel, 1] += self.values["dy"]
+        states[:, sel, 2] += self.values["dangle"]
+        return Trajectory(traj.bodies, traj.times, states, engine=traj.engine)
+
+
+class ClockScale(_Measurement):
+    """A recorder clock that runs at the wrong rate: a sample stamped ``t`` was taken at true time
+    ``scale·t`` (e.g. a logger whose nominal sample interval is shorter than the real one).
+
+    The measured trajectory is stamped ``t/scale`` and its velocities are per recorder second.
+    Simulate at least ``scale`` times the recording's duration.
+    """
+
+    name: ClassVar[str] = "clock_scale"
+    params: ClassVar[tuple[EffectParam, ...]] = (
+        EffectParam("scale", 1.0, 0.8, 1.25, "", "true seconds per recorded second"),
+    )
+
+    def measure(self, traj: Trajectory) -> Trajectory:
+        """Called after every simulation: the trajectory on the recorder's clock."""
+        s = self.values["scale"]
+        states = traj.states.copy()
+        states[:, :, 3:6] *= s
+        return Trajectory(traj.bodies, traj.times / s, states, engine=traj.engine)

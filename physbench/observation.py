@@ -1,0 +1,152 @@
+"""Observations: the frames the correction loop tries to reproduce, simulated or loaded from a file.
+
+File format (``.npz``, written by :func:`save_observation`, read by :func:`load_observation`):
+
+``frames``
+    required, ``(T, C, H, W)`` floats in [0, 1]; ``T`` must equal the scene's frame count and
+    ``C, H, W`` the model renderer's output (e.g. ``raster`` in ``mark`` mode: ``C = 2``, channel
+    0 every body, channel 1 empty; at ``--resolution 64`` on a square world ``H = W = 64``).
+``marked_<body>``
+    optional, same shape: the frames with ``<body>`` marked (rendered with ``focus=<body>``),
+    needed only by estimators that correct one marked object at a time.
+
+A file carries no true parameters, so a run on it reports only image MSE.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from physbench.errors import PhysbenchError
+
+if TYPE_CHECKING:
+    from physbench.params import Params
+    from physbench.protocols import Effect, Renderer, Simulator
+    from physbench.scene import Scene
+
+MARK_PREFIX = "marked_"
+
+
+class ObservationError(PhysbenchError, ValueError):
+    """An observation that does not fit the scene or renderer; names expected and got."""
+
+
+@dataclass
+class Observation:
+    """Observed frames, the true parameters when known, and per-body marked frames if any."""
+
+    frames: np.ndarray  # (T, C, H, W) float32 in [0, 1]
+    truth: Params | None = None
+    marked: dict[str, np.ndarray] = field(default_factory=dict)
+    source: str = ""
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(self.frames.shape)
+
+
+def expected_shape(renderer: Renderer, scene: Scene) -> tuple[int, int, int, int]:
+    """``(T, C, H, W)`` the renderer produces for ``scene``: from its ``shape()`` method when it has
+    one, else by rendering a one-frame still of the initial state (no simulation needed)."""
+    shape = getattr(renderer, "shape", None)
+    if callable(shape):
+        return tuple(int(v) for v in shape(scene))  # type: ignore[return-value]
+    from physbench.trajectory import Trajectory
+
+    n = len(scene.bodies)
+    states = np.zeros((1, n, 6))
+    for i, b in enumerate(scene.bodies):
+        states[0, i, :3] = (*b.position, b.angle)
+    frame = renderer.render(scene, Trajectory(scene.body_names, np.zeros(1), states))
+    return (scene.frames, *frame.shape[1:])  # type: ignore[return-value]
+
+
+def check_frames(frames: object, expected: Sequence[int], *, what: str = "observation") -> np.ndarray:
+    """``frames`` as float32 ``(T, C, H, W)``, or :class:`ObservationError` naming expected vs got."""
+    arr = np.asarray(frames)
+    if arr.dtype.kind not in "fiub":
+        raise ObservationError(f"{what}: expected numeric frames, got dtype {arr.dtype}")
+    exp = tuple(int(v) for v in expected)
+    if arr.shape != exp:
+        names = "(T, C, H, W)"
+        detail = ""
+        if arr.ndim == 4:
+            diffs = [f"{n} {g} != {e}" for n, g, e in zip("TCHW", arr.shape, exp, strict=True) if g != e]
+            detail = " (" + ", ".join(diffs) + ")"
+        raise ObservationError(
+            f"{what}: frames have shape {arr.shape}, expected {names} = {exp}{detail}; T is the scene's "
+            "frame count, C, H, W the renderer's channels and image size (check --resolution and the render mode)"
+        )
+    arr = arr.astype(np.float32, copy=False)
+    if not np.isfinite(arr).all():
+        raise ObservationError(f"{what}: frames contain NaN or inf")
+    lo, hi = float(arr.min()), float(arr.max())
+    if lo < -1e-6 or hi > 1 + 1e-6:
+        raise ObservationError(f"{what}: frame values span [{lo:g}, {hi:g}], expected values in [0, 1]")
+    return arr
+
+
+def validate(obs: Observation, expected: Sequence[int], *, bodies: Iterable[str] = ()) -> Observation:
+    """Check ``obs`` against the model's frame shape; ``bodies`` lists the marked frames required."""
+    what = obs.source or "observation"
+    frames = check_frames(obs.frames, expected, what=what)
+    marked = {b: check_frames(f, expected, what=f"{what} [{MARK_PREFIX}{b}]") for b, f in obs.marked.items()}
+    missing = [b for b in bodies if b not in marked]
+    if missing:
+        have = ", ".join(sorted(marked)) or "none"
+        raise ObservationError(
+            f"{what}: no marked frames for {', '.join(missing)} (have: {have}); an estimator that "
+            f"corrects one marked object at a time needs '{MARK_PREFIX}<body>' arrays for every unknown body"
+        )
+    return Observation(frames, obs.truth, marked, obs.source)
+
+
+def simulate_observation(
+    scene: Scene,
+    truth: Mapping[str, float],
+    simulator: Simulator,
+    renderer: Renderer,
+    *,
+    marked: Iterable[str] = (),
+    effects: Sequence[Effect] = (),
+) -> Observation:
+    """Simulate ``scene`` with the true parameters and render it (and once per ``marked`` body with
+    that body in focus). ``renderer`` is the observation model: blur or noise belong there."""
+    traj = simulator.simulate(scene, dict(truth), effects=effects)
+    frames = renderer.render(scene, traj)
+    focus = {b: renderer.render(scene, traj, focus=b) for b in marked}
+    return Observation(frames, dict(truth), focus, source=f"simulated ({getattr(simulator, 'name', '?')})")
+
+
+def save_observation(path: str | Path, obs: Observation) -> None:
+    """Write ``obs`` in the documented ``.npz`` format (truth is not stored)."""
+    arrays = {"frames": np.asarray(obs.frames, np.float32)}
+    arrays.update({MARK_PREFIX + b: np.asarray(f, np.float32) for b, f in obs.marked.items()})
+    np.savez_compressed(path, **arrays)  # type: ignore[arg-type]
+
+
+def load_observation(path: str | Path) -> Observation:
+    """Read an ``.npz`` observation; shape checks against a scene happen in :func:`validate`."""
+    p = Path(path)
+    if not p.is_file():
+        raise ObservationError(f"observation file {str(p)!r} does not exist")
+    try:
+        with np.load(p, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except Exception as exc:  # zip, pickle and format errors all mean "not a usable .npz"
+        raise ObservationError(f"{p}: cannot read as .npz ({type(exc).__name__}: {exc})") from None
+    if "frames" not in arrays:
+        raise ObservationError(
+            f"{p}: no 'frames' array (found: {', '.join(sorted(arrays)) or 'none'}); expected key 'frames' "
+            "holding (T, C, H, W) floats in [0, 1]"
+        )
+    frames = arrays.pop("frames")
+    if frames.ndim != 4:
+        raise ObservationError(f"{p}: 'frames' has shape {frames.shape}; expected 4 axes (T, C, H, W)")
+    marked = {k[len(MARK_PREFIX) :]: v for k, v in arrays.items() if k.startswith(MARK_PREFIX)}
+    return Observation(frames, None, marked, source=str(p))

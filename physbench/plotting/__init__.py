@@ -1,0 +1,1 @@
+"""Figures. Each module imports matplotlib (Agg backend) only inside its functions."""

@@ -1,0 +1,453 @@
+"""Recordings: tracked trajectories of real (or simulated) bodies, and their CSV format.
+
+A recording file is CSV with a header naming the columns ``t, body, x, y`` and optionally
+``angle`` and ``run``, in any order (SI units: s, m, rad; ``x, y`` is the centre of the body's shape,
+as in a :class:`~physbench.trajectory.Trajectory`). Rows may come in any order and each body may be
+sampled at its own, irregular times. Rules:
+
+- ``t >= 0``: recording time ``t`` is simulation time ``t`` (a scene starts at 0);
+- within one run, a body has at most one sample per time (a repeated time is an error, as is a
+  contradictory one: rows are sorted by time, so "time going backwards" can only show as a repeat);
+- ``angle`` may be left empty for a body that has no measured angle, but then for all of that
+  body's rows in the run;
+- ``run`` labels several runs in one file (any non-empty text); without it the file holds one run;
+- blank lines and lines starting with ``#`` are skipped.
+
+Errors name the line (1 = header), the data row (1 = first row after the header) and the column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from physbench.errors import PhysbenchError
+
+if TYPE_CHECKING:
+    from physbench.scene import Scene
+    from physbench.trajectory import Trajectory
+
+REQUIRED_COLUMNS = ("t", "body", "x", "y")
+OPTIONAL_COLUMNS = ("angle", "run")
+#: Pose fields a recording can hold, and the trajectory state column of each and of its rate.
+POSE_FIELDS = ("x", "y", "angle")
+_STATE_COLUMN = {"x": (0, 3), "y": (1, 4), "angle": (2, 5)}
+
+
+class RecordingError(PhysbenchError, ValueError):
+    """A malformed recording or a recording that does not fit a simulation."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        source: str = "",
+        line: int | None = None,
+        row: int | None = None,
+        column: str | None = None,
+    ) -> None:
+        self.source, self.line, self.row, self.column, self.reason = source, line, row, column, message
+        where = []
+        if line is not None:
+            where.append(f"line {line} ({'header' if row is None else f'data row {row}'})")
+        if column is not None:
+            where.append(f"column {column!r}")
+        prefix = f"{source}: " if source else ""
+        super().__init__(prefix + (", ".join(where) + ": " if where else "") + message)
+
+
+@dataclass(frozen=True, eq=False)
+class Track:
+    """One body's samples in one run, sorted by strictly increasing time ``t`` (s)."""
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    angle: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        arrays = {"t": self.t, "x": self.x, "y": self.y}
+        if self.angle is not None:
+            arrays["angle"] = self.angle
+        n = None
+        for name, arr in arrays.items():
+            a = np.asarray(arr, dtype=float)
+            if a.ndim != 1 or a.size == 0 or (n is not None and a.size != n):
+                raise RecordingError(f"track {name} must be a non-empty 1-D array as long as t, got shape {a.shape}")
+            if not np.isfinite(a).all():
+                raise RecordingError(f"track {name} has NaN/inf at sample {int(np.argmin(np.isfinite(a)))}")
+            n = a.size
+            object.__setattr__(self, name, a)
+        bad = np.nonzero(np.diff(self.t) <= 0)[0]
+        if bad.size:
+            i = int(bad[0]) + 1
+            raise RecordingError(f"track times must increase strictly; t[{i}] = {self.t[i]!r} follows {self.t[i - 1]!r}")
+        if self.t[0] < 0:
+            raise RecordingError(f"track times must be >= 0 (simulations start at t = 0), got {self.t[0]!r}")
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def fields(self) -> tuple[str, ...]:
+        return POSE_FIELDS if self.angle is not None else POSE_FIELDS[:2]
+
+    def values(self, name: str) -> np.ndarray:
+        if name == "angle" and self.angle is None:
+            raise RecordingError("this track has no angle")
+        return getattr(self, name)
+
+
+@dataclass(frozen=True, eq=False)
+class Recording:
+    """The tracked bodies of one run. ``fields`` names the pose fields that were measured (the
+    default of :meth:`residuals`; ``None`` = all the tracks hold), since a loader may have to fill
+    in a coordinate the format requires but the sensor did not see."""
+
+    tracks: Mapping[str, Track]
+    run: str = ""
+    fields: tuple[str, ...] | None = None
+    source: str = ""
+    meta: Mapping[str, object] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not self.tracks:
+            raise RecordingError("a recording needs at least one tracked body")
+        if self.fields is not None:
+            for f in self.fields:
+                if f not in POSE_FIELDS:
+                    raise RecordingError(f"unknown field {f!r}; fields: {', '.join(POSE_FIELDS)}")
+
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        return tuple(self.tracks)
+
+    def track(self, body: str) -> Track:
+        try:
+            return self.tracks[body]
+        except KeyError:
+            from physbench.errors import UnknownNameError
+
+            raise UnknownNameError(f"body of recording {self.run!r}", body, self.tracks) from None
+
+    @property
+    def t_end(self) -> float:
+        """Time of the last sample of any body (s)."""
+        return max(float(tr.t[-1]) for tr in self.tracks.values())
+
+    @property
+    def n_samples(self) -> int:
+        return sum(len(tr) for tr in self.tracks.values())
+
+    def frames_for(self, fps: float, scale: float = 1.0) -> int:
+        """Frames a simulation at ``fps`` needs to cover the recording (``scale``: see
+        :class:`~physbench.effects.ClockScale`)."""
+        return math.ceil(self.t_end * scale * fps - 1e-9) + 1
+
+    def _fields(self, fields: Sequence[str] | None) -> tuple[str, ...]:
+        if fields is None:
+            fields = self.fields if self.fields is not None else POSE_FIELDS
+            return tuple(f for f in fields if any(f in tr.fields for tr in self.tracks.values()))
+        for f in fields:
+            if f not in POSE_FIELDS:
+                raise RecordingError(f"unknown field {f!r}; fields: {', '.join(POSE_FIELDS)}")
+            if not any(f in tr.fields for tr in self.tracks.values()):
+                raise RecordingError(f"no track of recording {self.run!r} has field {f!r}")
+        return tuple(fields)
+
+    # ------------------------------------------------------------------ comparison with a simulation
+
+    def sample(self, traj: Trajectory, *, method: str = "hermite") -> Recording:
+        """The simulated poses at this recording's sample times, as a recording of the same
+        shape. ``hermite`` interpolates each frame interval with the simulated velocities (error
+        O(dt⁴) for smooth motion); ``linear`` ignores them."""
+        if method not in ("hermite", "linear"):
+            raise RecordingError(f"unknown interpolation {method!r}; known: hermite, linear")
+        times = np.asarray(traj.times, dtype=float)
+        tracks: dict[str, Track] = {}
+        for body, tr in self.tracks.items():
+            if body not in traj.bodies:
+                raise RecordingError(
+                    f"recorded body {body!r} is not simulated; simulated bodies: {', '.join(traj.bodies)}",
+                    source=self.source,
+                )
+            lo, hi = times[0], times[-1]
+            tol = 1e-9 * max(1.0, abs(hi))
+            if tr.t[0] < lo - tol or tr.t[-1] > hi + tol:
+                raise RecordingError(
+                    f"run {self.run!r}, body {body!r}: samples span t = {tr.t[0]:g}..{tr.t[-1]:g} s but the "
+                    f"simulation covers {lo:g}..{hi:g} s; simulate more frames "
+                    f"(at least {self.frames_for(1.0 / (times[1] - times[0])) if times.size > 1 else 'more'})",
+                    source=self.source,
+                )
+            state = traj.body(body)
+            vals = {}
+            for f in tr.fields:
+                p, v = _STATE_COLUMN[f]
+                vals[f] = _interpolate(times, state[:, p], state[:, v], tr.t, method == "hermite")
+            tracks[body] = Track(tr.t, vals["x"], vals["y"], vals.get("angle"))
+        return Recording(tracks, run=self.run, fields=self.fields, source=f"simulated ({traj.engine})", meta=self.meta)
+
+    def residuals(
+        self,
+        traj: Trajectory,
+        *,
+        fields: Sequence[str] | None = None,
+        bodies: Iterable[str] | None = None,
+        method: str = "hermite",
+    ) -> np.ndarray:
+        """Simulated minus recorded, flat, ordered by body, then field, then time; angles wrapped
+        to [-π, π). Called by discovery after every simulation (pass the trajectory through the
+        measurement effects first). Tracks without a requested field are skipped."""
+        names = self.bodies if bodies is None else tuple(bodies)
+        want = self._fields(fields)
+        sim = self.sample(traj, method=method)
+        parts = []
+        for body in names:
+            rec, got = self.track(body), sim.tracks[body]
+            for f in want:
+                if f not in rec.fields:
+                    continue
+                d = got.values(f) - rec.values(f)
+                if f == "angle":
+                    d = (d + math.pi) % (2 * math.pi) - math.pi
+                parts.append(d)
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def rms(self, traj: Trajectory, *, fields: Sequence[str] | None = None, method: str = "hermite") -> dict[str, float]:
+        """Root-mean-square residual per field over all bodies (m or rad)."""
+        return {f: float(np.sqrt(np.mean(self.residuals(traj, fields=[f], method=method) ** 2))) for f in self._fields(fields)}
+
+    # ------------------------------------------------------------------ construction
+
+    @classmethod
+    def from_trajectory(
+        cls,
+        traj: Trajectory,
+        *,
+        times: Mapping[str, np.ndarray] | np.ndarray | None = None,
+        bodies: Iterable[str] | None = None,
+        angle: bool = True,
+        run: str = "",
+        fields: tuple[str, ...] | None = None,
+    ) -> Recording:
+        """A recording of a simulated trajectory, at its frame times or at ``times`` (one array
+        for all bodies or one per body), e.g. to make synthetic data for a discovery test."""
+        names = traj.bodies if bodies is None else tuple(bodies)
+        if times is None:
+            tracks = {b: Track(traj.times, traj.body(b)[:, 0], traj.body(b)[:, 1], traj.body(b)[:, 2]) for b in names}
+        else:
+            tracks = {}
+            for b in names:
+                tb = np.asarray(times[b] if isinstance(times, Mapping) else times, dtype=float)
+                zero = np.zeros_like(tb)
+                tracks[b] = Track(tb, zero, zero, zero if angle else None)  # times only: resampled below
+            tracks = dict(cls(tracks).sample(traj).tracks)
+        if not angle:
+            tracks = {b: Track(tr.t, tr.x, tr.y) for b, tr in tracks.items()}
+        return cls(tracks, run=run, fields=fields, source=f"simulated ({traj.engine})")
+
+
+def _interpolate(times: np.ndarray, p: np.ndarray, v: np.ndarray, tq: np.ndarray, hermite: bool) -> np.ndarray:
+    if times.size == 1:
+        return np.full(tq.shape, p[0])
+    k = np.clip(np.searchsorted(times, tq, side="right") - 1, 0, times.size - 2)
+    dt = times[k + 1] - times[k]
+    s = np.clip((tq - times[k]) / dt, 0.0, 1.0)
+    if not hermite:
+        return p[k] + s * (p[k + 1] - p[k])
+    s2, s3 = s * s, s * s * s
+    return (
+        (2 * s3 - 3 * s2 + 1) * p[k]
+        + (s3 - 2 * s2 + s) * dt * v[k]
+        + (-2 * s3 + 3 * s2) * p[k + 1]
+        + (s3 - s2) * dt * v[k + 1]
+    )
+
+
+# --------------------------------------------------------------------------- CSV
+
+
+def _known_bodies(bodies: Scene | Iterable[str] | None) -> tuple[str, ...] | None:
+    if bodies is None:
+        return None
+    names = getattr(bodies, "body_names", None)
+    return tuple(names) if names is not None else tuple(bodies)  # type: ignore[arg-type]
+
+
+def parse_recordings(
+    text: str, *, bodies: Scene | Iterable[str] | None = None, source: str = "<string>"
+) -> list[Recording]:
+    """Parse recording CSV text into one :class:`Recording` per run, in order of first
+    appearance. ``bodies`` (a scene or names) makes an unknown body name an error."""
+    known = _known_bodies(bodies)
+    reader = csv.reader(io.StringIO(text.removeprefix("\ufeff")))
+    header: list[str] | None = None
+    header_line = 0
+    row_no = 0
+    # (run, body) -> {"t": [...], "x": [...], "y": [...], "angle": [...], "lines": [...], "angle_line": int}
+    groups: dict[tuple[str, str], dict[str, list]] = {}
+    seen_times: dict[tuple[str, str], dict[float, int]] = {}
+    angle_state: dict[tuple[str, str], tuple[bool, int]] = {}
+    col: dict[str, int] = {}
+
+    def err(msg: str, column: str | None, line: int, row: int | None) -> RecordingError:
+        return RecordingError(msg, source=source, line=line, row=row, column=column)
+
+    for cells in reader:
+        line = reader.line_num
+        if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
+            continue
+        cells = [c.strip() for c in cells]
+        if header is None:
+            header, header_line = cells, line
+            for i, name in enumerate(header):
+                if name not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS:
+                    raise err(
+                        f"unknown column name {name!r}; columns are {', '.join(REQUIRED_COLUMNS)} and optionally "
+                        f"{', '.join(OPTIONAL_COLUMNS)}",
+                        name or f"#{i + 1}",
+                        line,
+                        None,
+                    )
+                if name in col:
+                    raise err(f"duplicate column (also column {col[name] + 1})", name, line, None)
+                col[name] = i
+            for name in REQUIRED_COLUMNS:
+                if name not in col:
+                    raise err(
+                        f"missing required column; the header has {', '.join(header)} but needs {', '.join(REQUIRED_COLUMNS)}",
+                        name,
+                        line,
+                        None,
+                    )
+            continue
+        row_no += 1
+        if len(cells) != len(header):
+            column = header[len(cells)] if len(cells) < len(header) else f"#{len(header) + 1}"
+            raise err(f"expected {len(header)} values ({', '.join(header)}), got {len(cells)}", column, line, row_no)
+
+        def number(name: str, cells: list[str] = cells, line: int = line, row_no: int = row_no) -> float:
+            raw = cells[col[name]]
+            try:
+                v = float(raw)
+            except ValueError:
+                raise err(f"{raw!r} is not a number", name, line, row_no) from None
+            if not math.isfinite(v):
+                raise err(f"{raw!r}: values must be finite numbers", name, line, row_no)
+            return v
+
+        body = cells[col["body"]]
+        if not body:
+            raise err("empty body name", "body", line, row_no)
+        if known is not None and body not in known:
+            raise err(f"unknown body {body!r}; the scene's bodies are {', '.join(known)}", "body", line, row_no)
+        run = cells[col["run"]] if "run" in col else ""
+        if "run" in col and not run:
+            raise err("empty run label", "run", line, row_no)
+        t = number("t")
+        if t < 0:
+            raise err(f"t = {t!r}: times must be >= 0 (simulations start at t = 0)", "t", line, row_no)
+        x, y = number("x"), number("y")
+        has_angle = "angle" in col and cells[col["angle"]] != ""
+        a = number("angle") if has_angle else math.nan
+        key = (run, body)
+        if key in angle_state and angle_state[key][0] != has_angle:
+            first_with, first_line = angle_state[key]
+            raise err(
+                f"angle is {'given' if first_with else 'empty'} for body {body!r} in run {run!r} at line {first_line} "
+                f"but {'given' if has_angle else 'empty'} here; give it in all of the body's rows or in none",
+                "angle",
+                line,
+                row_no,
+            )
+        angle_state.setdefault(key, (has_angle, line))
+        times = seen_times.setdefault(key, {})
+        if t in times:
+            raise err(
+                f"t = {t!r} repeats for body {body!r} in run {run!r} (also at line {times[t]}); a body has one sample per time in a run",
+                "t",
+                line,
+                row_no,
+            )
+        times[t] = line
+        g = groups.setdefault(key, {"t": [], "x": [], "y": [], "angle": []})
+        g["t"].append(t)
+        g["x"].append(x)
+        g["y"].append(y)
+        g["angle"].append(a)
+
+    if header is None:
+        raise err(f"empty file; expected a header with columns {','.join(REQUIRED_COLUMNS)} (optionally angle, run)", "t", 1, None)
+    if not groups:
+        raise err("no data rows after the header", "t", header_line + 1, 1)
+
+    runs: dict[str, dict[str, Track]] = {}
+    for (run, body), g in groups.items():
+        t = np.asarray(g["t"])
+        order = np.argsort(t, kind="stable")
+        ang = np.asarray(g["angle"])[order] if angle_state[(run, body)][0] else None
+        runs.setdefault(run, {})[body] = Track(t[order], np.asarray(g["x"])[order], np.asarray(g["y"])[order], ang)
+    return [Recording(tracks, run=run, source=source) for run, tracks in runs.items()]
+
+
+def read_recordings(path: str | Path, *, bodies: Scene | Iterable[str] | None = None) -> list[Recording]:
+    """Read a recording CSV file: one :class:`Recording` per run (see the module docstring)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise RecordingError(f"not UTF-8 text: {exc}", source=str(p)) from None
+    return parse_recordings(text, bodies=bodies, source=str(p))
+
+
+def read_recording(
+    path: str | Path, *, bodies: Scene | Iterable[str] | None = None, run: str | None = None
+) -> Recording:
+    """Read one run: ``run`` names it; without ``run`` the file must hold exactly one."""
+    recs = read_recordings(path, bodies=bodies)
+    if run is None:
+        if len(recs) != 1:
+            raise RecordingError(f"file holds {len(recs)} runs ({', '.join(r.run for r in recs)}); pass run=...", source=str(path))
+        return recs[0]
+    for r in recs:
+        if r.run == run:
+            return r
+    raise RecordingError(f"no run {run!r}; runs: {', '.join(r.run for r in recs)}", source=str(path))
+
+
+def format_recordings(recordings: Sequence[Recording]) -> str:
+    """CSV text of ``recordings`` (one run each), exact to the last bit (``repr`` floats)."""
+    if not recordings:
+        raise RecordingError("nothing to write: no recordings")
+    labels = [r.run for r in recordings]
+    with_run = len(recordings) > 1 or labels[0] != ""
+    if with_run and (len(set(labels)) != len(labels) or "" in labels):
+        raise RecordingError(f"each run needs a distinct, non-empty label to share a file; labels: {labels}")
+    with_angle = any(tr.angle is not None for r in recordings for tr in r.tracks.values())
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["t", "body", "x", "y", *(["angle"] if with_angle else []), *(["run"] if with_run else [])])
+    for r in recordings:
+        for body, tr in r.tracks.items():
+            for i in range(len(tr)):
+                row = [repr(float(tr.t[i])), body, repr(float(tr.x[i])), repr(float(tr.y[i]))]
+                if with_angle:
+                    row.append(repr(float(tr.angle[i])) if tr.angle is not None else "")
+                if with_run:
+                    row.append(r.run)
+                w.writerow(row)
+    return buf.getvalue()
+
+
+def write_recordings(path: str | Path, recordings: Sequence[Recording] | Recording) -> None:
+    """Write one or several runs to a CSV file that :func:`read_recordings` reads back exactly."""
+    recs = [recordings] if isinstance(recordings, Recording) else list(recordings)
+    Path(path).write_text(format_recordings(recs), encoding="utf-8")

@@ -1,0 +1,261 @@
+"""The correction loop, its history, the metric and observations (on the closed-form toy task)."""
+
+from __future__ import annotations
+
+import json
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+from physbench.errors import PhysbenchError, SimulationError
+from physbench.estimators.random_search import RandomSearch
+from physbench.loop import (
+    FAILED_LOSS,
+    EstimatorError,
+    History,
+    MarkedStep,
+    derive_seeds,
+    draw_problem,
+    refine,
+)
+from physbench.metrics import format_mean_std, image_mse, mean_std, running_best
+from physbench.observation import (
+    Observation,
+    ObservationError,
+    load_observation,
+    save_observation,
+    simulate_observation,
+)
+from physbench.params import ParamSpace
+from physbench.protocols import Step, Task
+from physbench.testing import ToyRenderer, ToySimulator, toy_task
+
+
+class Scripted:
+    """Proposes a fixed list of points (then repeats the last); records what it was given."""
+
+    name: ClassVar[str] = "scripted"
+    per_object: ClassVar[bool] = False
+
+    def __init__(self, points: list[dict[str, float]]) -> None:
+        self.points = points
+        self.steps: list[Step] = []
+        self.task: Task | None = None
+
+    def start(self, task: Task, *, seed: int) -> None:
+        self.task = task
+
+    def propose(self, step: Step) -> dict[str, float]:
+        self.steps.append(step)
+        return self.points[min(len(self.steps) - 1, len(self.points) - 1)]
+
+
+class CountingSimulator(ToySimulator):
+    def __init__(self) -> None:
+        self.calls: list[dict[str, float]] = []
+
+    def simulate(self, scene, params=None, *, effects=()):  # type: ignore[no-untyped-def]
+        self.calls.append(dict(params or {}))
+        return super().simulate(scene, params, effects=effects)
+
+
+def _run(estimator, *, iterations: int = 6, params=("mass",), sim=None, obs=None, seed: int = 0):  # type: ignore[no-untyped-def]
+    t = toy_task(params, seed=seed)
+    return refine(
+        obs if obs is not None else t.observation, t.scene, t.space, sim or t.simulator, t.renderer, estimator,
+        iterations=iterations, seed=seed,
+    )
+
+
+def test_one_simulation_and_one_propose_per_iteration() -> None:
+    t = toy_task(("mass",), seed=0)
+    points = [{"a.mass": 1.0 + i, "b.mass": 9.0 - i} for i in range(7)]
+    est, sim = Scripted(points), CountingSimulator()
+    h = _run(est, iterations=7, sim=sim)
+    assert len(h) == 7 and len(sim.calls) == 7 and len(est.steps) == 7
+    _, initial = draw_problem(t.space, 0)
+    assert sim.calls[0] == initial == h.initial == est.task.initial  # type: ignore[union-attr]
+    assert sim.calls[1:] == points[:6]  # iteration k simulates proposal k-1
+    assert [s.iteration for s in est.steps] == list(range(7))
+    for s, r in zip(est.steps, h.records, strict=True):
+        assert s.params == r.params and s.loss == r.loss and s.frames.shape == t.observation.frames.shape
+        assert r.t_simulate >= 0 and r.t_render >= 0 and r.t_estimator >= 0
+
+
+def test_best_is_chosen_by_image_mse_without_peeking_at_the_truth() -> None:
+    t = toy_task(("mass",), seed=0)
+    looks_right = {"a.mass": 2.0, "b.mass": 3.0}  # reproduces the frames exactly
+    truly_right = {"a.mass": 8.0, "b.mass": 7.0}  # what we claim the truth is
+    frames = simulate_observation(t.scene, looks_right, t.simulator, t.renderer).frames
+    obs = Observation(frames, truth=truly_right)
+    h = _run(Scripted([truly_right, looks_right, truly_right]), iterations=4, obs=obs)
+    assert h.records[1].nmse == 0.0 and h.records[2].loss == 0.0
+    assert h.best.iteration == 2 and h.best.params == looks_right
+    assert h.min_nmse == pytest.approx(t.space.normalized_mse(looks_right, truly_right)) and h.min_nmse > 0
+    losses = [r.loss for r in h.records]
+    assert [r.best_iteration for r in h.records] == running_best(losses)
+    assert all(r.best_nmse == h.records[r.best_iteration].nmse for r in h.records)
+
+
+def test_normalized_mse_divides_by_the_range_maximum() -> None:
+    t = toy_task(("mass", "elasticity"), seed=0)
+    est = {"a.mass": 4.0, "a.elasticity": 0.5, "b.mass": 10.0, "b.elasticity": 1.0}
+    truth = {"a.mass": 2.0, "a.elasticity": 0.3, "b.mass": 10.0, "b.elasticity": 1.0}
+    assert t.space.normalized_mse(est, truth) == pytest.approx(((2 / 10) ** 2 + (0.2 / 1.0) ** 2) / 4)
+
+
+def test_history_round_trips_through_json_and_pandas() -> None:
+    h = _run(RandomSearch(), iterations=5, params=("mass", "elasticity"))
+    d = json.loads(h.to_json())
+    assert d["timings"].keys() == {"simulate", "render", "estimator"}
+    again = History.from_dict(d)
+    assert again.to_dict() == h.to_dict()
+    assert again.min_nmse == h.min_nmse and again.best == h.best
+    frame = h.to_frame()
+    assert list(frame.index) == list(range(5))
+    assert {"loss", "nmse", "best_nmse", "t_simulate", *h.keys} <= set(frame.columns)
+
+
+def test_seeds_are_derived_from_one_seed_sequence() -> None:
+    a, b = derive_seeds(7), derive_seeds(7)
+    assert a.estimator == b.estimator and a.truth.random() == b.truth.random()
+    assert derive_seeds(8).estimator != a.estimator
+    space = toy_task().space
+    truth, initial = draw_problem(space, 3)
+    assert truth != initial and space.contains(truth) and space.contains(initial)
+    with pytest.raises(PhysbenchError, match="seed = -1"):
+        derive_seeds(-1)
+
+
+@pytest.mark.parametrize("bad", [0, -3, 2.5])
+def test_impossible_iteration_counts_are_refused(bad: object) -> None:
+    with pytest.raises(PhysbenchError, match=f"iterations = {bad!r}: expected a whole number >= 1"):
+        _run(RandomSearch(), iterations=bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("proposal", "message"),
+    [
+        ({"a.mass": 11.0, "b.mass": 5.0}, r"a.mass = 11.0 .* expected a finite number in \[1, 10\]"),
+        ({"a.mass": float("nan"), "b.mass": 5.0}, r"a.mass = nan"),
+        ({"a.mass": 5.0}, r"missing \['b.mass'\]"),
+        ({"a.mass": 5.0, "b.mass": 5.0, "c.mass": 1.0}, r"extra \['c.mass'\]"),
+        ([5.0, 5.0], r"returned list .* expected a dict"),
+    ],
+)
+def test_bad_proposals_name_the_estimator_key_and_range(proposal: object, message: str) -> None:
+    with pytest.raises(EstimatorError, match="estimator 'scripted'") as info:
+        _run(Scripted([proposal]), iterations=3)  # type: ignore[list-item]
+    assert info.match(message)
+
+
+def test_initial_guess_outside_the_ranges_is_refused() -> None:
+    t = toy_task()
+    with pytest.raises(PhysbenchError, match=r"a.mass in \[1, 10\]"):
+        refine(t.observation, t.scene, t.space, t.simulator, t.renderer, RandomSearch(), iterations=2,
+               initial={"a.mass": 0.5, "b.mass": 2.0})
+
+
+def test_unknowns_can_be_given_as_parameter_names() -> None:
+    t = toy_task(("mass", "elasticity"))
+    h = refine(t.observation, t.scene, ["elasticity"], t.simulator, t.renderer, RandomSearch(), iterations=2)
+    assert h.keys == ("a.elasticity", "b.elasticity")
+    with pytest.raises(PhysbenchError, match="unknown parameter 'friction' of scene 'toy'"):
+        refine(t.observation, t.scene, ["friction"], t.simulator, t.renderer, RandomSearch(), iterations=2)
+
+
+def test_observation_of_the_wrong_shape_names_expected_and_got() -> None:
+    t = toy_task()
+    bad = t.observation.frames[:, :1]
+    with pytest.raises(ObservationError, match=r"shape \(12, 1, 16, 16\), expected .* \(12, 2, 16, 16\) \(C 1 != 2\)"):
+        _run(RandomSearch(), obs=bad)
+    with pytest.raises(ObservationError, match=r"values span \[0, 1.98.*expected values in \[0, 1\]"):
+        _run(RandomSearch(), obs=t.observation.frames * 2)
+
+
+def test_a_failed_simulation_costs_an_iteration_with_the_worst_loss() -> None:
+    class Fragile(ToySimulator):
+        def simulate(self, scene, params=None, *, effects=()):  # type: ignore[no-untyped-def]
+            if params and params["a.mass"] > 5:
+                raise SimulationError("exploded", engine="toy", frame=3, body="a")
+            return super().simulate(scene, params, effects=effects)
+
+    est = Scripted([{"a.mass": 9.0, "b.mass": 2.0}, {"a.mass": 2.0, "b.mass": 2.0}])
+    h = _run(est, iterations=3, sim=Fragile())
+    assert h.records[1].failed and "exploded" in h.records[1].failed and h.records[1].loss == FAILED_LOSS
+    assert h.records[2].failed is None and len(est.steps) == 3
+
+
+class PerObject(Scripted):
+    per_object: ClassVar[bool] = True
+
+
+def test_per_object_estimators_get_each_unknown_body_marked() -> None:
+    t = toy_task(("mass",), seed=1)
+    est = PerObject([{"a.mass": 3.0, "b.mass": 3.0}])
+    h = _run(est, iterations=2, seed=1)
+    assert h.meta["per_object"] is True
+    assert set(est.task.meta["marked_observation"]) == {"a", "b"}  # type: ignore[union-attr]
+    for step in est.steps:
+        assert isinstance(step, MarkedStep) and set(step.marked) == {"a", "b"}
+        assert step.marked["a"][:, 1].sum() > 0 and step.frames[:, 1].sum() == 0
+    with pytest.raises(ObservationError, match="no marked frames for a, b"):
+        _run(PerObject([{"a.mass": 3.0, "b.mass": 3.0}]), obs=Observation(t.observation.frames))
+
+
+def test_any_number_of_unknown_bodies() -> None:
+    from physbench.scene import Body, Circle, Scene, Unknown
+
+    bodies = tuple(Body(f"b{i}", Circle(0.2), (0.5 + 0.5 * i, 1.0)) for i in range(6))
+    scene = Scene("six", bodies, frames=8, unknowns=tuple(Unknown(b.name, "mass", 1.0, 10.0) for b in bodies))
+    space = ParamSpace.from_scene(scene)
+    sim, ren = ToySimulator(), ToyRenderer()
+    obs = simulate_observation(scene, draw_problem(space, 0)[0], sim, ren)
+    h = refine(obs, scene, space, sim, ren, RandomSearch(), iterations=4)
+    assert len(h.keys) == 6 and all(len(r.params) == 6 for r in h.records)
+
+
+def test_observation_files_round_trip_and_bad_files_are_explained(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    t = toy_task()
+    path = tmp_path / "obs.npz"
+    save_observation(path, t.observation)
+    back = load_observation(path)
+    assert back.truth is None and np.array_equal(back.frames, t.observation.frames)
+    assert set(back.marked) == {"a", "b"}
+    np.savez(tmp_path / "nokey.npz", images=t.observation.frames)
+    with pytest.raises(ObservationError, match=r"no 'frames' array .*found: images"):
+        load_observation(tmp_path / "nokey.npz")
+    np.savez(tmp_path / "flat.npz", frames=t.observation.frames[0])
+    with pytest.raises(ObservationError, match=r"shape \(2, 16, 16\); expected 4 axes"):
+        load_observation(tmp_path / "flat.npz")
+    with pytest.raises(ObservationError, match="does not exist"):
+        load_observation(tmp_path / "missing.npz")
+    (tmp_path / "junk.npz").write_text("not a zip")
+    with pytest.raises(ObservationError, match=r"cannot read as \.npz"):
+        load_observation(tmp_path / "junk.npz")
+
+
+def test_metrics() -> None:
+    assert running_best([3.0, 1.0, 1.0, 0.5, 2.0]) == [0, 1, 1, 3, 3]
+    assert image_mse(np.ones((2, 2)), np.zeros((2, 2))) == 1.0
+    assert mean_std([1.0, 3.0]) == (2.0, pytest.approx(2**0.5))
+    assert format_mean_std(0.011, 0.003) == "(1.1 ± 0.3)e-02"
+
+
+def test_bouncing_balls_end_to_end_with_six_masses_and_marked_objects() -> None:
+    from physbench.plugins import create
+    from physbench.scenes import bouncing_balls
+
+    scene = bouncing_balls.generate(0, n_balls=6)
+    space = ParamSpace.from_scene(scene, ["mass"])
+    sim, ren = create("simulator", "pymunk"), create("renderer", "raster", resolution=32)
+    truth, _ = draw_problem(space, 0)
+    obs = simulate_observation(scene, truth, sim, ren, marked=space.bodies)
+    est = PerObject([space.sample(np.random.default_rng(1))])
+    h = refine(obs, scene, space, sim, ren, est, iterations=2)
+    assert len(space) == 6 and set(est.task.meta["marked_observation"]) == set(space.bodies)  # type: ignore[union-attr]
+    step = est.steps[-1]
+    assert isinstance(step, MarkedStep) and len(step.marked) == 6
+    assert all(f[:, 1].max() > 0.5 for f in step.marked.values())  # the marked ball is in channel 1
+    assert h.records[0].nmse is not None and h.records[1].params == est.points[0]

@@ -1,0 +1,115 @@
+"""``physbench run``: output, JSON, observation files, reality gap, blur, plot, and clear errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from physbench.cli import main
+
+FAST = ["--iterations", "4", "--resolution", "32"]
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(["run", *argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_table_and_final_line(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "--estimator", "tpe", "--scene", "three_circles", "--params", "mass", *FAST, "--seed", "1")
+    assert code == 0
+    lines = out.splitlines()
+    assert lines[0].split()[:4] == ["iter", "a.mass", "b.mass", "image"]
+    assert [ln.split()[0] for ln in lines[1:5]] == ["0", "1", "2", "3"]
+    assert "per iteration: simulate" in out and "truth:" in out and "best (iteration" in out
+    assert lines[-1].startswith("normalized min MSE after 4 iterations: ")
+
+
+def test_quiet_prints_only_the_final_line(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "--estimator", "random", *FAST, "-q")
+    assert code == 0 and err == ""
+    assert out.count("\n") == 1 and out.startswith("normalized min MSE after 4 iterations")
+
+
+def test_json_history_is_reproducible(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ("--estimator", "optuna", "--params", "mass", "elasticity", *FAST, "--json", "-q", "--seed", "2")
+    _, out1, _ = run(capsys, *argv)
+    _, out2, _ = run(capsys, *argv)
+    a, b = json.loads(out1), json.loads(out2)
+    assert a["keys"] == ["a.mass", "a.elasticity", "b.mass", "b.elasticity"] and len(a["records"]) == 4
+    assert a["min_nmse"] == a["records"][-1]["best_nmse"] and a["truth"] is not None
+    for d in (a, b):
+        d.pop("timings"), d["meta"].pop("t_start")
+        for r in d["records"]:
+            for k in ("t_simulate", "t_render", "t_estimator"):
+                r.pop(k)
+    assert a == b
+
+
+def test_observation_file_round_trip_and_wrong_shape(capsys: pytest.CaptureFixture[str], tmp_path) -> None:  # type: ignore[no-untyped-def]
+    path = tmp_path / "obs.npz"
+    code, _, _ = run(capsys, "--estimator", "random", *FAST, "-q", "--save-observation", str(path))
+    assert code == 0 and path.exists()
+    code, out, _ = run(capsys, "--estimator", "random", *FAST, "-q", "--observation", str(path))
+    assert code == 0 and out.startswith("min image MSE after 4 iterations") and "no truth" in out
+
+    frames = np.load(path)["frames"]
+    np.savez(tmp_path / "short.npz", frames=frames[:10])
+    code, _, err = run(capsys, "--estimator", "random", *FAST, "--observation", str(tmp_path / "short.npz"))
+    assert code == 2
+    assert f"frames have shape (10, 2, 32, 32), expected (T, C, H, W) = {frames.shape}" in err and "T 10 != " in err
+    code, _, err = run(capsys, "--estimator", "random", "--iterations", "4", "--observation", str(path))
+    assert code == 2 and "H 32 != 64, W 32 != 64" in err  # observed at 32 px, modelled at the default 64
+
+
+def test_reality_gap_blur_and_plot(capsys: pytest.CaptureFixture[str], tmp_path) -> None:  # type: ignore[no-untyped-def]
+    png = tmp_path / "conv.png"
+    code, out, _ = run(
+        capsys, "--estimator", "cmaes", *FAST, "-q", "--engine", "pymunk", "--observe-engine", "box2d",
+        "--blur", "1.5", "--plot", str(png),
+    )
+    assert code == 0 and out.startswith("normalized min MSE")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_estimator_options(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "--estimator", "optuna", "-o", "sampler=random", "-o", "startup=2", *FAST, "--json", "-q")
+    assert code == 0 and json.loads(out)["options"] == {"sampler": "random", "startup": 2}
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--estimator", "nope"], "unknown estimator 'nope'; known estimators: cmaes, optuna, random, resnet3d"),
+        (["--scene", "no_such_scene"], "unknown scene 'no_such_scene'"),
+        (["--params", "friction"], "unknown parameter 'friction' of scene 'three_circles'"),
+        (["--iterations", "0"], "--iterations 0: expected a whole number >= 1"),
+        (["--seed", "-1"], "--seed -1: expected a whole number >= 0"),
+        (["--engine", "bullet"], "unknown simulator 'bullet'; known simulators: box2d, pymunk"),
+        (["-o", "startup=-1"], "tpe: startup = -1: expected a whole number >= 0"),
+        (["-o", "temperature=3"], "estimator 'tpe' does not take options {'temperature': 3}"),
+        (["-o", "startup"], "--option 'startup': expected KEY=VALUE"),
+        (["--observation", "x.npz", "--blur", "2"], "cannot apply to --observation frames"),
+        (["--observation", "missing.npz"], "observation file 'missing.npz' does not exist"),
+        (["--blur", "-1"], "blur = -1.0: expected a finite number >= 0"),
+    ],
+)
+def test_clear_errors(capsys: pytest.CaptureFixture[str], argv: list[str], message: str) -> None:
+    extra = [] if "--iterations" in argv else ["--iterations", "2", "--resolution", "32"]
+    code, _, err = run(capsys, *argv, *extra)
+    assert code == 2
+    assert err.startswith("physbench run: error: ") and message in err, err
+
+
+def test_argument_parsing_imports_nothing_heavy() -> None:
+    code = (
+        "import sys\nfrom physbench.cli import build_parser\nbuild_parser('run').parse_args(['run', '--estimator', 'tpe'])\n"
+        "print([m for m in ('numpy', 'physbench.loop', 'tqdm', 'pandas') if m in sys.modules])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

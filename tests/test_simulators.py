@@ -1,0 +1,570 @@
+"""Both built-in simulators against analytic solutions and against each other.
+
+Every test runs in both engines. Tolerances: pymunk works in float64; Box2D stores float32, so its
+values carry ~1e-7 relative rounding per step (``FLOAT``). Both integrate with semi-implicit
+Euler, whose positions under constant acceleration ``a`` lag the continuous solution by exactly
+``a h t / 2`` (``h`` = substep); free-fall tests check that discrete solution tightly.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import sys
+from dataclasses import replace
+from pathlib import Path
+from types import ModuleType
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+from physbench.errors import SimulationError
+from physbench.protocols import EffectParam
+from physbench.scene import (
+    Body,
+    Box,
+    Circle,
+    Force,
+    Joint,
+    Polygon,
+    Scene,
+    Segment,
+    StaticPolygon,
+)
+from physbench.scenes.bin import bin_walls
+from physbench.simulators.box2d_sim import Box2DSimulator
+from physbench.simulators.pymunk_sim import PymunkSimulator
+from physbench.simulators.stepping import SteppingSimulator
+from physbench.trajectory import Trajectory
+
+G = 9.81
+ENGINES = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}
+#: Absolute tolerance for values of order 1-10 after a few hundred steps, per engine.
+FLOAT = {"pymunk": 1e-9, "box2d": 1e-4}
+
+
+@pytest.fixture(params=sorted(ENGINES))
+def sim(request: pytest.FixtureRequest) -> SteppingSimulator:
+    return ENGINES[request.param]()
+
+
+def _tol(sim: SteppingSimulator) -> float:
+    return FLOAT[sim.name]
+
+
+def _period(t: np.ndarray, x: np.ndarray) -> float:
+    """Mean period from the zero crossings of ``x`` (linear interpolation between frames)."""
+    i = np.where(np.sign(x[:-1]) * np.sign(x[1:]) < 0)[0]
+    tz = t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
+    assert len(tz) >= 4, "too few oscillations to measure a period"
+    return float(2 * np.mean(np.diff(tz)))
+
+
+# --------------------------------------------------------------------------- free motion
+
+
+@pytest.mark.parametrize("v0", [(0.0, 0.0), (3.0, 7.0)], ids=["free_fall", "projectile"])
+def test_ballistic_motion_matches_analytic(sim: SteppingSimulator, v0: tuple[float, float]) -> None:
+    scene = Scene(
+        "ballistic",
+        (Body("b", Circle(0.1), (1.0, 15.0), velocity=v0),),
+        bounds=(0.0, 0.0, 20.0, 20.0),
+        fps=30,
+        frames=46,
+        substeps=10,
+    )
+    tr = sim.simulate(scene)
+    t, s = tr.times, tr.body("b")
+    h = scene.dt / scene.substeps
+    x = 1.0 + v0[0] * t
+    y_exact = 15.0 + v0[1] * t - G * t**2 / 2
+    y_euler = y_exact - G * h * t / 2  # semi-implicit Euler's known O(h) lag
+    tol = _tol(sim)
+    np.testing.assert_allclose(s[:, 0], x, atol=tol)
+    np.testing.assert_allclose(s[:, 1], y_euler, atol=tol)
+    np.testing.assert_allclose(s[:, 3], v0[0], atol=tol)
+    np.testing.assert_allclose(s[:, 4], v0[1] - G * t, atol=tol)
+    assert np.abs(s[:, 1] - y_exact).max() <= G * h * t[-1] / 2 + tol
+    np.testing.assert_array_equal(tr.times, np.arange(46) / 30)
+    assert tr.engine == sim.name and tr.bodies == ("b",)
+
+
+def test_slow_bodies_never_sleep(sim: SteppingSimulator) -> None:
+    """A body slower than Box2D's sleep tolerances (1 cm/s, 2°/s) for more than 0.5 s keeps moving
+    (pybox2d puts it to sleep even in a world with sleeping off, unless the body forbids it)."""
+    body = Body("b", Box(0.2, 0.2), (2.0, 2.0), velocity=(0.005, 0.0), angular_velocity=0.02)
+    tr = sim.simulate(Scene("creep", (body,), gravity=(0.0, 0.0), frames=61))
+    s = tr.body("b")
+    assert s[-1, 0] - 2.0 == pytest.approx(0.005 * tr.times[-1], abs=1e-4)  # asleep: < 0.005
+    assert s[-1, 2] == pytest.approx(0.02 * tr.times[-1], abs=1e-4)
+
+
+def test_angle_is_ccw_and_velocities_match_finite_differences(sim: SteppingSimulator) -> None:
+    """Positive ω turns counter-clockwise (y up); reported velocities are those of the shape
+    centre, also when the centre of mass is elsewhere."""
+    body = Body("b", Box(0.4, 0.2), (2.0, 2.0), velocity=(0.5, -0.2), angular_velocity=2.0, com_offset=(0.1, 0.05))
+    scene = Scene("spin", (body,), gravity=(0.0, 0.0), fps=60, frames=61)
+    tr = sim.simulate(scene)
+    t, s = tr.times, tr.body("b")
+    np.testing.assert_allclose(s[:, 2], 2.0 * t, atol=1e-4)  # CCW: angle grows with +ω
+    assert s[0, 3:5].tolist() == pytest.approx([0.5, -0.2], abs=1e-6)  # the centre velocity given
+    # Central differences of centre positions; error bound ω² |r| dt² / 6 ≈ 3e-5.
+    dt = scene.dt
+    vx_fd = (s[2:, 0] - s[:-2, 0]) / (2 * dt)
+    vy_fd = (s[2:, 1] - s[:-2, 1]) / (2 * dt)
+    np.testing.assert_allclose(s[1:-1, 3], vx_fd, atol=5e-4)
+    np.testing.assert_allclose(s[1:-1, 4], vy_fd, atol=5e-4)
+    # The CoM moves in a straight line at v_centre + ω × r; the centre circles around it.
+    c, sn = np.cos(s[:, 2]), np.sin(s[:, 2])
+    com = np.stack([s[:, 0] + c * 0.1 - sn * 0.05, s[:, 1] + sn * 0.1 + c * 0.05], axis=1)
+    v_com = np.array([0.5 - 2.0 * 0.05, -0.2 + 2.0 * 0.1])
+    np.testing.assert_allclose(com, np.array([2.1, 2.05]) + np.outer(t, v_com), atol=1e-4)
+    # A body-frame point on the +x edge has moved to +y after a quarter turn.
+    k = round((math.pi / 4) / dt)  # ω = 2 rad/s: a quarter turn at t = π/4
+    corner = (c[k] * 0.2, sn[k] * 0.2)
+    assert corner[1] > 0.19 and abs(corner[0]) < 0.02
+
+
+# --------------------------------------------------------------------------- collisions
+
+
+@pytest.mark.parametrize(
+    ("m1", "m2", "e1", "e2"),
+    [(1.0, 3.0, 1.0, 1.0), (2.0, 0.5, 1.0, 1.0), (1.0, 3.0, 0.8, 0.5)],
+    ids=["elastic_light_heavy", "elastic_heavy_light", "restitution_product"],
+)
+def test_head_on_collision(sim: SteppingSimulator, m1: float, m2: float, e1: float, e2: float) -> None:
+    u1, u2 = 2.0, -1.0
+    scene = Scene(
+        "collide",
+        (
+            Body("a", Circle(0.2), (1.0, 2.0), velocity=(u1, 0.0), mass=m1, elasticity=e1),
+            Body("b", Circle(0.3), (3.0, 2.0), velocity=(u2, 0.0), mass=m2, elasticity=e2),
+        ),
+        gravity=(0.0, 0.0),
+        frames=31,
+    )
+    s = sim.simulate(scene).states
+    p = m1 * s[:, 0, 3:5] + m2 * s[:, 1, 3:5]
+    np.testing.assert_allclose(p, p[[0]].repeat(len(p), 0), atol=_tol(sim))  # momentum
+    e = e1 * e2  # physbench's mixing rule: the product
+    v1 = (m1 * u1 + m2 * u2 - m2 * e * (u1 - u2)) / (m1 + m2)
+    v2 = (m1 * u1 + m2 * u2 + m1 * e * (u1 - u2)) / (m1 + m2)
+    assert s[-1, 0, 3] == pytest.approx(v1, abs=1e-4)
+    assert s[-1, 1, 3] == pytest.approx(v2, abs=1e-4)
+    assert np.abs(s[:, :, 4]).max() < 1e-6 and np.abs(s[:, :, 5]).max() < 1e-6  # stays 1-D
+    ke = 0.5 * (m1 * (s[:, 0, 3:5] ** 2).sum(1) + m2 * (s[:, 1, 3:5] ** 2).sum(1))
+    if e == 1.0:
+        assert ke[-1] == pytest.approx(ke[0], rel=1e-5)  # elastic: energy kept to 1e-5
+    else:
+        lost = 0.5 * m1 * m2 / (m1 + m2) * (1 - e**2) * (u1 - u2) ** 2
+        assert ke[0] - ke[-1] == pytest.approx(lost, rel=1e-3)
+
+
+@pytest.mark.parametrize("floor_kind", ["segment", "polygon"])
+def test_bounce_restitution_is_product(sim: SteppingSimulator, floor_kind: str) -> None:
+    """Ball e=0.8 on floor e=0.5: rebound height ratio e² with e = 0.4 (max rule: 0.64)."""
+    r, drop = 0.1, 1.0
+    floor = (
+        Segment((0.0, 0.0), (4.0, 0.0), elasticity=0.5)
+        if floor_kind == "segment"
+        else StaticPolygon(((0.0, -1.0), (4.0, -1.0), (4.0, 0.0), (0.0, 0.0)), elasticity=0.5)
+    )
+    scene = Scene(
+        "bounce",
+        (Body("ball", Circle(r), (2.0, r + drop), mass=1.0, elasticity=0.8),),
+        statics=(floor,),
+        bounds=(0.0, -1.0, 4.0, 3.0),
+        fps=120,
+        frames=121,
+        substeps=5,
+    )
+    s = sim.simulate(scene).body("ball")
+    i = int(np.argmax(s[:, 4] > 0))  # first frame moving up
+    j = i + int(np.argmax(s[i:, 4] <= 0))  # the apex after it
+    assert 0 < i < j
+    ratio = (s[j, 1] - r) / drop
+    assert ratio == pytest.approx(0.4**2, abs=0.008)
+
+
+def test_box2d_velocity_threshold_is_documented_divergence() -> None:
+    """Box2D treats impacts below 1 m/s as inelastic (compiled-in ``b2_velocityThreshold``); pymunk
+    bounces at any speed unless asked to mimic it. docs/engines.md describes this."""
+    drop = 0.03  # impact at 0.77 m/s
+    scene = Scene(
+        "slow_bounce",
+        (Body("ball", Circle(0.1), (2.0, 0.1 + drop), elasticity=1.0),),
+        statics=(Segment((0.0, 0.0), (4.0, 0.0), elasticity=1.0),),
+        fps=120,
+        frames=40,
+        substeps=5,
+    )
+    rise = {name: ENGINES[name]().simulate(scene).body("ball")[:, 4].max() for name in ENGINES}
+    assert rise["pymunk"] > 0.6  # bounced back at ~e · 0.77 m/s
+    assert rise["box2d"] < 0.01  # stuck to the floor
+    mimic = PymunkSimulator(velocity_threshold=1.0)
+    assert mimic.simulate(scene).body("ball")[:, 4].max() < 0.01
+    fast = replace(scene, bodies=(replace(scene.bodies[0], position=(2.0, 0.4)),))  # 2.4 m/s
+    assert mimic.simulate(fast).body("ball")[:, 4].max() > 2.0  # faster impacts still bounce
+
+
+@pytest.mark.parametrize("floor_kind", ["segment", "polygon"])
+def test_sliding_friction_is_product(sim: SteppingSimulator, floor_kind: str) -> None:
+    """A box sliding at 4 m/s decelerates at μ g with μ = 0.5 · 0.6 (the sqrt rule gives 0.548)."""
+    floor = (
+        Segment((0.0, 0.0), (10.0, 0.0), friction=0.6)
+        if floor_kind == "segment"
+        else StaticPolygon(((0.0, -1.0), (10.0, -1.0), (10.0, 0.0), (0.0, 0.0)), friction=0.6)
+    )
+    scene = Scene(
+        "slide",
+        (Body("box", Box(0.4, 0.2), (1.0, 0.1), velocity=(4.0, 0.0), friction=0.5, elasticity=0.0),),
+        statics=(floor,),
+        bounds=(0.0, -1.0, 10.0, 3.0),
+        frames=31,
+    )
+    tr = sim.simulate(scene)
+    s = tr.body("box")
+    accel = np.polyfit(tr.times[2:25], s[2:25, 3], 1)[0]
+    assert accel == pytest.approx(-0.3 * G, rel=1e-3)
+    assert np.abs(s[:, 1] - 0.1).max() < 2e-3  # rests on the floor, no 1-2 cm skin
+    assert np.abs(s[:, 2]).max() < 1e-3  # does not tip
+
+
+def test_slope_friction_is_product(sim: SteppingSimulator) -> None:
+    """A box on a 30° slope slides down at g (sin θ − μ cos θ), μ = 0.5 · 0.6."""
+    th = math.radians(30.0)
+    c, sn = math.cos(th), math.sin(th)
+    start = (0.5 + 6 * c - 0.1 * sn, 0.5 + 6 * sn + 0.1 * c)
+    scene = Scene(
+        "slope",
+        (Body("box", Box(0.4, 0.2), start, angle=th, friction=0.5, elasticity=0.0),),
+        statics=(Segment((0.5, 0.5), (0.5 + 8 * c, 0.5 + 8 * sn), friction=0.6),),
+        bounds=(0.0, 0.0, 8.0, 8.0),
+        frames=31,
+    )
+    tr = sim.simulate(scene)
+    s = tr.body("box")
+    along = s[:, 3] * c + s[:, 4] * sn
+    accel = np.polyfit(tr.times[3:25], along[3:25], 1)[0]
+    assert accel == pytest.approx(-G * (sn - 0.3 * c), rel=1e-3)
+
+
+def test_resting_contact_has_no_skin(sim: SteppingSimulator) -> None:
+    """Circles, boxes and a stack rest on the floor touching it (within 2 mm) in both engines."""
+    tri = Polygon(((-0.1, -0.1), (0.1, -0.1), (0.0, 0.1)))
+    scene = Scene(
+        "rest",
+        (
+            Body("circle", Circle(0.1), (0.5, 0.12)),
+            Body("box", Box(0.2, 0.2), (1.5, 0.12)),
+            Body("top", Box(0.2, 0.2), (1.5, 0.34)),
+            Body("tri", tri, (2.5, 0.12)),
+        ),
+        statics=bin_walls((0.0, 0.0, 4.0, 4.0)),
+        frames=61,
+    )
+    s = sim.simulate(scene).states[-1]
+    assert s[:, 1] == pytest.approx([0.1, 0.1, 0.3, 0.1], abs=2e-3)
+
+
+def test_fast_bodies_and_ccd() -> None:
+    """Box2D (bullets, continuous collision) keeps a 40 m/s box inside the bin; pymunk has no
+    continuous collision and lets it tunnel through the wall — reported as an explosion."""
+    scene = Scene(
+        "fast",
+        (Body("b", Box(0.1, 0.1), (2.0, 2.0), velocity=(40.0, 0.0), elasticity=1.0),),
+        gravity=(0.0, 0.0),
+        statics=bin_walls((0.0, 0.0, 4.0, 4.0)),
+        frames=11,
+    )
+    s = Box2DSimulator().simulate(scene).body("b")
+    assert s[-1, 3] == pytest.approx(-40.0, rel=1e-4) and 0 < s[-1, 0] < 4
+    with pytest.raises(SimulationError, match="left the world"):
+        PymunkSimulator().simulate(scene)
+
+
+# --------------------------------------------------------------------------- joints and mass
+
+
+def test_pendulum_small_angle_period(sim: SteppingSimulator) -> None:
+    """Bob of radius 1 cm on a 1 m pivot, 0.05 rad amplitude. The exact physical-pendulum period
+    differs from 2π√(L/g) by the amplitude factor 1 + θ₀²/16 (1.6e-4) and √(I_pivot / m L²)
+    (2.5e-5); the engines must match the corrected value to 3e-5 and the simple one to 3e-4."""
+    L, th0, r = 1.0, 0.05, 0.01
+    pivot = (2.0, 3.0)
+    bob = Body("bob", Circle(r), (pivot[0] + L * math.sin(th0), pivot[1] - L * math.cos(th0)))
+    scene = Scene("pendulum", (bob,), joints=(Joint("bob", pivot),), fps=60, frames=361)
+    tr = sim.simulate(scene)
+    s = tr.body("bob")
+    period = _period(tr.times, s[:, 0] - pivot[0])
+    simple = 2 * math.pi * math.sqrt(L / G)
+    exact = simple * (1 + th0**2 / 16) * math.sqrt(1 + 0.5 * r**2 / L**2)
+    assert period == pytest.approx(exact, rel=3e-5)
+    assert period == pytest.approx(simple, rel=3e-4)
+    assert np.abs(np.hypot(s[:, 0] - pivot[0], s[:, 1] - pivot[1]) - L).max() < 1e-4  # rod length
+
+
+@pytest.mark.parametrize("moment", [None, 0.5], ids=["uniform", "explicit_moment"])
+def test_com_offset_and_moment_are_honoured(sim: SteppingSimulator, moment: float | None) -> None:
+    """A box pivoted at its shape centre with its CoM 0.3 m off swings as a physical pendulum,
+    T = 2π√(I_pivot / (m g d)); the trajectory reports the (fixed) shape centre."""
+    d, th0 = 0.3, 0.05
+    box = Body("b", Box(0.8, 0.8), (2.0, 2.0), angle=th0, mass=2.0, com_offset=(0.0, -d), moment=moment)
+    scene = Scene("physical_pendulum", (box,), joints=(Joint("b", (2.0, 2.0)),), fps=60, frames=301)
+    tr = sim.simulate(scene)
+    s = tr.body("b")
+    i_pivot = box.inertia() + box.mass * d * d
+    expected = 2 * math.pi * math.sqrt(i_pivot / (box.mass * G * d)) * (1 + th0**2 / 16)
+    assert _period(tr.times, s[:, 2]) == pytest.approx(expected, rel=3e-5)
+    assert np.abs(s[:, 0:2] - 2.0).max() < 1e-5  # shape centre, not CoM, is reported
+    assert np.abs(s[:, 3:5]).max() < 1e-4
+
+
+def test_pivot_joint_between_bodies(sim: SteppingSimulator) -> None:
+    """A bar pivoted to the world at one end, a ball pivoted to its other end: both anchors stay
+    together while the double pendulum swings."""
+    bar = Body("bar", Box(1.0, 0.05), (2.5, 3.0), mass=1.0)
+    ball = Body("ball", Circle(0.05), (3.0, 3.0), mass=0.5)
+    scene = Scene(
+        "double",
+        (bar, ball),
+        joints=(Joint("bar", (2.0, 3.0)), Joint("bar", (3.0, 3.0), "ball")),
+        fps=60,
+        frames=121,
+    )
+    s = sim.simulate(scene).states
+    a = s[:, 0, 2]
+    end = np.stack([s[:, 0, 0] + 0.5 * np.cos(a), s[:, 0, 1] + 0.5 * np.sin(a)], axis=1)
+    start = np.stack([s[:, 0, 0] - 0.5 * np.cos(a), s[:, 0, 1] - 0.5 * np.sin(a)], axis=1)
+    assert np.abs(start - [2.0, 3.0]).max() < 3e-3  # Chipmunk's soft joints drift ~1 mm
+    assert np.hypot(*(end - s[:, 1, 0:2]).T).max() < 3e-3
+    assert s[:, 1, 1].min() < 2.2  # it really swung
+    assert np.ptp(s[:, 1, 2]) < 1e-6  # a pivot lets the ball keep its own (zero) rotation
+
+
+# --------------------------------------------------------------------------- forces
+
+
+@pytest.mark.parametrize(("t0", "t1"), [(0.1, 0.2), (0.1037, 0.2511), (0.0, 0.0004), (0.95, 1.2)])
+def test_force_window_and_impulse(sim: SteppingSimulator, t0: float, t1: float) -> None:
+    """Δv = F (t1 − t0) / m for a force window (also when not aligned to substeps, shorter than one,
+    or running past the end) and Δv = J / m for an impulse, in zero gravity."""
+    m, F, J = 2.0, (3.0, -1.0), (0.0, 4.0)
+    scene = Scene(
+        "push",
+        (Body("b", Circle(0.1), (2.0, 2.0), mass=m),),
+        gravity=(0.0, 0.0),
+        forces=(Force("b", F, t0, t1), Force("b", J, 0.5, kind="impulse")),
+        frames=31,
+    )
+    tr = sim.simulate(scene)
+    s = tr.body("b")
+    t_end = tr.times[-1]
+    acting = min(t1, t_end) - t0
+    assert s[-1, 3] == pytest.approx(F[0] * acting / m, abs=1e-6)
+    assert s[-1, 4] == pytest.approx((F[1] * acting + J[1]) / m, abs=1e-6)
+    before = tr.times <= min(t0, 0.5)
+    assert np.abs(s[before, 3:5]).max() == 0.0  # nothing acts before its start
+    at = round(0.5 * scene.fps)
+    assert s[at + 1, 4] - s[at, 4] == pytest.approx((J[1] + F[1] * _overlap(t0, t1, 0.5, 0.5 + scene.dt)) / m, abs=1e-6)
+
+
+def _overlap(a0: float, a1: float, b0: float, b1: float) -> float:
+    return max(0.0, min(a1, b1) - max(a0, b0))
+
+
+class _ConstantPush:
+    """A test effect: a constant force and torque on body 0."""
+
+    name: ClassVar[str] = "push"
+    params: ClassVar[tuple[EffectParam, ...]] = ()
+
+    def setup(self, scene: Scene, values: object) -> None:
+        pass
+
+    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        f = np.zeros((len(states), 2))
+        f[0] = (1.5, 0.0)
+        tau = np.zeros(len(states))
+        tau[0] = 0.2
+        return f, tau
+
+
+class _Broken(_ConstantPush):
+    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        raise ZeroDivisionError("effect bug")
+
+
+def test_effects_apply_force_and_torque(sim: SteppingSimulator) -> None:
+    box = Body("b", Box(0.4, 0.2), (2.0, 2.0), mass=2.0, moment=0.1)
+    scene = Scene("effect", (box,), gravity=(0.0, 0.0), frames=31)
+    tr = sim.simulate(scene, effects=[_ConstantPush()])
+    s = tr.body("b")
+    assert s[-1, 3] == pytest.approx(1.5 * tr.times[-1] / 2.0, abs=1e-5)
+    assert s[-1, 5] == pytest.approx(0.2 * tr.times[-1] / 0.1, rel=1e-5)
+    with pytest.raises(ZeroDivisionError, match="effect bug"):  # effect bugs are not explosions
+        sim.simulate(scene, effects=[_Broken()])
+
+
+# --------------------------------------------------------------------------- failures
+
+
+def _assert_names(err: SimulationError, sim: SteppingSimulator, body: str) -> None:
+    assert err.engine == sim.name and err.body == body and isinstance(err.frame, int)
+    assert f"[{sim.name}]" in str(err) and repr(body) in str(err)
+
+
+def test_body_leaving_the_world_raises(sim: SteppingSimulator) -> None:
+    scene = Scene("fall", (Body("b", Circle(0.1), (2.0, 2.0)),), frames=60)  # no floor
+    with pytest.raises(SimulationError, match="left the world") as info:
+        sim.simulate(scene)
+    _assert_names(info.value, sim, "b")
+    # y = 2 − g t²/2 passes ymin − world height = −4 at t = 1.106 s: frame 34 at 30 fps.
+    assert info.value.frame == 34
+
+
+def test_absurd_mass_raises(sim: SteppingSimulator) -> None:
+    """A subnormal mass: pymunk's state turns NaN, Box2D (float32) cannot hold it."""
+    scene = Scene(
+        "absurd",
+        (Body("ok", Circle(0.1), (1.0, 2.0)), Body("tiny", Circle(0.1), (2.0, 2.0), mass=1e-320)),
+        forces=(Force("tiny", (1.0, 0.0), 0.0, 0.5),),
+    )
+    with pytest.raises(SimulationError) as info:
+        sim.simulate(scene)
+    _assert_names(info.value, sim, "tiny")
+    assert info.value.frame <= 1
+
+
+def test_huge_impulse_raises(sim: SteppingSimulator) -> None:
+    """1e6 N·s on 1 kg inside a closed bin: pymunk tunnels out of the world, Box2D would clamp it
+    to 2 m per step and keep it bouncing inside; both report an explosion."""
+    scene = Scene(
+        "kick",
+        (Body("b", Circle(0.1), (2.0, 2.0)),),
+        statics=bin_walls((0.0, 0.0, 4.0, 4.0), ceiling=True),
+        forces=(Force("b", (1e6, 0.0), 0.1, kind="impulse"),),
+    )
+    with pytest.raises(SimulationError) as info:
+        sim.simulate(scene)
+    _assert_names(info.value, sim, "b")
+    assert info.value.frame == 4  # the impulse acts at t = 0.1 s, in the interval before frame 4
+
+
+def test_nan_impulse_raises(sim: SteppingSimulator) -> None:
+    scene = Scene(
+        "nan",
+        (Body("b", Circle(0.1), (2.0, 2.0)),),
+        forces=(Force("b", (1e300, 1e300), 0.2, kind="impulse"),),
+    )
+    with pytest.raises(SimulationError) as info:
+        sim.simulate(scene)
+    _assert_names(info.value, sim, "b")
+
+
+def test_box2d_polygon_vertex_limit_raises() -> None:
+    pts = tuple((0.2 * math.cos(2 * math.pi * i / 20), 0.2 * math.sin(2 * math.pi * i / 20)) for i in range(20))
+    scene = Scene("many", (Body("poly", Polygon(pts), (2.0, 2.0)),))
+    assert PymunkSimulator().simulate(scene).frames == 30
+    with pytest.raises(SimulationError, match="b2_maxPolygonVertices") as info:
+        Box2DSimulator().simulate(scene)
+    assert info.value.body == "poly" and info.value.frame == 0
+
+
+# --------------------------------------------------------------------------- determinism
+
+
+def _busy_scene() -> Scene:
+    bodies = (
+        Body("a", Circle(0.3), (1.0, 2.5), velocity=(3.0, 0.0), elasticity=0.7, friction=0.4),
+        Body("b", Box(0.5, 0.4), (2.0, 0.3), angle=0.1, mass=2.0, elasticity=0.3),
+        Body("c", Polygon(((-0.2, -0.2), (0.3, -0.2), (0.0, 0.3))), (3.0, 1.0), com_offset=(0.05, 0.0)),
+    )
+    return Scene(
+        "busy",
+        bodies,
+        statics=bin_walls((0.0, 0.0, 4.0, 4.0)),
+        forces=(Force("a", (50.0, -30.0), 0.0, 0.2),),
+        frames=90,
+    )
+
+
+def test_deterministic(sim: SteppingSimulator) -> None:
+    scene = _busy_scene()
+    first, second = sim.simulate(scene), type(sim)().simulate(scene)
+    assert first.states.tobytes() == second.states.tobytes()
+    assert np.ptp(first.states[:, :, 0], axis=0).min() > 0.01  # something happened
+
+
+def test_params_are_applied(sim: SteppingSimulator) -> None:
+    scene = _busy_scene()
+    base = sim.simulate(scene)
+    heavy = sim.simulate(scene, {"b.mass": 8.0})
+    assert isinstance(heavy, Trajectory)
+    assert not np.array_equal(base.states, heavy.states)
+    assert np.array_equal(heavy.states, sim.simulate(scene.with_params({"b.mass": 8.0})).states)
+
+
+# --------------------------------------------------------------------------- paper scenes
+
+
+def _divergence_module() -> ModuleType:
+    if "engine_divergence" in sys.modules:
+        return sys.modules["engine_divergence"]
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "engine_divergence.py"
+    spec = importlib.util.spec_from_file_location("engine_divergence", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["engine_divergence"] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+#: Per scene, limits on the final-position difference per body between engines (m) over seeds
+#: 0-9: (mean, max). About 2x the mean and 1.4x the max measured by
+#: benchmarks/engine_divergence.py (docs/engines.md). Before the step-order and skin fixes
+#: three_circles measured mean 0.025, max 0.055 and failed them (and one stacked_boxes seed's
+#: outcome differed).
+PAPER_LIMITS = {
+    "three_circles": (0.02, 0.04),
+    "second_order": (0.035, 0.11),
+    "stacked_boxes": (0.09, 0.5),
+    "bouncing_balls": (0.15, 0.3),
+}
+#: Seeds (of 10) allowed a different qualitative outcome: only the chaotic pool table, where a 1 mm
+#: shift of the start already changes one seed's outcome within Box2D.
+ALLOWED_MISSES = {"bouncing_balls": 1}
+
+
+def _paper_rows(name: str, **kwargs: float) -> list:
+    ed = _divergence_module()
+    rows = [c for seed in range(10) if (c := ed.compare(name, seed, **kwargs)) is not None]
+    if not rows:
+        pytest.skip(f"scene {name} not available")
+    return rows
+
+
+@pytest.mark.parametrize("name", sorted(PAPER_LIMITS))
+def test_paper_scenes_agree_between_engines(name: str) -> None:
+    """Same parameters, both engines: same bodies move and no two bodies swap sides, and final
+    positions within the measured divergence."""
+    rows = _paper_rows(name)
+    misses = [c.seed for c in rows if not c.same]
+    assert len(misses) <= ALLOWED_MISSES.get(name, 0), misses
+    final = np.concatenate([c.final_diff for c in rows])
+    mean_limit, max_limit = PAPER_LIMITS[name]
+    assert final.mean() <= mean_limit
+    assert final.max() <= max_limit
+
+
+def test_second_order_agrees_closely_once_the_velocity_threshold_matches() -> None:
+    """second_order is not chaotic (1 mm at the start moves the end < 1 cm); with Box2D's 1 m/s
+    restitution threshold mimicked in pymunk the engines agree to 0.3 cm mean, 1.8 cm max
+    (measured), so anything systematic (step order, skin, mixing) shows here."""
+    rows = _paper_rows("second_order", velocity_threshold=1.0)
+    assert all(c.same for c in rows)
+    final = np.concatenate([c.final_diff for c in rows])
+    assert final.mean() <= 0.008
+    assert final.max() <= 0.03

@@ -1,0 +1,180 @@
+"""The conformance suite catches deliberately broken estimators, and its pytest base class works."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
+
+import numpy as np
+import pytest
+
+from physbench.errors import PhysbenchError
+from physbench.estimators.random_search import RandomSearch
+from physbench.params import Params
+from physbench.protocols import Step, Task
+from physbench.testing import (
+    ConformanceError,
+    EstimatorConformance,
+    check_bad_input,
+    check_deterministic,
+    check_deterministic_in_subprocess,
+    check_estimator,
+    check_protocol,
+    check_respects_ranges,
+)
+
+
+class Base:
+    """A correct minimal estimator (uniform draws); the broken ones below change one thing."""
+
+    name: ClassVar[str] = "base"
+    per_object: ClassVar[bool] = False
+
+    def __init__(self, width: float = 1.0) -> None:
+        if not 0 < width <= 1:
+            raise PhysbenchError(f"width = {width!r}: expected a number in (0, 1]")
+        self.width = width
+        self.task: Task | None = None
+
+    def start(self, task: Task, *, seed: int) -> None:
+        self.task, self.rng = task, np.random.default_rng(seed)
+
+    def propose(self, step: Step) -> Params:
+        if self.task is None:
+            raise PhysbenchError("base: propose() called before start()")
+        return self.task.space.from_unit(self.rng.random(len(self.task.space)) * self.width)
+
+
+class OutOfRange(Base):
+    def propose(self, step: Step) -> Params:
+        p = super().propose(step)
+        key = next(iter(p))
+        return {**p, key: self.task.space.high[0] * 1.5}  # type: ignore[union-attr]
+
+
+class DropsAKey(Base):
+    def propose(self, step: Step) -> Params:
+        p = super().propose(step)
+        p.pop(next(iter(p)))
+        return p
+
+
+class Unseeded(Base):
+    def start(self, task: Task, *, seed: int) -> None:
+        self.task, self.rng = task, np.random.default_rng()
+
+
+class SeededByProcess(Base):
+    """Deterministic within one process, different in another: the in-process check cannot tell."""
+
+    def start(self, task: Task, *, seed: int) -> None:
+        self.task, self.rng = task, np.random.default_rng([seed, os.getpid()])
+
+
+class UnseededOutOfRange(OutOfRange, Unseeded):
+    pass
+
+
+class Nameless(Base):
+    name: ClassVar[str] = ""
+
+
+class NoPerObject:
+    name: ClassVar[str] = "no_per_object"
+
+    def start(self, task: Task, *, seed: int) -> None: ...
+
+    def propose(self, step: Step) -> Params:
+        return {}
+
+
+class SwallowsOptions(Base):
+    def __init__(self, **options: Any) -> None:
+        super().__init__()
+
+
+class CrashesBeforeStart(Base):
+    def propose(self, step: Step) -> Params:
+        return self.task.space.sample(self.rng)  # type: ignore[union-attr]  # AttributeError on None
+
+
+class AcceptsBadWidth(Base):
+    def __init__(self, width: float = 1.0) -> None:
+        self.width, self.task = width, None
+
+
+def test_a_correct_estimator_passes() -> None:
+    check_estimator(Base, width=0.5, bad_options=[{"width": 0.0}, {"width": 3}])
+
+
+def test_out_of_range_proposals_fail() -> None:
+    with pytest.raises(ConformanceError, match=r"proposed a.mass = 15.0 .*expected a finite number in \[1, 10\]"):
+        check_respects_ranges(OutOfRange)
+    with pytest.raises(ConformanceError, match=r"missing \['a.mass'\]"):
+        check_respects_ranges(DropsAKey)
+
+
+def test_unseeded_randomness_fails() -> None:
+    with pytest.raises(ConformanceError, match="two runs with seed 3 differ at iteration 1"):
+        check_deterministic(Unseeded)
+
+
+def test_process_dependent_randomness_fails_only_in_another_process() -> None:
+    check_deterministic(SeededByProcess)
+    with pytest.raises(ConformanceError, match="different history in another process"):
+        check_deterministic_in_subprocess(SeededByProcess)
+
+
+def test_classes_the_child_cannot_import_are_explained() -> None:
+    class Local(Base):
+        pass
+
+    with pytest.raises(ConformanceError, match="define it at module level"):
+        check_deterministic_in_subprocess(Local)
+
+
+def test_protocol_shape() -> None:
+    with pytest.raises(ConformanceError, match="'name' must be a non-empty string"):
+        check_protocol(Nameless)
+    with pytest.raises(ConformanceError, match="'per_object' must be True or False"):
+        check_protocol(NoPerObject)
+    with pytest.raises(ConformanceError, match=r"Base\(\*\*\{'width': 5\}\) raised PhysbenchError"):
+        check_protocol(Base, width=5)
+
+
+def test_unclear_errors_fail() -> None:
+    with pytest.raises(ConformanceError, match="unknown option 'no_such_option_xyz' was accepted silently"):
+        check_bad_input(SwallowsOptions)
+    with pytest.raises(ConformanceError, match="propose\\(\\) before start\\(\\) raised AttributeError"):
+        check_bad_input(CrashesBeforeStart)
+    with pytest.raises(ConformanceError, match=r"bad options \{'width': -1\} were accepted"):
+        check_bad_input(AcceptsBadWidth, [{"width": -1}])
+
+
+def test_check_estimator_lists_every_failure() -> None:
+    with pytest.raises(ConformanceError) as info:
+        check_estimator(Unseeded, subprocess=False)
+    assert "fails 1 conformance check(s)" in str(info.value) and "- deterministic:" in str(info.value)
+    with pytest.raises(ConformanceError, match=r"fails 2 conformance check\(s\)"):
+        check_estimator(UnseededOutOfRange, subprocess=False)
+
+
+class TestBaseThroughTheBaseClass(EstimatorConformance):
+    estimator = Base
+    options: ClassVar[Mapping[str, Any]] = {"width": 0.8}
+    bad_options: ClassVar[Sequence[Mapping[str, Any]]] = [{"width": 0}]
+
+
+class TestRandomSearchThroughTheBaseClass(EstimatorConformance):
+    estimator = RandomSearch
+
+
+def test_the_base_class_reports_a_broken_estimator() -> None:
+    class TestBroken(EstimatorConformance):
+        estimator = OutOfRange
+
+    with pytest.raises(ConformanceError):
+        TestBroken().test_respects_ranges()
+    with pytest.raises(ConformanceError, match="set the class attribute 'estimator'"):
+        EstimatorConformance().test_protocol()
