@@ -498,6 +498,20 @@ def test_deterministic(sim: SteppingSimulator) -> None:
     assert np.ptp(first.states[:, :, 0], axis=0).min() > 0.01  # something happened
 
 
+def test_pymunk_batch_read_matches_per_body_read(monkeypatch: pytest.MonkeyPatch) -> None:
+    """pymunk's experimental batch reader is a pure speed-up: without it, the same trajectory."""
+    import physbench.simulators.pymunk_sim as pymunk_sim
+
+    scene = _busy_scene()
+    world = PymunkSimulator().build(scene)
+    assert world._batch is not None  # in use with the pinned pymunk 7
+    fast = PymunkSimulator().simulate(scene)
+    monkeypatch.setattr(pymunk_sim._BatchReader, "for_world", classmethod(lambda cls, w: None))
+    assert PymunkSimulator().build(scene)._batch is None
+    slow = PymunkSimulator().simulate(scene)
+    assert fast.states.tobytes() == slow.states.tobytes()
+
+
 def test_params_are_applied(sim: SteppingSimulator) -> None:
     scene = _busy_scene()
     base = sim.simulate(scene)

@@ -10,6 +10,7 @@ the same positions (see ``docs/engines.md``).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from typing import Any, ClassVar
@@ -75,16 +76,26 @@ class PymunkWorld:
         if velocity_threshold > 0:
             space.on_collision(begin=_inelastic_below(velocity_threshold))
         self.space = space
+        self._batch = _BatchReader.for_world(self)
 
     def step(self, h: float) -> None:
         self.space.step(h)
 
     def read(self) -> list[float]:
+        out = self._batch.read() if self._batch is not None else self.read_bodies()
         h = self.h
+        for i in range(0, len(out), 6):
+            out[i] += h * out[i + 3]
+            out[i + 1] += h * out[i + 4]
+            out[i + 2] += h * out[i + 5]
+        return out
+
+    def read_bodies(self) -> list[float]:
+        """Chipmunk's own state ``[x, y, angle, vx, vy, omega] * N``, one body at a time."""
         out: list[float] = []
         for b in self.bodies:
-            (px, py), (vx, vy), w = b.position, b.velocity, b.angular_velocity
-            out += (px + h * vx, py + h * vy, b.angle + h * w, vx, vy, w)
+            (px, py), (vx, vy) = b.position, b.velocity
+            out += (px, py, b.angle, vx, vy, b.angular_velocity)
         return out
 
     def apply_force(self, i: int, fx: float, fy: float) -> None:
@@ -100,6 +111,50 @@ class PymunkWorld:
         dvx, dvy = jx / b.mass, jy / b.mass
         b.velocity = (b.velocity.x + dvx, b.velocity.y + dvy)
         b.position = (b.position.x - h * dvx, b.position.y - h * dvy)
+
+
+class _BatchReader:
+    """Reads every body in one call through ``pymunk.batch`` (4x faster than per-body properties
+    at 5 bodies). The module is marked experimental, so it is used only when it reads back exactly
+    what the per-body properties give, in body order."""
+
+    def __init__(self, space: Any, n: int) -> None:
+        import pymunk.batch as batch
+
+        self.space, self.get, self.buf = space, batch.get_space_bodies, batch.Buffer()
+        self.n = 6 * n  # the space's static body follows the dynamic ones
+        f = batch.BodyFields
+        self.fields = f.POSITION | f.ANGLE | f.VELOCITY | f.ANGULAR_VELOCITY
+
+    def read(self) -> list[float]:
+        self.buf.clear()
+        self.get(self.space, self.fields, self.buf)
+        return memoryview(self.buf.float_buf()).cast("d")[: self.n].tolist()
+
+    @classmethod
+    def for_world(cls, world: PymunkWorld) -> _BatchReader | None:
+        if not _batch_layout_ok():
+            return None
+        reader = cls(world.space, len(world.bodies))
+        return reader if reader.read() == world.read_bodies() else None
+
+
+@functools.cache
+def _batch_layout_ok() -> bool:
+    """Whether ``pymunk.batch`` returns ``x, y, angle, vx, vy, omega`` per body in insertion order
+    (checked once on bodies whose every field differs)."""
+    try:
+        import pymunk
+
+        space = pymunk.Space()
+        for k in (1.0, 2.0):
+            b = pymunk.Body(1.0, 1.0)
+            b.position, b.angle, b.velocity, b.angular_velocity = (k, k + 0.1), k + 0.2, (k + 0.3, k + 0.4), k + 0.5
+            space.add(b, pymunk.Circle(b, 0.1))
+        expected = [v for k in (1.0, 2.0) for v in (k, k + 0.1, k + 0.2, k + 0.3, k + 0.4, k + 0.5)]
+        return _BatchReader(space, 2).read() == expected
+    except Exception:
+        return False
 
 
 def _inelastic_below(threshold: float) -> Callable[[Any, Any, Any], None]:
