@@ -1,6 +1,8 @@
-"""Developer sessions: ``nox -s tests``, ``nox -s lint``, ``nox -s bench``."""
+"""Developer sessions: ``nox -s tests``, ``nox -s lint``, ``nox -s bench``, ``nox -s regression``."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import nox
 
@@ -26,3 +28,15 @@ def bench(session: nox.Session) -> None:
     session.install(TORCH)
     session.install("-e", ".[all]")
     session.run("pytest", "benchmarks/test_speed.py", "--benchmark-only", *session.posargs)
+
+
+@nox.session
+def regression(session: nox.Session) -> None:
+    """Rerun benchmarks/smoke.toml from scratch and compare it with results/baseline; fails when an
+    estimator x scene x unknown set got significantly worse (see `physbench compare --help`).
+    In an environment where physbench is already installed (CI): nox --no-venv --no-install -s regression."""
+    session.install("-e", ".")
+    out = Path(session.create_tmp()) / "smoke"
+    # --fresh: resuming would reuse the cells of the last session instead of testing this code
+    session.run("physbench", "bench", "benchmarks/smoke.toml", "--out", str(out), "--fresh", "-q", external=True)
+    session.run("physbench", "compare", str(out), "results/baseline", external=True)

@@ -18,6 +18,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "bench": ("bench", "run a benchmark sweep spec (TOML) into tables of normalized min MSE"),
     "plot": ("plot", "plots and an HTML report for a benchmark output folder"),
     "compare": ("compare", "flag estimator x scene cells that got significantly worse than a baseline"),
+    "discover": ("discover", "find the missing physical effect behind a recording's disagreement with the model"),
 }
 
 

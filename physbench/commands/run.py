@@ -61,25 +61,6 @@ def parse_options(items: list[str]) -> dict[str, Any]:
     return out
 
 
-def _estimator(name: str, options: dict[str, Any]) -> Any:
-    import inspect
-
-    from physbench.errors import PhysbenchError
-    from physbench.plugins import get_registry
-
-    cls = get_registry().get("estimator", name)
-    try:
-        return cls(**options)
-    except TypeError as exc:
-        try:
-            accepted = [q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")]
-        except (TypeError, ValueError):
-            accepted = []
-        raise PhysbenchError(
-            f"estimator {name!r} does not take options {options}: {exc}; its options: {', '.join(accepted) or 'none'}"
-        ) from None
-
-
 def _fmt(v: float | None) -> str:
     return "-" if v is None else f"{v:.3e}"
 
@@ -112,41 +93,23 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(f"--iterations {args.iterations}: expected a whole number >= 1")
     if args.seed < 0:
         raise PhysbenchError(f"--seed {args.seed}: expected a whole number >= 0")
-    if args.observation and (args.observe_engine or args.blur or args.noise):
-        raise PhysbenchError(
-            "--observe-engine, --blur and --noise shape a simulated observation; they cannot apply to --observation frames"
-        )
 
-    from physbench.loop import draw_problem, refine
-    from physbench.observation import load_observation, save_observation, simulate_observation
-    from physbench.params import ParamSpace
-    from physbench.plugins import create
-    from physbench.scenes import resolve_scene
+    from physbench.experiment import Case, case_space, make_estimator, run_case
 
-    scene = resolve_scene(args.scene, args.seed)
-    params = [q for item in args.params for q in item.split(",") if q]
-    bodies = None if args.bodies is None else [b for item in args.bodies for b in item.split(",") if b]
-    space = ParamSpace.from_scene(scene, params, bodies)
-    estimator = _estimator(args.estimator, parse_options(args.option))
-    simulator = create("simulator", args.engine)
-    model_renderer = create("renderer", "raster", resolution=args.resolution, mode=args.render_mode)
-    per_object = bool(getattr(estimator, "per_object", False))
-    truth, initial = draw_problem(space, args.seed)
-    if args.observation:
-        obs = load_observation(args.observation)
-    else:
-        observer = create("simulator", args.observe_engine or args.engine)
-        obs_renderer = create(
-            "renderer", "raster", resolution=args.resolution, mode=args.render_mode,
-            blur=args.blur, noise=args.noise, seed=args.seed,
-        )
-        obs = simulate_observation(scene, truth, observer, obs_renderer, marked=space.bodies if per_object else ())
-    if args.save_observation:
-        save_observation(args.save_observation, obs)
+    params = tuple(q for item in args.params for q in item.split(",") if q)
+    bodies = None if args.bodies is None else tuple(b for item in args.bodies for b in item.split(",") if b)
+    case = Case(
+        scene=args.scene, params=params, estimator=args.estimator, options=parse_options(args.option),
+        seed=args.seed, iterations=args.iterations, engine=args.engine, observe_engine=args.observe_engine,
+        blur=args.blur, noise=args.noise, resolution=args.resolution, render_mode=args.render_mode,
+        bodies=bodies, observation=args.observation,
+    )
+    space = case_space(case)  # unknown scene or parameter: fail before the progress bar appears
+    make_estimator(case.estimator, case.options)
 
     from tqdm import tqdm
 
-    bar = tqdm(total=args.iterations, desc=f"{args.estimator} on {scene.name}", unit="it", file=sys.stderr,
+    bar = tqdm(total=args.iterations, desc=f"{args.estimator} on {args.scene}", unit="it", file=sys.stderr,
                disable=True if args.quiet else None, leave=False)
 
     def progress(rec: Any) -> None:
@@ -157,21 +120,14 @@ def main(args: argparse.Namespace) -> int:
         bar.update(1)
 
     try:
-        history = refine(
-            obs, scene, space, simulator, model_renderer, estimator,
-            iterations=args.iterations, seed=args.seed, initial=initial, callback=progress,
-        )
+        history = run_case(case, callback=progress, save_observation=args.save_observation)
     finally:
         bar.close()
-    history.meta.update(
-        observe_engine=None if args.observation else (args.observe_engine or args.engine),
-        blur=args.blur, noise=args.noise, resolution=args.resolution, render_mode=args.render_mode,
-    )
 
     if args.plot:
         from physbench.plotting.convergence import plot_convergence
 
-        plot_convergence({f"{history.estimator}": [history]}, args.plot, title=f"{scene.name}: {', '.join(space.keys)}")
+        plot_convergence({f"{history.estimator}": [history]}, args.plot, title=f"{history.meta['scene']}: {', '.join(space.keys)}")
 
     if args.json:
         print(history.to_json(indent=1))

@@ -1,0 +1,282 @@
+"""Figures of a sweep, from its long table (matplotlib, Agg backend, imported inside each function).
+
+- :func:`convergence`: best-so-far normalized MSE per iteration, mean over seeds and the spread
+  (interquartile band) for every estimator, one panel per unknown set (the paper's Fig. 3).
+- :func:`trajectories`: the iterates of the first seeds in the plane of two unknowns, as arrows,
+  with the truth as a filled circle (Fig. 5).
+- :func:`landscape`: image MSE against the deviation of one parameter from its nominal value,
+  per body (Fig. 4); this one simulates.
+- :func:`win_rate`: how often each estimator ends closer to the truth than each other one.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from physbench.bench.tables import (
+    final_rows,
+    paper_value,
+    param_frame,
+    scene_label,
+    unknowns_label,
+    win_rate_table,
+)
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.figure import Figure
+
+#: Settings that split figures (everything in a configuration but unknowns and estimator).
+SETTINGS = ("scene", "bodies", "engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
+DPI = 90
+
+
+def _plt() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _groups(df: pd.DataFrame, cols: Sequence[str]) -> list[tuple[dict[str, Any], pd.DataFrame]]:
+    """(values, rows) per distinct ``cols`` in spec order."""
+    order = df.sort_values("cell_index").drop_duplicates(list(cols))[list(cols)]
+    out = []
+    for vals in order.itertuples(index=False):
+        cfg = dict(zip(cols, vals, strict=True))
+        sel = np.logical_and.reduce([df[c] == v for c, v in cfg.items()])
+        out.append((cfg, df[sel]))
+    return out
+
+
+def _varying(df: pd.DataFrame) -> list[str]:
+    return [c for c in SETTINGS[1:] if df[c].nunique(dropna=False) > 1]
+
+
+def _name(prefix: str, cfg: dict[str, Any], varying: Sequence[str], extra: str = "") -> str:
+    parts = [prefix, str(cfg["scene"]), *(f"{c}{cfg[c]}" for c in varying), *([extra] if extra else [])]
+    return re.sub(r"[^A-Za-z0-9_.+-]+", "-", "_".join(parts)) + ".png"
+
+
+def _title(cfg: dict[str, Any], varying: Sequence[str]) -> str:
+    bits = [f"{c} {cfg[c]}" for c in varying]
+    return scene_label(str(cfg["scene"])) + (f" ({', '.join(bits)})" if bits else "")
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    """PNG with a 128-colour palette: line plots lose nothing visible and shrink 2-4x (committed files)."""
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI)
+    _plt().close(fig)
+    buf.seek(0)
+    with Image.open(buf) as im:
+        im.convert("RGB").quantize(colors=128).save(path, optimize=True)
+    return path
+
+
+def convergence(df: pd.DataFrame, out: Path) -> list[Path]:
+    """One figure per scene (and setting): a panel per unknown set, a line per estimator."""
+    plt = _plt()
+    ok = df[(df["status"] == "ok") & df["iteration"].notna()]
+    if ok.empty:
+        return []
+    varying = _varying(df)
+    paths = []
+    for cfg, rows in _groups(ok, SETTINGS):
+        sets = list(dict.fromkeys(rows.sort_values("cell_index")["unknowns"]))
+        fig, axes = plt.subplots(1, len(sets), figsize=(4.2 * len(sets), 3.4), squeeze=False)
+        for ax, unknowns in zip(axes[0], sets, strict=True):
+            sub = rows[rows["unknowns"] == unknowns]
+            for est, er in _groups(sub, ["estimator"]):
+                y = er.pivot_table(index="seed", columns="iteration", values="best_nmse").to_numpy(dtype=float)
+                x = np.arange(1, y.shape[1] + 1)
+                lo, hi = np.nanpercentile(y, [25, 75], axis=0)
+                (line,) = ax.plot(x, np.nanmean(y, axis=0), marker="o", ms=2.5, lw=1.3, label=f"{est['estimator']}")
+                ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.15, lw=0)
+            for which, style in (("NN", "--"), ("Hyperopt", ":")):
+                ref = paper_value(str(cfg["scene"]), unknowns, which)
+                if ref:
+                    ax.axhline(ref[0], color="0.35", ls=style, lw=1, label=f"paper {which} (11 it.)")
+            ax.set_yscale("log")
+            ax.set_title(unknowns_label(unknowns), fontsize="medium")
+            ax.set_xlabel("iterations (simulations)")
+            ax.xaxis.get_major_locator().set_params(integer=True)
+            ax.grid(True, which="both", alpha=0.25)
+        axes[0, 0].set_ylabel("best-so-far normalized MSE")
+        axes[0, -1].legend(fontsize="x-small", loc="upper right")
+        n = rows["seed"].nunique()
+        fig.suptitle(f"{_title(cfg, varying)}: mean over {n} seeds, band = interquartile range", fontsize="medium")
+        fig.tight_layout()
+        paths.append(_save(fig, out / _name("convergence", cfg, varying)))
+    return paths
+
+
+def _ranges(scene: str, seed: int, keys: Sequence[str]) -> dict[str, tuple[float, float]]:
+    try:
+        from physbench.scenes import resolve_scene
+
+        sc = resolve_scene(scene, seed)
+        return {k: (sc.unknown(k).low, sc.unknown(k).high) for k in keys}
+    except Exception:  # a scene file that moved: fall back to the data's extent
+        return {}
+
+
+def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
+    """For every configuration with exactly two unknowns: a panel per estimator, the first
+    ``seeds`` seeds in colours, iterates joined by arrows, the truth filled, the start hollow,
+    the best-by-image iterate starred."""
+    plt = _plt()
+    ok = df[(df["status"] == "ok") & df["iteration"].notna()]
+    varying = _varying(df)
+    paths = []
+    for cfg, rows in _groups(ok, [*SETTINGS, "unknowns"]):
+        keys = set(rows["keys"])
+        if len(keys) != 1 or len(json.loads(next(iter(keys)))) != 2:
+            continue
+        kx, ky = json.loads(next(iter(keys)))
+        chosen = sorted(rows["seed"].unique())[:seeds]
+        ests = _groups(rows, ["estimator"])
+        fig, axes = plt.subplots(1, len(ests), figsize=(3.3 * len(ests), 3.5), squeeze=False)
+        rng = _ranges(str(cfg["scene"]), int(chosen[0]), [kx, ky])
+        colors = plt.get_cmap("tab10").colors
+        for ax, (est, er) in zip(axes[0], ests, strict=True):
+            for i, seed in enumerate(chosen):
+                run = er[er["seed"] == seed].sort_values("iteration")
+                if run.empty:
+                    continue
+                p = param_frame(run)
+                t = json.loads(run["truth"].iloc[0])
+                c = colors[i % len(colors)]
+                xs, ys = p[kx].to_numpy(), p[ky].to_numpy()
+                for j in range(len(xs) - 1):
+                    ax.annotate("", xy=(xs[j + 1], ys[j + 1]), xytext=(xs[j], ys[j]),
+                                arrowprops={"arrowstyle": "->", "color": c, "lw": 0.8, "alpha": 0.8})
+                ax.plot(xs[0], ys[0], "o", mfc="none", mec=c, ms=5)
+                b = int(run["best_iteration"].iloc[-1])
+                ax.plot(xs[b], ys[b], "*", color=c, ms=8, mec="k", mew=0.4)
+                ax.plot(t[kx], t[ky], "o", color=c, ms=8, mec="k", mew=0.6)
+            if rng:
+                ax.set_xlim(*rng[kx])
+                ax.set_ylim(*rng[ky])
+            ax.set_title(str(est["estimator"]), fontsize="medium")
+            ax.set_xlabel(kx)
+        axes[0, 0].set_ylabel(ky)
+        fig.suptitle(
+            f"{_title(cfg, varying)}, {unknowns_label(str(cfg['unknowns']))}: seeds {', '.join(map(str, chosen))} "
+            "(hollow: start, star: best by image MSE, filled: truth)", fontsize="small",
+        )
+        fig.tight_layout()
+        paths.append(_save(fig, out / _name("trajectories", cfg, varying, str(cfg["unknowns"]))))
+    return paths
+
+
+def landscape_data(
+    scene: str, param: str, *, engine: str = "pymunk", resolution: int = 64, render_mode: str = "mark",
+    seeds: Sequence[int] = (0, 1, 2), points: int = 21,
+) -> dict[str, np.ndarray]:
+    """Image MSE between the scene at nominal parameters and the scene with one unknown
+    ``body.param`` moved across its range, per key: ``{"x": Δp grid (points,), key: (seeds, points)}``,
+    Δp relative to the nominal value (the range's middle)."""
+    from physbench.metrics import image_mse
+    from physbench.plugins import create
+    from physbench.scenes import resolve_scene
+
+    sim = create("simulator", engine)
+    ren = create("renderer", "raster", resolution=resolution, mode=render_mode)
+    out: dict[str, Any] = {}
+    for si, seed in enumerate(seeds):
+        sc = resolve_scene(scene, seed)
+        units = [u for u in sc.unknowns if u.param == param]
+        nominal = {u.key: 0.5 * (u.low + u.high) for u in sc.unknowns}
+        obs = ren.render(sc, sim.simulate(sc, nominal))
+        for u in units:
+            half = 0.5 * (u.high - u.low)
+            grid = np.linspace(-half, half, points)
+            out.setdefault("x", grid)
+            row = out.setdefault(u.key, np.full((len(seeds), points), np.nan))
+            for j, d in enumerate(grid):
+                try:
+                    frames = ren.render(sc, sim.simulate(sc, {**nominal, u.key: nominal[u.key] + d}))
+                    row[si, j] = image_mse(frames, obs)
+                except Exception:  # an exploding simulation leaves a gap in the curve
+                    pass
+    return out
+
+
+def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) -> list[Path]:
+    """Per scene: a panel per parameter among the sweep's unknowns, a line per body (mean over
+    ``seeds`` scene instances, band: min to max), with the model settings of the sweep's first cell."""
+    plt = _plt()
+    first = df.sort_values("cell_index").iloc[0]
+    engine, res, mode = str(first["engine"]), int(first["resolution"]), str(first["render_mode"])
+    paths = []
+    for scene in dict.fromkeys(df.sort_values("cell_index")["scene"]):
+        params = list(dict.fromkeys(p for u in df.loc[df["scene"] == scene, "unknowns"] for p in u.split("+")))
+        fig, axes = plt.subplots(1, len(params), figsize=(4 * len(params), 3.2), squeeze=False)
+        try:
+            for ax, param in zip(axes[0], params, strict=True):
+                data = landscape_data(str(scene), param, engine=engine, resolution=res, render_mode=mode,
+                                      seeds=range(seeds), points=points)
+                x = data.pop("x")
+                for key, y in data.items():
+                    (line,) = ax.plot(x, np.nanmean(y, axis=0), lw=1.3, label=key)
+                    if y.shape[0] > 1:
+                        ax.fill_between(x, np.nanmin(y, axis=0), np.nanmax(y, axis=0), color=line.get_color(), alpha=0.15, lw=0)
+                ax.axvline(0, color="0.5", ls="--", lw=0.8)
+                ax.set_xlabel(f"Δ{param} from nominal")
+                ax.set_title(param, fontsize="medium")
+                ax.legend(fontsize="x-small")
+                ax.grid(True, alpha=0.25)
+        except Exception:  # e.g. a scene file that moved since the sweep
+            plt.close(fig)
+            continue
+        axes[0, 0].set_ylabel("image MSE vs nominal")
+        fig.suptitle(f"{scene_label(str(scene))}: image-MSE landscape ({engine}, {res} px, mean of {seeds} scene instances)",
+                     fontsize="medium")
+        fig.tight_layout()
+        paths.append(_save(fig, out / f"landscape_{re.sub(r'[^A-Za-z0-9_.-]+', '-', str(scene))}.png"))
+    return paths
+
+
+def win_rate(df: pd.DataFrame, out: Path) -> list[Path]:
+    """Heatmap: row estimator's share of matched cells (same configuration and seed, both
+    finished) that end with a lower normalized min MSE than the column estimator (ties: half)."""
+    plt = _plt()
+    wr, n = win_rate_table(final_rows(df))
+    if wr.shape[0] < 2:
+        return []
+    fig, ax = plt.subplots(figsize=(1.1 * len(wr) + 2.4, 0.9 * len(wr) + 1.6))
+    im = ax.imshow(wr.to_numpy(dtype=float), cmap="RdBu", vmin=0, vmax=1)
+    for i in range(len(wr)):
+        for j in range(len(wr)):
+            v = wr.iat[i, j]
+            if np.isfinite(v):
+                ax.text(j, i, f"{100 * v:.0f}%\n(n={int(n.iat[i, j])})", ha="center", va="center", fontsize="x-small")
+    ax.set_xticks(range(len(wr)), wr.columns, rotation=30, ha="right")
+    ax.set_yticks(range(len(wr)), wr.index)
+    ax.set_xlabel("opponent")
+    ax.set_title("win rate: row beats column (normalized min MSE)", fontsize="medium")
+    fig.colorbar(im, ax=ax, fraction=0.046)
+    fig.tight_layout()
+    return [_save(fig, out / "win_rate.png")]
+
+
+def plot_all(df: pd.DataFrame, out: Path, *, seeds: int = 3, landscape_seeds: int = 3) -> dict[str, list[Path]]:
+    """Every figure into ``out`` (created); ``landscape_seeds=0`` skips the simulating one."""
+    out.mkdir(parents=True, exist_ok=True)
+    figs = {"convergence": convergence(df, out), "trajectories": trajectories(df, out, seeds=seeds),
+            "win rate": win_rate(df, out)}
+    figs["landscape"] = landscape(df, out, seeds=landscape_seeds) if landscape_seeds else []
+    return figs

@@ -1,0 +1,181 @@
+"""Run a sweep: every cell of a spec through an executor into the cell store, then the tables.
+
+A cell that raises (an exploding simulation that the loop does not absorb, an estimator without
+weights, ...) is stored as failed with its error and the sweep goes on. Re-running on the same
+output folder runs only the cells without a stored result, and the long table is rebuilt from the
+stored cells in spec order, so an interrupted-and-resumed sweep ends with exactly the rows of an
+uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import json
+import sys
+import time
+import traceback
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from physbench.bench.spec import Cell, Spec
+from physbench.bench.store import RESULTS, CellStore, atomic_write
+from physbench.experiment import Case
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+#: Distributions whose versions are recorded with every cell (those installed).
+VERSIONED = ("physbench", "numpy", "scipy", "pymunk", "box2d", "hyperopt", "optuna", "nevergrad", "cmaes", "torch")
+
+
+@functools.cache
+def versions() -> dict[str, str]:
+    """Python and the installed versions of :data:`VERSIONED` in this process."""
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"python": platform.python_version()}
+    for dist in VERSIONED:
+        with contextlib.suppress(PackageNotFoundError):
+            out[dist] = version(dist)
+    return out
+
+
+def run_cell(case: Case) -> dict[str, Any]:
+    """Run one cell; called by the executor, in whatever process it chooses. Never raises for a
+    failing case: the error is returned, with its traceback for the cell file."""
+    from physbench.experiment import run_case
+
+    t0 = time.perf_counter()
+    out: dict[str, Any] = {"case": case.to_dict(), "status": "ok", "error": None, "history": None}
+    try:
+        out["history"] = run_case(case).to_dict()
+    except Exception as exc:  # any failure of one cell is data, not the end of the sweep
+        out.update(status="failed", error=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc(limit=8))
+    out["t_cell"] = time.perf_counter() - t0
+    out["versions"] = versions()
+    return out
+
+
+@dataclass
+class SweepResult:
+    """What :func:`run_sweep` did and produced."""
+
+    out: Path
+    cells: int
+    ran: int
+    skipped: int
+    failed: int
+    wall_s: float
+    executor: str
+    table: pd.DataFrame
+    stats: pd.DataFrame
+
+
+def assemble(cells: list[Cell], store: CellStore) -> pd.DataFrame:
+    """The long table from the stored cells, in cell order (cells without a result are left out)."""
+    from physbench.bench.tables import cell_rows, to_frame
+
+    rows: list[dict[str, Any]] = []
+    for c in cells:
+        data = store.load(c.key)
+        if data is not None:
+            rows += cell_rows({"key": c.key, "index": c.index, "scene": c.scene, "label": c.label}, data)
+    return to_frame(rows)
+
+
+def write_table(df: pd.DataFrame, out: Path) -> Path:
+    import io
+
+    buf = io.BytesIO()
+    df.to_parquet(buf, index=False)
+    atomic_write(out / RESULTS, buf.getvalue())
+    return out / RESULTS
+
+
+def read_table(path: str | Path) -> pd.DataFrame:
+    """A sweep's long table from its folder or its ``results.parquet``."""
+    import pandas as pd
+
+    from physbench.errors import PhysbenchError
+
+    p = Path(path)
+    f = p / RESULTS if p.is_dir() else p
+    if not f.is_file():
+        raise PhysbenchError(
+            f"{str(p)!r}: no {RESULTS} there; expected the --out folder of a finished `physbench bench` run"
+        )
+    return pd.read_parquet(f)
+
+
+def run_sweep(
+    spec: Spec,
+    out: str | Path,
+    *,
+    executor: str = "processes",
+    workers: int | None = None,
+    address: str | None = None,
+    fresh: bool = False,
+    retry_failed: bool = False,
+    progress: bool = True,
+    command: str = "",
+) -> SweepResult:
+    """Run the cells of ``spec`` that ``out`` lacks, then write ``results.parquet``, the summary
+    tables and ``run.json`` (one entry per invocation: executor, workers, cells run, wall time)."""
+    from tqdm import tqdm
+
+    from physbench.bench.executors import make_executor
+    from physbench.bench.tables import write_summary
+
+    out = Path(out)
+    ex = make_executor(executor, workers=workers, address=address)
+    cells = spec.cells()
+    store = CellStore(out)
+    store.prepare(fresh=fresh)
+    if spec.source:
+        atomic_write(out / "spec.toml", spec.source.encode())
+
+    def finished(c: Cell) -> bool:
+        data = store.load(c.key)
+        return data is not None and not (retry_failed and data.get("status") != "ok")
+
+    todo = [c for c in cells if not finished(c)]
+    by_case = {id(c.case): c for c in todo}  # executors hand back the very objects they were given
+    t0 = time.perf_counter()
+    started = datetime.now(UTC).isoformat(timespec="seconds")
+    n_failed = 0
+    bar = tqdm(total=len(cells), initial=len(cells) - len(todo), desc=spec.name, unit="cell",
+               file=sys.stderr, disable=None if progress else True, dynamic_ncols=True)
+    try:
+        if todo:
+            with ex:
+                for case, data in ex.map_unordered(run_cell, [c.case for c in todo]):
+                    store.save(by_case[id(case)].key, data)
+                    if data["status"] != "ok":
+                        n_failed += 1
+                        bar.set_postfix(failed=n_failed, refresh=False)
+                    bar.update(1)
+    finally:
+        bar.close()
+    wall = time.perf_counter() - t0
+
+    table = assemble(cells, store)
+    write_table(table, out)
+    st = write_summary(table, out, title=spec.name)
+    failed = int((table.drop_duplicates("cell")["status"] != "ok").sum())
+    log_path = out / "run.json"
+    try:
+        log = json.loads(log_path.read_text())
+    except (OSError, ValueError):
+        log = {"runs": []}
+    log.update(spec=spec.name, spec_path=spec.path, cells=len(cells), failed=failed, versions=versions())
+    log["runs"].append({
+        "started": started, "executor": ex.describe(), "workers": ex.workers, "ran": len(todo),
+        "skipped": len(cells) - len(todo), "failed_now": n_failed, "wall_s": round(wall, 2),
+        "command": command,
+    })
+    atomic_write(log_path, (json.dumps(log, indent=1) + "\n").encode())
+    return SweepResult(out, len(cells), len(todo), len(cells) - len(todo), failed, wall, ex.describe(), table, st)

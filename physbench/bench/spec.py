@@ -1,0 +1,319 @@
+"""Sweep specs: a TOML file naming the axes of a benchmark, expanded into cells.
+
+A cell is one :class:`~physbench.experiment.Case` (one seed of one configuration). The product is
+``Σ_scenes (scene's unknown sets) × engine × observe_engine × blur × noise × resolution ×
+render_mode × iterations × estimators × seeds``; each scene lists its own unknown sets because
+the paper's Table 1 is not a full product. Every axis takes one value or a list::
+
+    name = "example"
+    estimators = ["tpe", "random", {name = "tpe", label = "tpe-20", options = {startup = 20}}]
+    seeds = 10                       # 0..9; or a list [3, 7]; or {start = 100, count = 10}
+    iterations = 11
+    engine = "pymunk"                # the model's simulator
+    observe_engine = "box2d"         # the observation's simulator (default: the same as engine)
+    blur = [0.0, 1.5]
+    noise = 0.0
+    resolution = 64
+    render_mode = "mark"
+    unknowns = ["mass"]              # default for scenes that list none; each item is one set
+
+    [[scenes]]
+    name = "three_circles"           # a registered scene or a scene TOML (relative to this file)
+    unknowns = ["mass", "elasticity", "mass+elasticity"]
+    bodies = ["a"]                   # optional: only these bodies' unknowns
+
+Seeds: a cell's run seed *is* the seed value, so every configuration sees the same scene instances,
+truths and initial guesses (paired comparisons), and ``physbench run ... --seed S`` reproduces a
+cell exactly.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from physbench.errors import PhysbenchError, UnknownNameError
+from physbench.experiment import Case
+
+AXES = ("engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
+TOP_KEYS = ("name", "description", "scenes", "unknowns", "estimators", "seeds", *AXES)
+SCENE_KEYS = ("name", "unknowns", "bodies")
+ESTIMATOR_KEYS = ("name", "label", "options")
+DEFAULTS: dict[str, Any] = {
+    "engine": "pymunk", "observe_engine": None, "blur": 0.0, "noise": 0.0, "resolution": 64,
+    "render_mode": "mark", "iterations": 11, "unknowns": ["mass"],
+}
+
+
+class SpecError(PhysbenchError, ValueError):
+    """A sweep spec that cannot be run; the message names the file, key and accepted values."""
+
+
+@dataclass(frozen=True)
+class EstimatorSpec:
+    name: str
+    label: str
+    options: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    name: str  # as written (the table's scene column); ``path`` is what runs
+    path: str
+    unknowns: tuple[tuple[str, ...], ...]
+    bodies: tuple[str, ...] | None = None
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One run of a sweep. ``index`` is its position in the spec's product (the table's order);
+    ``key`` hashes everything that determines the result, so it names the cell's result file."""
+
+    index: int
+    case: Case
+    scene: str
+    label: str
+
+    @property
+    def key(self) -> str:
+        blob = json.dumps(self.case.to_dict(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+@dataclass(frozen=True)
+class Spec:
+    name: str
+    description: str
+    scenes: tuple[SceneSpec, ...]
+    estimators: tuple[EstimatorSpec, ...]
+    seeds: tuple[int, ...]
+    axes: Mapping[str, tuple[Any, ...]]
+    source: str = ""  # the TOML text
+    path: str = ""
+
+    def cells(self) -> list[Cell]:
+        """Every cell in product order: scene, unknowns, axes, estimator, seed (seed innermost)."""
+        out: list[Cell] = []
+        for sc in self.scenes:
+            for unknowns in sc.unknowns:
+                for values in itertools.product(*(self.axes[a] for a in AXES)):
+                    ax = dict(zip(AXES, values, strict=True))
+                    for est in self.estimators:
+                        for seed in self.seeds:
+                            case = Case(
+                                scene=sc.path, params=unknowns, estimator=est.name, options=dict(est.options),
+                                seed=seed, bodies=sc.bodies, **ax,
+                            )
+                            out.append(Cell(len(out), case, sc.name, est.label))
+        return out
+
+
+def _where(path: str, key: str) -> str:
+    return f"{path}: {key}" if path else key
+
+
+def _as_list(value: Any) -> list[Any]:
+    return list(value) if isinstance(value, list) else [value]
+
+
+def _unknown_set(value: Any, where: str) -> tuple[str, ...]:
+    if isinstance(value, str):
+        parts = [p for p in value.replace("+", " ").replace(",", " ").split() if p]
+    elif isinstance(value, list) and all(isinstance(v, str) for v in value):
+        parts = list(value)
+    else:
+        parts = []
+    if not parts or len(set(parts)) != len(parts):
+        raise SpecError(
+            f"{where} = {value!r}: expected an unknown-parameter set such as \"mass\", \"mass+elasticity\" "
+            "or [\"mass\", \"elasticity\"] (no repeats)"
+        )
+    return tuple(parts)
+
+
+def _seeds(value: Any, where: str) -> tuple[int, ...]:
+    def ok(v: Any) -> bool:
+        return isinstance(v, int) and not isinstance(v, bool) and v >= 0
+
+    if ok(value):
+        seeds = list(range(value))
+    elif isinstance(value, list) and all(ok(v) for v in value):
+        seeds = list(value)
+    elif isinstance(value, dict) and set(value) <= {"start", "count"} and ok(value.get("start", 0)) and ok(value.get("count")):
+        seeds = list(range(value.get("start", 0), value.get("start", 0) + value["count"]))
+    else:
+        raise SpecError(
+            f"{where} = {value!r}: expected a count (50 -> seeds 0..49), a list of whole numbers >= 0, "
+            "or {start = S, count = N}"
+        )
+    if len(set(seeds)) != len(seeds):
+        raise SpecError(f"{where} = {value!r}: seeds repeat")
+    return tuple(seeds)
+
+
+def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
+    def bad(v: Any, expected: str) -> SpecError:
+        return SpecError(f"{where} = {v!r}: expected {expected}")
+
+    out = []
+    for v in values:
+        if name in ("engine", "render_mode") or (name == "observe_engine" and v is not None):
+            if not isinstance(v, str) or not v:
+                raise bad(v, "a name (string)")
+        elif name in ("blur", "noise"):
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v) or v < 0:
+                raise bad(v, "a finite number >= 0")
+            v = float(v)
+        elif name in ("resolution", "iterations") and (isinstance(v, bool) or not isinstance(v, int) or v < 1):
+            raise bad(v, "a whole number >= 1")
+        out.append(v)
+    if len(set(out)) != len(out):
+        raise SpecError(f"{where} = {values!r}: values repeat")
+    return tuple(out)
+
+
+def _estimators(value: Any, where: str) -> tuple[EstimatorSpec, ...]:
+    out = []
+    for i, item in enumerate(_as_list(value)):
+        at = f"{where}[{i}]"
+        if isinstance(item, str):
+            item = {"name": item}
+        if not isinstance(item, dict) or not isinstance(item.get("name"), str):
+            raise SpecError(f"{at} = {item!r}: expected an estimator name or {{name = \"tpe\", label = \"...\", options = {{...}}}}")
+        extra = sorted(set(item) - set(ESTIMATOR_KEYS))
+        if extra:
+            raise SpecError(f"{at}: unknown key {extra[0]!r}; known keys: {', '.join(ESTIMATOR_KEYS)}")
+        options = item.get("options", {})
+        if not isinstance(options, dict):
+            raise SpecError(f"{at}.options = {options!r}: expected a table of estimator options")
+        label = item.get("label") or item["name"] + (
+            "(" + ", ".join(f"{k}={v}" for k, v in sorted(options.items())) + ")" if options else ""
+        )
+        out.append(EstimatorSpec(item["name"], str(label), options))
+    labels = [e.label for e in out]
+    dup = next((x for x in labels if labels.count(x) > 1), None)
+    if dup is not None:
+        raise SpecError(f"{where}: two estimators are labelled {dup!r}; give each a distinct label")
+    same = [(e.name, json.dumps(dict(e.options), sort_keys=True)) for e in out]
+    dup2 = next((x for x in same if same.count(x) > 1), None)
+    if dup2 is not None:
+        raise SpecError(f"{where}: estimator {dup2[0]!r} with options {dup2[1]} appears twice (it would run the same cells)")
+    return tuple(out)
+
+
+def _scenes(value: Any, default_unknowns: Any, base: Path, where: str) -> tuple[SceneSpec, ...]:
+    out = []
+    for i, item in enumerate(_as_list(value)):
+        at = f"{where}[{i}]"
+        if isinstance(item, str):
+            item = {"name": item}
+        if not isinstance(item, dict) or not isinstance(item.get("name"), str):
+            raise SpecError(f"{at} = {item!r}: expected a scene name or a [[scenes]] table with name and unknowns")
+        extra = sorted(set(item) - set(SCENE_KEYS))
+        if extra:
+            raise SpecError(f"{at}: unknown key {extra[0]!r}; known keys: {', '.join(SCENE_KEYS)}")
+        name = item["name"]
+        path = name
+        if name.endswith(".toml"):
+            p = Path(name) if Path(name).is_absolute() else base / name
+            if not p.is_file():
+                raise SpecError(f"{at}.name = {name!r}: scene file {str(p)!r} does not exist")
+            path = str(p.resolve())
+        raw = item.get("unknowns", default_unknowns)
+        # Each item is one set: "mass", "mass+elasticity" or ["mass", "elasticity"].
+        sets = tuple(_unknown_set(u, f"{at}.unknowns") for u in _as_list(raw))
+        if not sets:
+            raise SpecError(f"{at}.unknowns = []: empty product: the scene lists no unknown-parameter set")
+        if len(set(sets)) != len(sets):
+            raise SpecError(f"{at}.unknowns = {raw!r}: an unknown set repeats")
+        bodies = item.get("bodies")
+        if bodies is not None and (not isinstance(bodies, list) or not all(isinstance(b, str) for b in bodies) or not bodies):
+            raise SpecError(f"{at}.bodies = {bodies!r}: expected a non-empty list of body names")
+        out.append(SceneSpec(name, path, sets, None if bodies is None else tuple(bodies)))
+    return tuple(out)
+
+
+def parse_spec(data: Mapping[str, Any], *, path: str = "", source: str = "", base: Path | None = None) -> Spec:
+    """A :class:`Spec` from parsed TOML; names are checked against the plugin registry and each
+    scene's unknowns, so a bad spec fails before anything runs."""
+    base = Path(path).parent if base is None and path else (base or Path.cwd())
+    for key in data:
+        if key not in TOP_KEYS:
+            raise SpecError(f"{_where(path, key)}: unknown axis or key {key!r}; known: {', '.join(TOP_KEYS)}")
+    for key in ("scenes", "estimators", "seeds"):
+        if key not in data:
+            raise SpecError(f"{_where(path, key)}: missing; a spec needs scenes, estimators and seeds")
+    name = data.get("name", Path(path).stem if path else "sweep")
+    if not isinstance(name, str) or not name:
+        raise SpecError(f"{_where(path, 'name')} = {name!r}: expected a non-empty string")
+    description = str(data.get("description", ""))
+    scenes = _scenes(data["scenes"], data.get("unknowns", DEFAULTS["unknowns"]), base, _where(path, "scenes"))
+    estimators = _estimators(data["estimators"], _where(path, "estimators"))
+    seeds = _seeds(data["seeds"], _where(path, "seeds"))
+    axes = {a: _check_axis(a, _as_list(data.get(a, DEFAULTS[a])), _where(path, a)) for a in AXES}
+    empty = [k for k, v in (("scenes", scenes), ("estimators", estimators), ("seeds", seeds), *axes.items()) if not v]
+    if empty:
+        raise SpecError(f"{_where(path, empty[0])}: empty product: the axis {empty[0]!r} has no values")
+    spec = Spec(name, description, scenes, estimators, seeds, axes, source, path)
+    _check_names(spec)
+    check_unique(spec.cells())
+    return spec
+
+
+def check_unique(cells: list[Cell]) -> None:
+    """Refuse a spec that lists the same run twice (e.g. a scene entry repeated)."""
+    seen: dict[str, Cell] = {}
+    for c in cells:
+        if c.key in seen:
+            a = seen[c.key]
+            raise SpecError(
+                f"cells {a.index} and {c.index} are the same run (scene {c.scene!r}, unknowns "
+                f"{'+'.join(c.case.params)}, estimator {c.label!r}, seed {c.case.seed}); remove the repeated entry"
+            )
+        seen[c.key] = c
+
+
+def load_spec(path: str | Path) -> Spec:
+    """Read and check a spec file."""
+    p = Path(path)
+    if not p.is_file():
+        raise SpecError(f"spec file {str(p)!r} does not exist")
+    text = p.read_text()
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"{p}: not valid TOML: {exc}") from None
+    return parse_spec(data, path=str(p), source=text)
+
+
+def _check_names(spec: Spec) -> None:
+    from physbench.experiment import case_space, make_estimator
+    from physbench.plugins import create, get_registry
+    from physbench.scenes import resolve_scene
+
+    reg = get_registry()
+    where = spec.path or spec.name
+    try:
+        for est in spec.estimators:
+            make_estimator(est.name, est.options)
+        for e in {*spec.axes["engine"], *(v for v in spec.axes["observe_engine"] if v is not None)}:
+            reg.get("simulator", e)
+        for res, mode, blur, noise in itertools.product(*(spec.axes[a] for a in ("resolution", "render_mode", "blur", "noise"))):
+            create("renderer", "raster", resolution=res, mode=mode, blur=blur, noise=noise)
+        for sc in spec.scenes:
+            scene = resolve_scene(sc.path, spec.seeds[0])
+            for unknowns in sc.unknowns:
+                case_space(Case(scene=sc.path, params=unknowns, bodies=sc.bodies, seed=spec.seeds[0]), scene)
+    except UnknownNameError as exc:
+        raise SpecError(f"{where}: {exc}") from None
+    except SpecError:
+        raise
+    except PhysbenchError as exc:
+        raise SpecError(f"{where}: {exc}") from None

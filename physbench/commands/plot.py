@@ -1,0 +1,54 @@
+"""``physbench plot DIR``: figures and an HTML report for a ``physbench bench`` output folder.
+
+Writes ``DIR/plots/*.png`` (convergence per scene like the paper's Fig. 3, parameter-space
+trajectories for two unknowns like Fig. 5, the image-MSE landscape along each parameter like
+Fig. 4, and the estimators' win-rate matrix), ``DIR/win_rate.csv`` and ``DIR/report.html``
+(self-contained: tables and figures embedded).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("dir", metavar="DIR", help="output folder of `physbench bench` (holds results.parquet)")
+    p.add_argument("--seeds", type=int, default=3, metavar="N", help="seeds drawn in the trajectory plots (default: 3)")
+    p.add_argument(
+        "--landscape-seeds", type=int, default=3, metavar="N",
+        help="scene instances averaged in the image-MSE landscape, which simulates (default: 3; 0 skips it)",
+    )
+
+
+def main(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from physbench.errors import PhysbenchError
+
+    if args.seeds < 1:
+        raise PhysbenchError(f"--seeds {args.seeds}: expected a whole number >= 1")
+    if args.landscape_seeds < 0:
+        raise PhysbenchError(f"--landscape-seeds {args.landscape_seeds}: expected a whole number >= 0")
+
+    from physbench.bench import plots, report
+    from physbench.bench.runner import read_table
+    from physbench.bench.store import atomic_write
+    from physbench.bench.tables import final_rows, win_rate_table
+
+    out = Path(args.dir)
+    df = read_table(out)
+    if df.empty:
+        raise PhysbenchError(f"{str(out)!r}: the results table is empty; run `physbench bench SPEC --out {out}` first")
+    figures = plots.plot_all(df, out / "plots", seeds=args.seeds, landscape_seeds=args.landscape_seeds)
+    rate, _ = win_rate_table(final_rows(df))
+    atomic_write(out / "win_rate.csv", rate.to_csv(index_label="estimator").encode())
+    try:
+        log = json.loads((out / "run.json").read_text())
+        title = str(log.get("spec", out.name))
+    except (OSError, ValueError):
+        log, title = None, out.name
+    page = report.build(df, out, figures, title=title, run_log=log)
+    count = sum(len(v) for v in figures.values())
+    print(f"{count} figures in {out / 'plots'}; report {page}")
+    return 0

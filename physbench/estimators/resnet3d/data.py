@@ -1,0 +1,114 @@
+"""Training pairs generated on the fly: (p, p') for the unknowns of a random marked object of a
+random scene instance, simulated and rendered as the network trains.
+
+A *group* is one scene instance simulated with K random parameter sets; every ordered pair of its
+simulations, for every unknown body, is a sample. That reuses each simulation K-1 times per body.
+Seeds: training groups use seeds from :data:`TRAIN_SEED0` upward, validation groups from
+:data:`VAL_SEED0`; evaluation uses small seeds (0, 1, 2, ...), so the three never meet.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from physbench.estimators.resnet3d.inputs import make_input
+
+TRAIN_SEED0 = 1 << 24
+VAL_SEED0 = 1 << 30
+
+
+@dataclass(frozen=True)
+class DataSpec:
+    """What to simulate for training; stored in the weights' sidecar."""
+
+    scene: str
+    params: tuple[str, ...]
+    engine: str = "pymunk"
+    render_resolution: int = 64
+    resolution: int = 32
+    frames: int = 15
+    group: int = 4
+    scene_options: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["params"] = list(self.params)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> DataSpec:
+        return cls(**{**d, "params": tuple(d["params"])})
+
+
+class PairMaker:
+    """Builds sample groups for one :class:`DataSpec` (one per worker process)."""
+
+    def __init__(self, spec: DataSpec) -> None:
+        from physbench.plugins import create, get_registry
+
+        self.spec = spec
+        self.generator = get_registry().get("scene", spec.scene)
+        self.sim = create("simulator", spec.engine)
+        self.renderer = create("renderer", "raster", resolution=spec.render_resolution, mode="mark")
+
+    def group(self, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        """Samples ``x (S, 2, 2F, R, R)`` and targets ``y (S, P)`` from the instance ``seed``."""
+        from physbench.errors import SimulationError
+        from physbench.params import ParamSpace
+
+        spec = self.spec
+        scene = self.generator(seed, **spec.scene_options)
+        space = ParamSpace.from_scene(scene, spec.params)
+        rng = np.random.default_rng([seed, 7])
+        # Per simulation: its parameters and, per unknown body, the frames with that body marked.
+        sims: list[tuple[dict[str, float], dict[str, np.ndarray]]] = []
+        for _ in range(spec.group * 2):
+            if len(sims) == spec.group:
+                break
+            p = space.sample(rng)
+            try:
+                traj = self.sim.simulate(scene, p)
+            except SimulationError:
+                continue
+            sims.append((p, {b: self.renderer.render(scene, traj, focus=b) for b in space.bodies}))
+        xs, ys = [], []
+        for body in space.bodies:
+            sub = space.subset(body)
+            scale = sub.high - sub.low
+            for i, (pi, fi) in enumerate(sims):
+                for j, (pj, fj) in enumerate(sims):
+                    if i != j:
+                        xs.append(make_input(fi[body], fj[body], spec.frames, spec.resolution))
+                        ys.append((sub.to_vector(pi) - sub.to_vector(pj)) / scale)
+        return np.stack(xs), np.asarray(ys, dtype=np.float32)
+
+
+def validation_set(spec: DataSpec, groups: int) -> tuple[np.ndarray, np.ndarray]:
+    """The fixed, seeded validation set: ``groups`` instances from :data:`VAL_SEED0`."""
+    maker = PairMaker(spec)
+    parts = [maker.group(VAL_SEED0 + g) for g in range(groups)]
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+def stream(spec: DataSpec, start_group: int, worker: int = 0, workers: int = 1, buffer: int = 256) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Endless shuffled samples from training groups ``start_group + worker + k·workers``."""
+    maker = PairMaker(spec)
+    rng = np.random.default_rng([start_group, worker])
+    pool_x: list[np.ndarray] = []
+    pool_y: list[np.ndarray] = []
+    g = start_group + worker
+    while True:
+        while len(pool_x) < buffer:
+            x, y = maker.group(TRAIN_SEED0 + g)
+            g += workers
+            pool_x.extend(x)
+            pool_y.extend(y)
+        # Draw from a shuffle buffer so samples of one instance do not arrive together.
+        k = int(rng.integers(len(pool_x)))
+        pool_x[k], pool_x[-1] = pool_x[-1], pool_x[k]
+        pool_y[k], pool_y[-1] = pool_y[-1], pool_y[k]
+        yield pool_x.pop(), pool_y.pop()

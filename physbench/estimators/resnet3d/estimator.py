@@ -1,0 +1,93 @@
+"""The learned correction estimator: p(k+1) = p(k) + Δp, Δp = net(observed, simulated)."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+
+from physbench.errors import PhysbenchError
+from physbench.params import Params
+from physbench.protocols import Step, Task
+
+
+class ResNet3DEstimator:
+    """3D-ResNet correction estimator (paper). Marks one unknown body at a time and batches all
+    marked bodies into one forward pass (the loop renders each marked view)."""
+
+    name: ClassVar[str] = "resnet3d"
+    per_object: ClassVar[bool] = True
+
+    def __init__(self, weights: str | None = None, threads: int = 0) -> None:
+        self.weights_path, self.threads = weights, threads
+
+    def start(self, task: Task, *, seed: int) -> None:
+        import torch
+
+        from physbench.estimators.resnet3d import weights
+        from physbench.estimators.resnet3d.model import NetConfig, build_net
+
+        params = tuple(dict.fromkeys(u.param for u in task.space.unknowns))
+        if self.weights_path:
+            state, meta = weights.load(self.weights_path)
+            trained_for = tuple(sorted(meta["data"]["params"]))
+            if trained_for != tuple(sorted(params)):
+                raise PhysbenchError(
+                    f"weights {self.weights_path!r} were trained for {'+'.join(trained_for)}, "
+                    f"the task asks for {'+'.join(sorted(params))}"
+                )
+        else:
+            info = weights.find(task.scene.name, params)
+            state, meta = weights.load(info.path)
+        self.params = tuple(meta["data"]["params"])
+        if self.threads:
+            torch.set_num_threads(self.threads)
+        torch.manual_seed(seed)
+        self.cfg = NetConfig.from_dict(meta["net"])
+        self.net = build_net(self.cfg)
+        self.net.load_state_dict({k: v.float() for k, v in state.items()})
+        self.net.eval()
+        self.space = task.space
+        self.observed: dict[str, np.ndarray] = dict(task.meta.get("marked_observation") or {})
+        # Per unknown body: its unknown keys in the network's output order and their range widths.
+        self.targets: list[tuple[str, list[str], np.ndarray]] = []
+        for body in task.space.bodies:
+            sub = task.space.subset(body)
+            keys = [f"{body}.{p}" for p in self.params]
+            missing = [k for k in keys if k not in sub.keys]
+            if missing:
+                raise PhysbenchError(f"body {body!r} lacks unknowns {missing} the weights predict")
+            if body not in self.observed:
+                raise PhysbenchError(
+                    f"resnet3d needs the observation with {body!r} marked (frames rendered with focus={body!r}); "
+                    "give marked_<body> arrays in the observation file"
+                )
+            by_key = {u.key: u for u in sub.unknowns}
+            self.targets.append((body, keys, np.array([by_key[k].high - by_key[k].low for k in keys])))
+
+    def propose(self, step: Step) -> Params:
+        import torch
+
+        from physbench.estimators.resnet3d.inputs import make_input
+
+        marked = getattr(step, "marked", None)
+        if not marked:
+            raise PhysbenchError("resnet3d corrects one marked object at a time: the loop must pass marked frames")
+        x = np.stack([
+            make_input(self.observed[body], marked[body], self.cfg.frames, self.cfg.resolution)
+            for body, _, _ in self.targets
+        ])
+        with torch.no_grad():
+            delta = self.net(torch.from_numpy(x)).numpy().astype(float)
+        new = dict(step.params)
+        for (_, keys, scale), d in zip(self.targets, delta, strict=True):
+            for k, s, dk in zip(keys, scale, d, strict=True):
+                new[k] = step.params[k] + dk * s
+        return self.space.clip(new)
+
+
+def info() -> dict[str, Any]:
+    """Shipped and user weights, for ``physbench plugins``-style listings."""
+    from physbench.estimators.resnet3d import weights
+
+    return {f"{w.scene}[{'+'.join(w.params)}]": str(w.path) for w in weights.available()}

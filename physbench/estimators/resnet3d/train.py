@@ -1,0 +1,183 @@
+"""Training loop for the correction network: on-the-fly pairs, Adam on the MSE of the normalised
+Δp, periodic atomic checkpoints (safetensors, no pickle) and resume."""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from physbench.estimators.resnet3d import weights
+from physbench.estimators.resnet3d.data import DataSpec, stream, validation_set
+from physbench.estimators.resnet3d.model import NetConfig, build_net
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    samples: int = 40_000  # training budget, in samples
+    batch: int = 16
+    lr: float = 1e-3
+    weight_decay: float = 1e-5
+    val_groups: int = 24
+    eval_every: int = 2_000  # samples between validation + checkpoint
+    workers: int = 1  # data processes beside the training process
+    threads: int = 0  # torch threads; 0 = torch's default
+    seed: int = 0
+
+
+def learning_rate(cfg: TrainConfig, seen: int) -> float:
+    """Linear warm-up over the first 5% of the budget, then cosine decay to 5% of ``cfg.lr``.
+
+    A function of samples seen only, so a resumed run (even with a larger budget) needs no
+    scheduler state.
+    """
+    import math
+
+    warm = max(1, cfg.samples // 20)
+    if seen < warm:
+        return cfg.lr * (seen + cfg.batch) / warm
+    frac = min(1.0, (seen - warm) / max(1, cfg.samples - warm))
+    return cfg.lr * (0.05 + 0.95 * 0.5 * (1 + math.cos(math.pi * frac)))
+
+
+def weights_name(spec: DataSpec) -> str:
+    return f"{spec.scene}__{'+'.join(sorted(spec.params))}"
+
+
+def _ranges(spec: DataSpec) -> dict[str, list[float]]:
+    from physbench.params import ParamSpace
+    from physbench.plugins import get_registry
+
+    scene = get_registry().get("scene", spec.scene)(0, **spec.scene_options)
+    space = ParamSpace.from_scene(scene, spec.params)
+    return {u.param: [u.low, u.high] for u in space.unknowns}
+
+
+def _optimizer_tensors(opt: Any) -> tuple[dict[str, Any], dict[str, Any]]:
+    sd = opt.state_dict()
+    tensors = {f"opt.{i}.{k}": v for i, st in sd["state"].items() for k, v in st.items()}
+    return tensors, {"param_groups": sd["param_groups"]}
+
+
+def _load_optimizer(opt: Any, tensors: dict[str, Any], groups: dict[str, Any]) -> None:
+    state: dict[int, dict[str, Any]] = {}
+    for key, v in tensors.items():
+        _, i, k = key.split(".", 2)
+        state.setdefault(int(i), {})[k] = v
+    opt.load_state_dict({"state": state, "param_groups": groups["param_groups"]})
+
+
+def _pairs_dataset(spec: DataSpec, start: int) -> Any:
+    """A torch ``IterableDataset`` over :func:`stream`, one disjoint seed stream per worker."""
+    import torch
+
+    class Pairs(torch.utils.data.IterableDataset):  # type: ignore[misc]
+        def __iter__(self):  # type: ignore[no-untyped-def]
+            info = torch.utils.data.get_worker_info()
+            w, n = (info.id, info.num_workers) if info else (0, 1)
+            for x, y in stream(spec, start, w, n):
+                yield torch.from_numpy(x), torch.from_numpy(y)
+
+    return Pairs()
+
+
+def evaluate_net(net: Any, x: np.ndarray, y: np.ndarray, batch: int = 64) -> float:
+    """Mean squared error of normalised Δp over a fixed set (dropout off)."""
+    import torch
+
+    net.eval()
+    err = 0.0
+    with torch.no_grad():
+        for i in range(0, len(x), batch):
+            pred = net(torch.from_numpy(x[i : i + batch])).numpy()
+            err += float(((pred - y[i : i + batch]) ** 2).sum())
+    net.train()
+    return err / y.size
+
+
+def train(
+    spec: DataSpec,
+    net_cfg: NetConfig,
+    cfg: TrainConfig,
+    out: str | Path,
+    *,
+    resume: bool = True,
+    progress: bool = True,
+) -> tuple[Path, dict[str, Any]]:
+    """Train (or resume) into ``out``; returns the final weights path and its sidecar."""
+    import torch
+    from tqdm import tqdm
+
+    import physbench
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    if cfg.threads:
+        torch.set_num_threads(cfg.threads)
+    torch.manual_seed(cfg.seed)
+    net = build_net(net_cfg)
+    opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    ckpt = out / "checkpoint.safetensors"
+    seen, best, history, wall0 = 0, float("inf"), [], 0.0
+    if resume and ckpt.is_file():
+        tensors, meta = weights.load(ckpt)
+        net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
+        _load_optimizer(opt, {k: v for k, v in tensors.items() if k.startswith("opt.")}, meta["optimizer"])
+        seen, best, history, wall0 = meta["samples"], meta["best_val"], meta["history"], meta["wall_s"]
+    vx, vy = validation_set(spec, cfg.val_groups)
+    loader = torch.utils.data.DataLoader(
+        _pairs_dataset(spec, seen), batch_size=cfg.batch, num_workers=cfg.workers,
+        persistent_workers=cfg.workers > 0, prefetch_factor=4 if cfg.workers else None,
+    )
+    bar = tqdm(total=cfg.samples, initial=seen, disable=not progress, unit="sample", dynamic_ncols=True)
+    t0, ema, next_eval = time.perf_counter(), None, seen + cfg.eval_every
+    net.train()
+    it = iter(loader)
+    while seen < cfg.samples:
+        x, y = next(it)
+        for group in opt.param_groups:
+            group["lr"] = learning_rate(cfg, seen)
+        loss = torch.nn.functional.mse_loss(net(x), y)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
+        opt.step()
+        seen += len(x)
+        value = loss.item()
+        ema = value if ema is None else 0.98 * ema + 0.02 * value
+        bar.update(len(x))
+        if seen >= next_eval or seen >= cfg.samples:
+            next_eval += cfg.eval_every
+            val = evaluate_net(net, vx, vy)
+            wall = wall0 + time.perf_counter() - t0
+            history.append({"samples": seen, "train_loss": ema, "val_mse": val, "wall_s": round(wall, 1)})
+            if val < best:
+                best = val
+                weights.save(out / "best.safetensors", dict(net.state_dict()), {"samples": seen, "val_mse": val})
+            tensors, groups = _optimizer_tensors(opt)
+            weights.save(ckpt, {**{f"net.{k}": v for k, v in net.state_dict().items()}, **tensors}, {
+                "samples": seen, "best_val": best, "history": history, "wall_s": wall,
+                "optimizer": groups,
+            })
+        bar.set_postfix(loss=f"{ema:.4f}", val=f"{best:.4f}", rate=f"{bar.format_dict.get('rate') or 0:.0f}/s")
+    bar.close()
+    best_state, _ = weights.load(out / "best.safetensors")
+    meta = {
+        "data": spec.to_dict(),
+        "net": net_cfg.to_dict(),
+        "ranges": _ranges(spec),
+        "normalization": "target = (p_observed - p_simulated) / (high - low), per parameter of the marked body",
+        "training": {**asdict(cfg), "samples_seen": seen, "wall_s": round(history[-1]["wall_s"], 1) if history else 0.0},
+        "val_mse": best,
+        "history": history,
+        "physbench_version": physbench.__version__,
+        "torch_version": torch.__version__,
+    }
+    # Shipped weights are float16 (half the size; inference casts back to float32).
+    final = weights.save(out / weights_name(spec), {k: v.half() for k, v in best_state.items()}, meta)
+    (out / "train_log.json").write_text(json.dumps(history, indent=1))
+    return final, meta

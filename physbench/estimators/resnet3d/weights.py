@@ -1,0 +1,91 @@
+"""Weights as safetensors plus a JSON sidecar; loading never unpickles.
+
+``NAME.safetensors`` holds the tensors, ``NAME.json`` the scene, unknowns, ranges, normalisation,
+architecture, input layout, training budget, validation error and physbench version. Shipped
+weights live in ``physbench/estimators/resnet3d/weights/``; ``PHYSBENCH_WEIGHTS`` (a path list)
+adds folders searched first.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from physbench.errors import PhysbenchError
+
+SHIPPED = Path(__file__).with_name("weights")
+
+
+@dataclass(frozen=True)
+class WeightsInfo:
+    path: Path  # the .safetensors file
+    meta: dict[str, Any]
+
+    @property
+    def scene(self) -> str:
+        return str(self.meta["data"]["scene"])
+
+    @property
+    def params(self) -> tuple[str, ...]:
+        return tuple(self.meta["data"]["params"])
+
+
+def save(path: str | Path, state: dict[str, Any], meta: dict[str, Any]) -> Path:
+    """Write ``state`` (name -> tensor) and ``meta`` atomically; returns the .safetensors path."""
+    from safetensors.torch import save_file
+
+    path = Path(path).with_suffix(".safetensors")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    save_file({k: v.detach().contiguous().cpu() for k, v in state.items()}, str(tmp))
+    side = path.with_suffix(".json")
+    side_tmp = path.with_suffix(".json.tmp")
+    side_tmp.write_text(json.dumps(meta, indent=2, sort_keys=True))
+    os.replace(tmp, path)
+    os.replace(side_tmp, side)
+    return path
+
+
+def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(tensors, meta) from a .safetensors file and its sidecar."""
+    from safetensors.torch import load_file
+
+    path = Path(path).with_suffix(".safetensors")
+    side = path.with_suffix(".json")
+    if not path.is_file() or not side.is_file():
+        raise PhysbenchError(f"weights {str(path)!r} need both {path.name} and {side.name}")
+    return load_file(str(path)), json.loads(side.read_text())
+
+
+def search_dirs() -> list[Path]:
+    extra = [Path(p) for p in os.environ.get("PHYSBENCH_WEIGHTS", "").split(os.pathsep) if p]
+    return [*extra, SHIPPED]
+
+
+def available() -> list[WeightsInfo]:
+    """Every weights file found, searched folders first to last."""
+    out = []
+    for d in search_dirs():
+        for side in sorted(d.glob("*.json")) if d.is_dir() else []:
+            st = side.with_suffix(".safetensors")
+            if st.is_file():
+                out.append(WeightsInfo(st, json.loads(side.read_text())))
+    return out
+
+
+def find(scene: str, params: tuple[str, ...]) -> WeightsInfo:
+    """The first weights trained for ``scene`` and exactly the parameter set ``params``."""
+    want = tuple(sorted(params))
+    found = available()
+    for w in found:
+        if w.scene == scene and tuple(sorted(w.params)) == want:
+            return w
+    have = ", ".join(f"{w.scene}[{'+'.join(w.params)}]" for w in found) or "none"
+    raise PhysbenchError(
+        f"no resnet3d weights for scene {scene!r} with parameters {'+'.join(want)}; available: {have}. "
+        f"Train them with `physbench train --scene {scene} --params {','.join(want)}` "
+        "and put the output folder on PHYSBENCH_WEIGHTS."
+    )

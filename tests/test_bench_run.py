@@ -1,0 +1,139 @@
+"""``physbench bench``: the long table, summaries, failed cells, resume-by-skipping, and identical
+tables from every executor."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from physbench.bench.runner import run_sweep
+from physbench.bench.spec import parse_spec
+from physbench.bench.tables import SCHEMA, TIMINGS, bootstrap_ci, without_timings
+from physbench.cli import main
+from physbench.errors import PhysbenchError
+from physbench.hookspecs import hookimpl
+from physbench.plugins import discover, get_registry, reset_registry
+
+TINY = {
+    "name": "tiny",
+    "estimators": ["random", {"name": "optuna", "options": {"startup": 2}}],
+    "seeds": 2,
+    "iterations": 3,
+    "resolution": 32,
+    "scenes": [{"name": "three_circles", "unknowns": ["mass", "mass+elasticity"]}],
+}
+
+
+class Flaky:
+    """Random search that fails in ``start`` when told to: a cell that raises."""
+
+    name: ClassVar[str] = "flaky"
+    per_object: ClassVar[bool] = False
+
+    def __init__(self, fail: bool = False) -> None:
+        self.options = {"fail": fail}
+
+    def start(self, task: Any, *, seed: int) -> None:
+        if self.options["fail"]:
+            raise PhysbenchError("flaky: asked to fail")
+        self.space, self.rng = task.space, np.random.default_rng(seed)
+
+    def propose(self, step: Any) -> dict[str, float]:
+        return self.space.from_unit(self.rng.random(len(self.space)))
+
+
+class _Plugin:
+    @staticmethod
+    @hookimpl
+    def register_estimators() -> list[type]:
+        return [Flaky]
+
+
+@pytest.fixture
+def flaky_registry() -> Iterator[None]:
+    reset_registry(discover(extra=[("test-flaky", _Plugin())]))
+    yield
+    reset_registry(None)
+
+
+def test_long_table_summary_and_failed_cells(tmp_path: Path, flaky_registry: None) -> None:
+    spec = parse_spec({**TINY, "estimators": ["random", {"name": "flaky", "label": "bad", "options": {"fail": True}}]})
+    res = run_sweep(spec, tmp_path, executor="serial", progress=False)
+    df = pd.read_parquet(tmp_path / "results.parquet")
+    assert list(df.columns) == list(SCHEMA) and res.failed == 4 and res.ran == 8
+    ok, bad = df[df["status"] == "ok"], df[df["status"] == "failed"]
+    assert len(ok) == 4 * 3 and len(bad) == 4  # one row per iteration; one row per failed cell
+    assert bad["iteration"].isna().all() and (bad["error"] == "PhysbenchError: flaky: asked to fail").all()
+    assert ok["iteration"].tolist() == [0, 1, 2] * 4
+    first = ok.iloc[0]
+    assert json.loads(first["keys"]) == ["a.mass", "b.mass"] and set(json.loads(first["params"])) == {"a.mass", "b.mass"}
+    assert json.loads(ok.iloc[6]["keys"]) == ["a.mass", "a.elasticity", "b.mass", "b.elasticity"]
+    assert (ok["best_nmse"] <= ok.groupby("cell")["nmse"].transform("max")).all()
+    assert json.loads(first["versions"])["physbench"] and first["t_cell"] > 0
+
+    st = pd.read_csv(tmp_path / "stats.csv")
+    row = st[(st["estimator"] == "random") & (st["unknowns"] == "mass")].iloc[0]
+    finals = ok[(ok["unknowns"] == "mass") & (ok["iteration"] == 2)]["best_nmse"]
+    assert row["n"] == 2 and row["mean"] == pytest.approx(finals.mean()) and row["median"] == pytest.approx(finals.median())
+    assert row["ci_low"] <= row["mean"] <= row["ci_high"] and row["paper_nn"] == "(2.6 ± 0.9)e-03"
+    assert st[st["estimator"] == "bad"]["failed"].tolist() == [2, 2]
+    md = (tmp_path / "summary.md").read_text()
+    assert "| 3 circles | paper NN | (2.6 ± 0.9)e-03 | (1.4 ± 0.5)e-02 |" in md and "failed (2)" in md
+    assert "flaky: asked to fail" in md
+    assert r"$(2.6 \pm 0.9) \times 10^{-3}$" in (tmp_path / "summary.tex").read_text()
+    assert pd.read_csv(tmp_path / "summary.csv").columns.tolist() == ["scene", "estimator", "Mass", "Mass + Elasticity"]
+
+    again = run_sweep(spec, tmp_path, executor="serial", progress=False)  # everything is done: nothing runs
+    assert (again.ran, again.skipped) == (0, 8)
+    pd.testing.assert_frame_equal(again.table, df)
+    retried = run_sweep(spec, tmp_path, executor="serial", progress=False, retry_failed=True)
+    assert (retried.ran, retried.failed) == (4, 4)
+    log = json.loads((tmp_path / "run.json").read_text())
+    assert [r["ran"] for r in log["runs"]] == [8, 0, 4]
+
+
+def test_bootstrap_interval_is_deterministic() -> None:
+    v = [1.0, 2.0, 3.0, 10.0]
+    assert bootstrap_ci(v) == bootstrap_ci(v)
+    lo, hi = bootstrap_ci(v)
+    assert 1.0 <= lo < np.mean(v) < hi <= 10.0
+    assert bootstrap_ci([5.0]) == (5.0, 5.0)
+
+
+@pytest.mark.slow
+def test_executors_give_identical_tables(tmp_path: Path) -> None:
+    pytest.importorskip("distributed")
+    reset_registry(None)
+    get_registry()
+    spec = parse_spec(TINY)
+    tables = {}
+    for name, kw in [("serial", {}), ("processes", {"workers": 2}), ("dask", {"workers": 2})]:
+        tables[name] = run_sweep(spec, tmp_path / name, executor=name, progress=False, **kw).table
+    assert len(tables["serial"]) == 8 * 3 and (tables["serial"]["status"] == "ok").all()
+    base = without_timings(tables["serial"])
+    assert not any(c in base.columns for c in TIMINGS)
+    for name in ("processes", "dask"):
+        pd.testing.assert_frame_equal(without_timings(tables[name]), base, check_exact=True)
+        on_disk = pd.read_parquet(tmp_path / name / "results.parquet")
+        pd.testing.assert_frame_equal(without_timings(on_disk), base, check_exact=True)
+
+
+def test_cli_prints_table_and_final_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "cli"\nestimators = ["random"]\nseeds = 2\niterations = 2\nresolution = 16\n'
+        '[[scenes]]\nname = "second_order"\nunknowns = ["elasticity"]\n'
+    )
+    assert main(["bench", str(spec), "--out", str(tmp_path / "o"), "--executor", "serial"]) == 0
+    out = capsys.readouterr().out
+    assert "| second order | paper NN | (4 ± 2)e-03 |" in out
+    assert out.splitlines()[-1].startswith("cli: 2 cells (2 run, 0 already done, 0 failed) in ")
+    assert (tmp_path / "o" / "spec.toml").read_text() == spec.read_text()
+    assert main(["bench", str(spec), "--out", str(tmp_path / "o"), "--executor", "serial", "-q", "--fresh"]) == 0
+    assert "(2 run, 0 already done" in capsys.readouterr().out

@@ -1,0 +1,126 @@
+"""Sweep specs: expansion into cells, seeds, and clear errors for bad specs and output folders."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from physbench.bench.spec import SpecError, load_spec, parse_spec
+from physbench.cli import main
+
+GOOD = {
+    "name": "t",
+    "estimators": ["random", {"name": "optuna", "label": "optuna-rs", "options": {"sampler": "random"}}],
+    "seeds": 3,
+    "iterations": [2, 3],
+    "resolution": 32,
+    "scenes": [{"name": "three_circles", "unknowns": ["mass", "mass+elasticity"]}, "second_order"],
+}
+
+
+def test_product_order_and_seeds() -> None:
+    spec = parse_spec(GOOD)
+    cells = spec.cells()
+    # (2 + 1 unknown sets) x 2 iteration budgets x 2 estimators x 3 seeds
+    assert len(cells) == 3 * 2 * 2 * 3
+    assert [c.index for c in cells] == list(range(len(cells)))
+    first = cells[0].case
+    assert (first.scene, first.params, first.iterations, first.estimator, first.seed) == ("three_circles", ("mass",), 2, "random", 0)
+    assert [c.case.seed for c in cells[:3]] == [0, 1, 2]  # the run seed is the seed value
+    assert cells[3].label == "optuna-rs" and cells[3].case.options == {"sampler": "random"}
+    assert cells[-1].case.params == ("mass",) and cells[-1].scene == "second_order"  # the default unknowns
+    assert len({c.key for c in cells}) == len(cells)
+    assert parse_spec(GOOD).cells()[5].key == cells[5].key  # keys are stable
+
+
+@pytest.mark.parametrize(
+    ("seeds", "expected"),
+    [(2, (0, 1)), ([7, 3], (7, 3)), ({"start": 10, "count": 2}, (10, 11))],
+)
+def test_seed_forms(seeds: object, expected: tuple[int, ...]) -> None:
+    assert parse_spec({**GOOD, "seeds": seeds}).seeds == expected
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"temperature": 3}, "unknown axis or key 'temperature'; known: name, description, scenes"),
+        ({"estimators": ["random", "nope"]}, "unknown estimator 'nope'; known estimators: "),
+        ({"estimators": [{"name": "optuna", "options": {"temperature": 1}}]}, "estimator 'optuna' does not take options"),
+        ({"scenes": ["no_such_scene"]}, "unknown scene 'no_such_scene'"),
+        ({"scenes": [{"name": "three_circles", "unknowns": ["friction"]}]}, "unknown parameter 'friction' of scene 'three_circles'"),
+        ({"scenes": [{"name": "three_circles", "colour": "red"}]}, "scenes[0]: unknown key 'colour'; known keys: name, unknowns, bodies"),
+        ({"engine": ["pymunk", "bullet"]}, "unknown simulator 'bullet'"),
+        ({"seeds": []}, "empty product: the axis 'seeds' has no values"),
+        ({"estimators": []}, "empty product: the axis 'estimators' has no values"),
+        ({"blur": []}, "empty product: the axis 'blur' has no values"),
+        ({"scenes": [{"name": "three_circles", "unknowns": []}]}, "empty product: the scene lists no unknown-parameter set"),
+        ({"seeds": -1}, "seeds = -1: expected a count"),
+        ({"iterations": 0}, "iterations = 0: expected a whole number >= 1"),
+        ({"blur": -1.0}, "blur = -1.0: expected a finite number >= 0"),
+        ({"estimators": ["random", "random"]}, "two estimators are labelled 'random'"),
+    ],
+)
+def test_bad_specs(change: dict[str, object], message: str) -> None:
+    with pytest.raises(SpecError) as err:
+        parse_spec({**GOOD, **change})
+    assert message in str(err.value), str(err.value)
+
+
+def test_missing_axis_and_duplicate_cells() -> None:
+    with pytest.raises(SpecError, match="seeds: missing; a spec needs scenes, estimators and seeds"):
+        parse_spec({k: v for k, v in GOOD.items() if k != "seeds"})
+    with pytest.raises(SpecError, match=r"cells 0 and 12 are the same run \(scene 'three_circles', unknowns mass"):
+        parse_spec({**GOOD, "scenes": ["three_circles", "three_circles"]})
+
+
+def test_cli_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "s.toml"
+    spec.write_text('name = "s"\nestimators = ["random"]\nseeds = 1\niterations = 1\nresolution = 16\nscenes = ["three_circles"]\n')
+    blocker = tmp_path / "file.txt"
+    blocker.write_text("")
+    cases = [
+        ([str(tmp_path / "missing.toml")], "spec file"),
+        ([str(spec), "--executor", "serial", "--out", str(blocker / "sub")], "cannot write results there"),
+        ([str(spec), "--executor", "serial", "--address", "tcp://x:1"], "needs --executor dask"),
+        ([str(spec), "--workers", "0"], "--workers 0: expected a whole number >= 1"),
+    ]
+    for argv, message in cases:
+        if "--out" not in argv:
+            argv = [*argv, "--out", str(tmp_path / "out")]
+        code = main(["bench", *argv])
+        err = capsys.readouterr().err
+        assert code == 2 and err.startswith("physbench bench: error: ") and message in err, err
+    bad = tmp_path / "bad.toml"
+    bad.write_text("seeds = [\n")
+    assert main(["bench", str(bad), "--out", str(tmp_path / "o")]) == 2
+    assert "not valid TOML" in capsys.readouterr().err
+
+
+def test_shipped_specs_load() -> None:
+    root = Path(__file__).parent.parent / "benchmarks"
+    t1 = load_spec(root / "table1.toml")
+    assert t1.seeds == tuple(range(50)) and t1.axes["iterations"] == (11,)
+    assert {e.name for e in t1.estimators} >= {"tpe", "cmaes", "optuna", "random", "resnet3d"}
+    assert {(s.name, u) for s in t1.scenes for u in s.unknowns} == {
+        ("three_circles", ("mass",)), ("three_circles", ("elasticity",)), ("three_circles", ("mass", "elasticity")),
+        ("second_order", ("mass",)), ("second_order", ("elasticity",)),
+        ("stacked_boxes", ("mass",)), ("stacked_boxes", ("friction",)), ("bouncing_balls", ("mass",)),
+    }
+    assert len(load_spec(root / "smoke.toml").seeds) >= 5  # the compare test needs >= 5 seeds
+    gap = load_spec(root / "reality_gap.toml")
+    assert any(c.case.engine != c.case.observe_engine for c in gap.cells())
+
+
+def test_argument_parsing_imports_nothing_heavy() -> None:
+    code = (
+        "import sys\nfrom physbench.cli import build_parser\n"
+        "for c in ('bench', 'plot', 'compare'):\n"
+        "    build_parser(c)\n"
+        "print([m for m in ('numpy', 'pandas', 'physbench.bench.runner', 'matplotlib') if m in sys.modules])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
