@@ -13,7 +13,8 @@ TORCH = "torch==2.13.0"  # a CPU wheel; a bare "torch" pulls a multi-GB CUDA bui
 @nox.session
 def tests(session: nox.Session) -> None:
     session.install(TORCH)
-    session.install("-e", ".[all]", "./plugins/physbench-scipy")
+    session.install("-e", ".[all]")
+    session.install("./plugins/physbench-scipy")
     session.run("pytest", "tests", "plugins/physbench-scipy/tests", *session.posargs)
 
 
