@@ -13,12 +13,17 @@ from physbench.protocols import Step, Task
 
 class ResNet3DEstimator:
     """3D-ResNet correction estimator (paper). Marks one unknown body at a time and batches all
-    marked bodies into one forward pass (the loop renders each marked view)."""
+    marked bodies into one forward pass (the loop renders each marked view).
+
+    Options: ``weights`` (a .safetensors path; default: the shipped or ``PHYSBENCH_WEIGHTS``
+    weights matching the scene and unknowns), ``threads`` (torch threads for inference, set
+    process-wide; 1 keeps parallel runs from oversubscribing the cores, 0 = torch's default).
+    """
 
     name: ClassVar[str] = "resnet3d"
     per_object: ClassVar[bool] = True
 
-    def __init__(self, weights: str | None = None, threads: int = 0) -> None:
+    def __init__(self, weights: str | None = None, threads: int = 1) -> None:
         self.weights_path, self.threads = weights, threads
 
     def start(self, task: Task, *, seed: int) -> None:
