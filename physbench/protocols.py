@@ -34,13 +34,32 @@ class EffectParam:
 @runtime_checkable
 class Effect(Protocol):
     """A model extension (drag, rolling resistance, joint damping, ...) that every engine applies
-    the same way: as extra forces and torques on the bodies at every substep."""
+    the same way: as extra forces and torques on the bodies at every substep.
+
+    Optional members the framework uses when present:
+
+    ``key: str``
+        prefix of the effect's parameter keys (default ``name``); two instances of one effect in a
+        simulation need distinct keys.
+    ``applies_forces: bool``
+        ``False`` when :meth:`forces` is always zero; the stepping loop then skips it.
+    ``restitution(normal_speed, a, b) -> float | None``
+        called by the engine once when a contact starts between bodies ``a`` and ``b`` (indices
+        into ``scene.bodies``, ``b`` ``None`` for static geometry) with the approach speed along
+        the normal (m/s, >= 0); returns the coefficient of restitution for that contact, or
+        ``None`` to keep the scene's.
+    ``measure(traj) -> Trajectory``
+        a measurement effect: called after every simulation, before the trajectory is compared
+        with data (:func:`physbench.effects.apply_measurements`).
+    """
 
     name: ClassVar[str]
     params: ClassVar[tuple[EffectParam, ...]]
 
     def setup(self, scene: Scene, values: Mapping[str, float]) -> None:
-        """Called once before each simulation with the effect's parameter values."""
+        """Called by the simulator once before each simulation, with the scene as simulated (body
+        parameters applied) and the effect's parameter values given to ``simulate`` as
+        ``"<key>.<param>"`` (bare names; missing ones keep their current value)."""
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Called every substep with ``states`` ``(N, 6)`` (x, y, angle, vx, vy, omega of the

@@ -3,7 +3,14 @@
 An effect is configured in two ways that combine: keyword values at construction
 (``LinearDrag(c=0.1)``) and :meth:`EffectBase.setup` before each simulation, whose values override
 the constructor's. Values are keyed by the bare parameter name (``"c"``) or the qualified one
-(``"linear_drag.c"``); every value must be finite and inside the parameter's ``[low, high]``.
+(``"linear_drag.c"``, or ``"<label>.c"`` for an instance built with ``label=...``); every value must
+be finite and inside the parameter's ``[low, high]``.
+
+The simulators call :meth:`EffectBase.setup` themselves before every simulation, with the scene as
+simulated and the values found in ``simulate(params=...)`` under the effect's :attr:`~EffectBase.key`
+(``{"linear_drag.c": 0.2}``), so an effect can be fitted like any body parameter. Two instances of
+one effect need distinct labels (``LinearDrag(label="drag_a", bodies=["a"])``): the label is the
+prefix of their parameter keys.
 """
 
 from __future__ import annotations
@@ -58,22 +65,35 @@ class EffectBase:
 
     name: ClassVar[str] = ""
     params: ClassVar[tuple[EffectParam, ...]] = ()
+    #: False for effects whose :meth:`forces` are always zero (measurement and contact laws): the
+    #: stepping loop then does not call them every substep.
+    applies_forces: ClassVar[bool] = True
 
-    def __init__(self, *, bodies: Iterable[str] | None = None, **values: float) -> None:
+    def __init__(self, *, bodies: Iterable[str] | None = None, label: str | None = None, **values: float) -> None:
         if isinstance(bodies, str):
             raise EffectError(f"{self.name}: bodies must be a list of body names, not the string {bodies!r}")
+        if label is not None and (not isinstance(label, str) or not label or "." in label):
+            raise EffectError(f"{self.name}: label = {label!r}: expected a non-empty name without '.'")
         self.bodies = None if bodies is None else tuple(bodies)
+        #: Prefix of this instance's parameter keys (``"<key>.<param>"``): the label, else the name.
+        self.key: str = label or self.name
         self.values: dict[str, float] = {p.name: p.default for p in self.params}
         self.values.update(self._checked(values))
         self.scene: Scene | None = None
         self.mask = np.zeros(0, dtype=bool)
+        self.sel: slice | np.ndarray = slice(None)
         self.masses = np.zeros(0)
         self.inertias = np.zeros(0)
 
     def __repr__(self) -> str:
         vals = ", ".join(f"{k}={v:g}" for k, v in self.values.items())
         sel = f", bodies={list(self.bodies)!r}" if self.bodies is not None else ""
-        return f"{type(self).__name__}({vals}{sel})"
+        lab = f", label={self.key!r}" if self.key != self.name else ""
+        return f"{type(self).__name__}({vals}{sel}{lab})"
+
+    def qualified(self) -> dict[str, float]:
+        """The current values keyed ``"<key>.<param>"``, as :meth:`setup` and ``simulate`` take them."""
+        return {f"{self.key}.{k}": v for k, v in self.values.items()}
 
     # ----------------------------------------------------------------- configuration
 
@@ -87,19 +107,20 @@ class EffectBase:
     def _checked(self, values: Mapping[str, float]) -> dict[str, float]:
         out: dict[str, float] = {}
         for key, value in values.items():
-            name = key.removeprefix(f"{self.name}.")
+            name = key.removeprefix(f"{self.key}.").removeprefix(f"{self.name}.")
             p = self.param(name)
             if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
-                raise EffectError(f"{self.name}.{name} = {value!r}: must be a number in [{p.low:g}, {p.high:g}] {p.unit}")
+                raise EffectError(f"{self.key}.{name} = {value!r}: must be a number in [{p.low:g}, {p.high:g}] {p.unit}")
             v = float(value)
             if not math.isfinite(v) or not p.low <= v <= p.high:
-                raise EffectError(f"{self.name}.{name} = {v!r}: must lie in [{p.low:g}, {p.high:g}] {p.unit}".rstrip())
+                raise EffectError(f"{self.key}.{name} = {v!r}: must lie in [{p.low:g}, {p.high:g}] {p.unit}".rstrip())
             out[name] = v
         return out
 
     def setup(self, scene: Scene, values: Mapping[str, float]) -> None:
-        """Called once before each simulation, with the scene as simulated (body parameters
-        applied) and the effect's parameter values (missing ones keep their current value)."""
+        """Called by the simulator once before each simulation, with the scene as simulated (body
+        parameters applied) and the effect's parameter values (missing ones keep their current
+        value)."""
         self.values.update(self._checked(values))
         names = scene.body_names
         if self.bodies is None:
@@ -109,6 +130,8 @@ class EffectBase:
                 if b not in names:
                     raise UnknownNameError(f"body of scene {scene.name!r} (effect {self.name})", b, names)
             self.mask = np.array([n in self.bodies for n in names], dtype=bool)
+        # Index of the selected bodies: a plain slice when all are selected (cheaper every substep).
+        self.sel = slice(None) if self.mask.all() else np.nonzero(self.mask)[0]
         self.masses = np.array([b.mass for b in scene.bodies], dtype=float)
         self.inertias = np.array([b.inertia() for b in scene.bodies], dtype=float)
         self.scene = scene
@@ -150,6 +173,7 @@ class JointEffectBase(EffectBase):
         self.ia = np.zeros(0, dtype=int)
         self.ib = np.zeros(0, dtype=int)  # -1: the world
         self.reduced_inertia = np.zeros(0)
+        self._to_world = False
 
     def configure(self, scene: Scene) -> None:
         chosen = range(len(scene.joints)) if self.joints is None else self.joints
@@ -168,6 +192,7 @@ class JointEffectBase(EffectBase):
         # Smallest inertia the torque acts on: the pivot only adds inertia, so this bounds the
         # fastest response of the relative rate and sets the regularisation floor.
         self.reduced_inertia = 1.0 / (ia_inv + ib_inv)
+        self._to_world = bool(np.all(self.ib < 0) and len(set(self.ia.tolist())) == len(self.ia))
 
     def law(self, rate: np.ndarray) -> np.ndarray:
         """Torque on body ``a`` for relative rates ``rate`` (one per selected joint)."""
@@ -178,6 +203,9 @@ class JointEffectBase(EffectBase):
         n = states.shape[0]
         f, tau = self.zeros(n)
         omega = states[:, 5]
+        if self._to_world:  # every selected joint ties a distinct body to the world
+            tau[self.ia] = self.law(omega[self.ia])
+            return f, tau
         rate = omega[self.ia] - np.where(self.ib >= 0, omega[np.maximum(self.ib, 0)], 0.0)
         torque = self.law(rate)
         np.add.at(tau, self.ia, torque)

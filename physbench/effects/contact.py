@@ -1,7 +1,9 @@
 """Contact laws that replace the scene's constant restitution.
 
-These need a per-contact engine hook that the simulators do not offer yet (see
-:meth:`VelocityDependentRestitution.restitution`); until then the effect applies no forces.
+They act through the simulators' contact hook, not through forces: when a contact starts, the
+stepping loop asks every effect that has a ``restitution`` method for the coefficient to use (see
+:meth:`VelocityDependentRestitution.restitution`). pymunk applies it for the whole contact;
+Box2D still treats impacts slower than its compiled-in 1 m/s as inelastic.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ class VelocityDependentRestitution(EffectBase):
     """
 
     name: ClassVar[str] = "velocity_dependent_restitution"
+    applies_forces: ClassVar[bool] = False
     params: ClassVar[tuple[EffectParam, ...]] = (
         EffectParam("e0", 0.9, 0.0, 1.0, "", "restitution of a very slow impact"),
         EffectParam("k", 0.0, 0.0, 1.0, "s/m", "restitution lost per m/s of normal impact speed"),
@@ -42,9 +45,10 @@ class VelocityDependentRestitution(EffectBase):
         return self.zeros(states.shape[0])
 
     def restitution(self, normal_speed: float, a: int, b: int | None) -> float | None:
-        """To be called by an engine when a new contact starts between body ``a`` and body ``b``
-        (``None``: static geometry), before the solver runs, with the approach speed along the
-        contact normal (>= 0). Returns the restitution to use, or ``None`` to keep the scene's."""
+        """Called by the engine once when a new contact starts between body ``a`` and body ``b``
+        (indices into ``scene.bodies``; ``b`` is ``None`` for static geometry), before the solver
+        runs, with the approach speed along the contact normal (>= 0). Returns the restitution to
+        use for that contact, or ``None`` to keep the scene's."""
         if self.statics_only and b is not None:
             return None
         if self.bodies is not None and not (self.mask[a] or (b is not None and self.mask[b])):

@@ -21,7 +21,7 @@ class LinearDrag(EffectBase):
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         self._require_setup(states)
         f, tau = self.zeros(states.shape[0])
-        f[self.mask] = -self.values["c"] * states[self.mask, 3:5]
+        f[self.sel] = -self.values["c"] * states[self.sel, 3:5]
         return f, tau
 
 
@@ -39,7 +39,7 @@ class QuadraticDrag(EffectBase):
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         self._require_setup(states)
         f, tau = self.zeros(states.shape[0])
-        v = states[self.mask, 3:5]
+        v = states[self.sel, 3:5]
         speed = np.sqrt((v * v).sum(axis=1, keepdims=True))
-        f[self.mask] = -self.values["c"] * speed * v
+        f[self.sel] = -self.values["c"] * speed * v
         return f, tau

@@ -23,7 +23,7 @@ class ConstantForce(EffectBase):
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         self._require_setup(states)
         f, tau = self.zeros(states.shape[0])
-        f[self.mask] = (self.values["fx"], self.values["fy"])
+        f[self.sel] = (self.values["fx"], self.values["fy"])
         return f, tau
 
 
@@ -39,6 +39,6 @@ class TableTilt(EffectBase):
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         self._require_setup(states)
         f, tau = self.zeros(states.shape[0])
-        m = self.masses[self.mask, None]
-        f[self.mask] = m * np.array([self.values["ax"], self.values["ay"]])
+        m = self.masses[self.sel, None]
+        f[self.sel] = m * np.array([self.values["ax"], self.values["ay"]])
         return f, tau

@@ -17,6 +17,8 @@ from physbench.trajectory import Trajectory
 
 
 class _Measurement(EffectBase):
+    applies_forces: ClassVar[bool] = False
+
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return self.zeros(states.shape[0])
 

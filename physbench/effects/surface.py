@@ -37,6 +37,6 @@ class RollingResistance(EffectBase):
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         self._require_setup(states)
         f, tau = self.zeros(states.shape[0])
-        m = self.masses[self.mask, None]
-        f[self.mask] = -self.values["mu"] * self.g * m * smooth_unit(states[self.mask, 3:5], self._eps)
+        m = self.masses[self.sel, None]
+        f[self.sel] = -self.values["mu"] * self.g * m * smooth_unit(states[self.sel, 3:5], self._eps)
         return f, tau

@@ -43,6 +43,36 @@ def _listener_class() -> Any:
     return ProductMixing
 
 
+@functools.cache
+def _hooked_listener_class() -> Any:
+    """Product mixing plus a restitution hook asked in ``PreSolve`` when a contact first touches
+    (``oldManifold.pointCount == 0``); the contact keeps that restitution while it lasts."""
+
+    class HookedMixing(_listener_class()):  # type: ignore[misc]
+        def __init__(self, hook: Any) -> None:
+            super().__init__()
+            self.hook = hook
+
+        def PreSolve(self, contact: Any, old: Any) -> None:
+            if old.pointCount != 0:
+                return
+            fa, fb = contact.fixtureA, contact.fixtureB
+            ba, bb = fa.body, fb.body
+            ia, ib = ba.userData, bb.userData
+            if ia is None and ib is None:
+                return
+            wm = contact.worldManifold
+            n = wm.normal
+            p = wm.points[0]
+            va, vb = ba.GetLinearVelocityFromWorldPoint(p), bb.GetLinearVelocityFromWorldPoint(p)
+            speed = max(0.0, -((vb[0] - va[0]) * n[0] + (vb[1] - va[1]) * n[1]))
+            e = self.hook(speed, ia, ib) if ia is not None else self.hook(speed, ib, None)
+            if e is not None:
+                contact.restitution = e
+
+    return HookedMixing
+
+
 def _polygon(points: Any) -> Any:
     import Box2D
 
@@ -151,6 +181,7 @@ class Box2DWorld:
         for b, (*_, vx, vy, w) in zip(scene.bodies, initial_com_state(scene), strict=True):
             try:
                 self.bodies.append(_add_body(world, b, (vx, vy), w))
+                self.bodies[-1].userData = len(self.bodies) - 1  # index for the contact hook
             except SimulationError:
                 raise
             except Exception as exc:  # e.g. more vertices than Box2D's b2_maxPolygonVertices
@@ -165,6 +196,13 @@ class Box2DWorld:
         h = scene.dt / scene.substeps
         self.max_speed = Box2D.b2_maxTranslation / h
         self.max_angular_speed = Box2D.b2_maxRotation / h
+
+    def set_restitution_hook(self, hook: Any) -> None:
+        """Ask ``hook`` for the restitution of every contact when it first touches. Box2D still
+        makes impacts slower than ``b2_velocityThreshold`` (1 m/s) inelastic."""
+        listener = _hooked_listener_class()(hook)
+        self.world.contactListener = listener
+        self._listener = listener  # keep alive: Box2D holds only a raw pointer
 
     def step(self, h: float) -> None:
         self.world.Step(h, self.vi, self.pi)

@@ -75,6 +75,7 @@ class PymunkWorld:
             space.add(joint)
         if velocity_threshold > 0:
             space.on_collision(begin=_inelastic_below(velocity_threshold))
+        self.velocity_threshold = velocity_threshold
         self.space = space
         self._batch = _BatchReader.for_world(self)
 
@@ -104,6 +105,41 @@ class PymunkWorld:
 
     def apply_torque(self, i: int, tau: float) -> None:
         self.bodies[i].torque += tau
+
+    def set_restitution_hook(self, hook: Callable[[float, int, int | None], float | None]) -> None:
+        """Ask ``hook`` for the restitution of every contact when it starts (Chipmunk resets a
+        contact's restitution to the product every step, so it is re-applied each step until the
+        shapes separate)."""
+        index = {b: i for i, b in enumerate(self.bodies)}
+        chosen: dict[tuple[int, int], float | None] = {}
+        threshold = self.velocity_threshold
+
+        def pair(arbiter: Any) -> tuple[int, int]:
+            a, b = arbiter.shapes
+            return (id(a), id(b)) if id(a) < id(b) else (id(b), id(a))
+
+        def pre_solve(arbiter: Any, space: Any, data: Any) -> None:
+            key = pair(arbiter)
+            if arbiter.is_first_contact:
+                e = None
+                points = arbiter.contact_point_set.points
+                a, b = arbiter.bodies
+                ia, ib = index.get(a), index.get(b)
+                if points and (ia is not None or ib is not None):
+                    p = points[0].point_a
+                    speed = max(0.0, -(b.velocity_at_world_point(p) - a.velocity_at_world_point(p)).dot(arbiter.normal))
+                    e = hook(speed, ia, ib) if ia is not None else hook(speed, ib, None)  # type: ignore[arg-type]
+                    if e is not None and speed < threshold:
+                        e = 0.0  # as the begin handler of velocity_threshold would
+                chosen[key] = e
+            e = chosen.get(key)
+            if e is not None:
+                arbiter.restitution = e
+
+        def separate(arbiter: Any, space: Any, data: Any) -> None:
+            chosen.pop(pair(arbiter), None)
+
+        self.space.on_collision(pre_solve=pre_solve, separate=separate)
 
     def apply_impulse(self, i: int, jx: float, jy: float) -> None:
         # The velocity change must not move the already-reported position x + h v.

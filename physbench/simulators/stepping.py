@@ -4,17 +4,24 @@ An engine adapter (:class:`EngineWorld`) only builds the world, steps it and rea
 state; the schedule of forces and impulses, effects, recording at the frame rate, the conversion
 from centre of mass to shape centre and the explosion check live here once, so both engines
 behave the same by construction.
+
+Effects: ``simulate(scene, params, effects=[...])`` routes every ``params`` key ``"<key>.<param>"``
+whose prefix is an effect's key (its label, else its name) to that effect, applies the rest to the
+scene's bodies, and calls each effect's ``setup(scene_as_simulated, values)`` before building, so
+every engine prepares effects the same way. Effects with a ``restitution`` method are installed as
+the engine's contact hook (:meth:`EngineWorld.set_restitution_hook`); effects with
+``applies_forces = False`` are not called every substep.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import ClassVar, Protocol
 
 import numpy as np
 
-from physbench.errors import SimulationError
+from physbench.errors import PhysbenchError, SimulationError
 from physbench.protocols import Effect
 from physbench.scene import Scene
 from physbench.trajectory import Trajectory
@@ -44,6 +51,62 @@ class EngineWorld(Protocol):
     def apply_torque(self, i: int, tau: float) -> None: ...
 
     def apply_impulse(self, i: int, jx: float, jy: float) -> None: ...
+
+    # Optional: ``set_restitution_hook(hook)``, with ``hook(normal_speed, a, b) -> float | None``
+    # called once when a contact starts (a, b body indices, b None for static geometry); the
+    # returned restitution replaces the contact's for its duration. Needed by contact effects.
+
+
+RestitutionHook = Callable[[float, int, "int | None"], "float | None"]
+
+
+def split_params(
+    params: Mapping[str, float] | None, effects: Sequence[Effect]
+) -> tuple[dict[str, float], list[dict[str, float]]]:
+    """``params`` split into body parameters and, per effect, its values by bare parameter name.
+
+    A key belongs to an effect when its prefix (before the last ``.``) is the effect's key.
+    Raises :class:`~physbench.errors.PhysbenchError` when two effects share a key.
+    """
+    values: list[dict[str, float]] = [{} for _ in effects]
+    if not effects:
+        return dict(params or {}), values
+    keys: dict[str, int] = {}
+    for i, eff in enumerate(effects):
+        k = str(getattr(eff, "key", eff.name))
+        if k in keys:
+            raise PhysbenchError(
+                f"two effects share the parameter key {k!r} ({effects[keys[k]]!r} and {eff!r}); "
+                f"give one a distinct label, e.g. label='{k}_2'"
+            )
+        keys[k] = i
+    body: dict[str, float] = {}
+    for key, value in (params or {}).items():
+        prefix, _, name = key.rpartition(".")
+        if prefix in keys:
+            values[keys[prefix]][name] = value
+        else:
+            body[key] = value
+    return body, values
+
+
+def first_restitution(effects: Sequence[object]) -> RestitutionHook | None:
+    """One hook asking each effect with a ``restitution`` method in turn (the first answer that
+    is not ``None`` wins), or ``None`` when no effect has one."""
+    hooks = [e.restitution for e in effects if callable(getattr(e, "restitution", None))]  # type: ignore[attr-defined]
+    if not hooks:
+        return None
+    if len(hooks) == 1:
+        return hooks[0]
+
+    def hook(speed: float, a: int, b: int | None) -> float | None:
+        for h in hooks:
+            e = h(speed, a, b)
+            if e is not None:
+                return e
+        return None
+
+    return hook
 
 
 def com_offsets_world(scene: Scene, angles: np.ndarray) -> np.ndarray:
@@ -109,8 +172,13 @@ class SteppingSimulator:
         *,
         effects: Sequence[Effect] = (),
     ) -> Trajectory:
+        values: list[dict[str, float]] = []
+        if effects:
+            params, values = split_params(params, effects)
         if params:
             scene = scene.with_params(params)
+        for eff, vals in zip(effects, values, strict=True):
+            eff.setup(scene, vals)  # errors in effect values are the caller's, raised unchanged
         try:
             world = self.build(scene)
         except SimulationError:
@@ -119,6 +187,18 @@ class SteppingSimulator:
             raise SimulationError(
                 f"engine cannot build the scene: {type(exc).__name__}: {exc}", engine=self.name, frame=0
             ) from exc
+        if effects:
+            hook = first_restitution(effects)
+            if hook is not None:
+                install = getattr(world, "set_restitution_hook", None)
+                if install is None:
+                    names = [e.name for e in effects if callable(getattr(e, "restitution", None))]
+                    raise SimulationError(
+                        f"effects {names} change contacts, but this engine has no contact hook "
+                        "(EngineWorld.set_restitution_hook)", engine=self.name, frame=0
+                    )
+                install(hook)
+            effects = [e for e in effects if getattr(e, "applies_forces", True)]
         T, n_sub = scene.frames, scene.substeps
         h = scene.dt / n_sub
         sched = _schedule(scene, h, (T - 1) * n_sub)
@@ -187,16 +267,20 @@ class SteppingSimulator:
     @staticmethod
     def _apply_effects(world: EngineWorld, effects: Sequence[Effect], t: float, n: int) -> None:
         state = np.asarray(world.read()).reshape(n, 6)
-        for eff in effects:
-            try:
-                fxy, tau = eff.forces(t, state)
-            except Exception as exc:
-                raise _EffectFailed from exc
-            for i in range(n):
-                if fxy[i, 0] or fxy[i, 1]:
-                    world.apply_force(i, float(fxy[i, 0]), float(fxy[i, 1]))
-                if tau[i]:
-                    world.apply_torque(i, float(tau[i]))
+        try:
+            fxy, tau = effects[0].forces(t, state)
+            for eff in effects[1:]:
+                f2, t2 = eff.forces(t, state)
+                fxy, tau = fxy + f2, tau + t2
+        except Exception as exc:
+            raise _EffectFailed from exc
+        forces, torques = np.asarray(fxy, dtype=float).tolist(), np.asarray(tau, dtype=float).tolist()
+        for i in range(n):
+            fx, fy = forces[i]
+            if fx or fy:
+                world.apply_force(i, fx, fy)
+            if torques[i]:
+                world.apply_torque(i, torques[i])
 
     def _check(self, scene: Scene, states: np.ndarray, world: EngineWorld) -> None:
         """Raise for the earliest frame where a body is NaN, far outside the world, or at the

@@ -1,0 +1,107 @@
+"""The candidate model extensions for a scene: which registered effects apply and to which bodies,
+and where their parameters start (where the effect changes nothing, so that a candidate fit starts
+from the current model).
+
+Rules for the built-ins: translational losses (``linear_drag``, ``quadratic_drag``,
+``rolling_resistance``) act on free bodies only: on a body hanging from a pivot they are the joint
+losses again (for one arm, drag on the centre of mass *is* viscous or quadratic joint damping and
+rolling resistance *is* Coulomb friction), which the joint effects describe. Contact laws need
+static geometry or a second body. Any other effect (third-party ones included) is a candidate when
+its ``setup`` accepts the scene.
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from physbench.errors import UnknownNameError
+
+if TYPE_CHECKING:
+    from physbench.protocols import Effect
+    from physbench.scene import Scene
+
+#: Effects that act on a body's translation like a loss; offered for free bodies only.
+TRANSLATIONAL_LOSSES = ("linear_drag", "quadratic_drag", "rolling_resistance")
+CONTACT_LAWS = ("velocity_dependent_restitution",)
+
+
+@dataclass(frozen=True)
+class CandidateSpec:
+    """How to make one candidate effect: its registered ``name`` and construction options."""
+
+    name: str
+    options: tuple[tuple[str, Any], ...] = ()
+
+    def make(self) -> Effect:
+        from physbench.plugins import get_registry
+
+        return get_registry().get("effect", self.name)(**dict(self.options))
+
+    @property
+    def label(self) -> str:
+        return dict(self.options).get("label", self.name)
+
+
+def _order(names: Sequence[str]) -> list[str]:
+    from physbench.effects import BUILTIN_EFFECTS
+
+    builtin = [c.name for c in BUILTIN_EFFECTS]
+    return [n for n in builtin if n in names] + sorted(n for n in names if n not in builtin)
+
+
+def free_bodies(scene: Scene) -> list[str]:
+    jointed = {j.a for j in scene.joints} | {j.b for j in scene.joints if j.b is not None}
+    return [b.name for b in scene.bodies if b.name not in jointed]
+
+
+def candidates_for(
+    scene: Scene, names: Sequence[str] | None = None, *, factories: dict[str, Callable[..., Effect]] | None = None
+) -> tuple[list[CandidateSpec], list[tuple[str, str]]]:
+    """Candidates for ``scene`` from the registered effects (or ``names``), and the ones left out
+    with the reason. Raises :class:`UnknownNameError` for a name that is not registered."""
+    from physbench.plugins import get_registry
+
+    registry = get_registry()
+    known = registry.names("effect")
+    chosen = _order(known) if names is None else list(dict.fromkeys(names))
+    for n in chosen:
+        if n not in known:
+            raise UnknownNameError("effect", n, known)
+    free = free_bodies(scene)
+    out: list[CandidateSpec] = []
+    skipped: list[tuple[str, str]] = []
+    for name in chosen:
+        options: dict[str, Any] = {}
+        if name in TRANSLATIONAL_LOSSES and len(free) < len(scene.bodies):
+            if not free:
+                skipped.append((name, "no free bodies (on a jointed body this loss is joint damping)"))
+                continue
+            options["bodies"] = free
+        if name in CONTACT_LAWS and not scene.statics and len(scene.bodies) < 2:
+            skipped.append((name, "nothing to collide with"))
+            continue
+        spec = CandidateSpec(name, tuple(sorted(options.items())))
+        try:
+            eff = (factories or {}).get(name, registry.get("effect", name))(**options)
+            eff.setup(scene, {})
+        except Exception as exc:  # an effect that cannot describe this scene is not a candidate
+            skipped.append((name, f"{type(exc).__name__}: {exc}"))
+            continue
+        out.append(spec)
+    return out, skipped
+
+
+def start_values(effect: Effect, scene: Scene) -> dict[str, float]:
+    """Parameter values at which ``effect`` leaves ``scene``'s dynamics unchanged, where they
+    differ from the defaults: a velocity-dependent restitution starts at the scene's typical
+    restitution (median product of the surfaces that can meet) and no speed dependence."""
+    if getattr(effect, "name", "") == "velocity_dependent_restitution":
+        products = [b.elasticity * s.elasticity for b in scene.bodies for s in scene.statics]
+        if not getattr(effect, "statics_only", False):
+            bs = scene.bodies
+            products += [bs[i].elasticity * bs[j].elasticity for i in range(len(bs)) for j in range(i + 1, len(bs))]
+        return {"e0": float(statistics.median(products)) if products else 0.9, "k": 0.0}
+    return {}

@@ -1,0 +1,314 @@
+"""Summary statistics of the disagreement between a fitted model and the data that point at causes:
+speed lost in free flight beyond the model (and how that loss scales with speed), energy lost at
+impacts beyond the restitution, a uniform acceleration the model lacks, a constant offset, and the
+amplitude envelope, period and centre of oscillations.
+
+Each statistic becomes a :class:`Finding` with a sentence and the effects it suggests. They guide
+the reader; the decision is made by the candidate fits (:mod:`physbench.discover.select`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from physbench.discover.residuals import EVENTS, Layout, breakdown, frame_events
+from physbench.recording import Recording, Track
+
+if TYPE_CHECKING:
+    from physbench.discover.select import Discovery, Scored
+    from physbench.scene import Scene
+    from physbench.trajectory import Trajectory
+
+#: A statistic is reported when it is this many standard errors from zero.
+Z_REPORT = 3.0
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One statistic of the disagreement: ``kind`` (``free_flight``, ``impacts``, ``drift``,
+    ``offset``, ``envelope``, ``period``, ``centre``, ``growth``), the run and body, a sentence, the
+    numbers, and the effects it points at."""
+
+    kind: str
+    run: str
+    body: str
+    text: str
+    values: dict[str, float] = field(default_factory=dict)
+    suggests: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, object]:
+        return {"kind": self.kind, "run": self.run, "body": self.body, "text": self.text,
+                "values": {k: float(v) for k, v in self.values.items()}, "suggests": list(self.suggests)}
+
+
+@dataclass(frozen=True, eq=False)
+class RunView:
+    """One run seen through one fitted model: the simulation and the data side by side."""
+
+    name: str
+    scene: Scene
+    traj: Trajectory  # as the engine simulated it
+    measured: Trajectory  # after the measurement effects (the data's clock)
+    recording: Recording | None
+    simulated: Recording | None  # the simulation sampled at the recording's times
+    events: np.ndarray  # (T, N) event index per frame of ``measured``
+
+
+def views(scored: Scored) -> list[RunView]:
+    """Full-length simulations of every run with the fitted values."""
+    model = scored.model
+    out = []
+    for i, run in enumerate(model.problem.runs):
+        traj, measured = model.simulate(i, model.values)
+        scene, _ = model.run_scene(i, model.values)
+        sim = run.recording.sample(measured) if run.recording is not None else None
+        out.append(RunView(run.name, scene, traj, measured, run.recording, sim, frame_events(scene, measured)))
+    return out
+
+
+def diagnose(disc: Discovery) -> None:
+    """Fill ``disc.findings`` and ``disc.breakdowns`` for the base and (when it differs) the
+    final model."""
+    for label, scored in (("base", disc.base), ("final", disc.final)):
+        if label == "final" and not disc.causes:
+            disc.findings["final"], disc.breakdowns["final"] = disc.findings["base"], disc.breakdowns["base"]
+            break
+        vs = views(scored)
+        parts = []
+        for v in vs:
+            if v.recording is None:
+                continue
+            lay = Layout.of_recording(v.recording, v.scene)
+            r = v.recording.residuals(v.measured) * lay.weight
+            k = np.clip(np.searchsorted(v.measured.times, lay.t - 1e-9), 0, v.measured.frames - 1)
+            idx = np.array([v.scene.body_index(n) for n in v.recording.bodies])
+            parts.append((lay, r, v.events[k, idx[lay.body]], list(v.recording.bodies)))
+        disc.breakdowns[label] = breakdown(parts)
+        disc.findings[label] = findings(vs)
+
+
+def findings(vs: Sequence[RunView]) -> list[Finding]:
+    out: list[Finding] = []
+    for v in vs:
+        if v.recording is None or v.simulated is None:
+            continue
+        for body in v.recording.bodies:
+            i = v.scene.body_index(body)
+            obs, sim = v.recording.track(body), v.simulated.track(body)
+            k = np.clip(np.searchsorted(v.measured.times, obs.t - 1e-9), 0, v.measured.frames - 1)
+            ev = v.events[k, i]
+            jointed = any(j.a == body or j.b == body for j in v.scene.joints)
+            fields = set(obs.fields) & set(v.recording.fields or obs.fields)
+            if jointed and "angle" in fields:
+                out += _oscillation(v.name, body, obs, sim)
+                continue
+            pos = [f for f in ("x", "y") if f in fields]
+            if pos:
+                out += _free_flight(v.name, body, obs, sim, ev, pos)
+                out += _impacts(v.name, body, obs, sim, ev, pos)
+                out += _drift(v.name, body, obs, sim, pos)
+            out += _offset(v.name, body, obs, sim, sorted(fields))
+    return out
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _speed(t: np.ndarray, tr: Track, pos: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Speeds from successive samples (m/s) at the interval midpoints."""
+    dt = np.diff(t)
+    d2 = sum(np.diff(tr.values(f)) ** 2 for f in pos)
+    return 0.5 * (t[1:] + t[:-1]), np.sqrt(d2) / dt
+
+
+def _segments(mask: np.ndarray, min_len: int) -> list[tuple[int, int]]:
+    out, i, n = [], 0, mask.size
+    while i < n:
+        if not mask[i]:
+            i += 1
+            continue
+        j = i
+        while j < n and mask[j]:
+            j += 1
+        if j - i >= min_len:
+            out.append((i, j))
+        i = j
+    return out
+
+
+def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
+    """Slope, its standard error and intercept of a least-squares line."""
+    a = np.stack([np.ones_like(x), x], axis=1)
+    coef, *_ = np.linalg.lstsq(a, y, rcond=None)
+    r = y - a @ coef
+    dof = max(x.size - 2, 1)
+    cov = np.linalg.pinv(a.T @ a) * float(r @ r) / dof
+    return float(coef[1]), float(math.sqrt(max(cov[1, 1], 0.0))), float(coef[0])
+
+
+def _free_flight(run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, pos: Sequence[str]) -> list[Finding]:
+    free = ev == EVENTS.index("free")
+    tm, vo = _speed(obs.t, obs, pos)
+    _, vs = _speed(obs.t, sim, pos)
+    ok = free[1:] & free[:-1]
+    slopes, weights, halves = [], [], []
+    for i, j in _segments(ok, 8):
+        s, se, _ = _line(tm[i:j], vo[i:j] - vs[i:j])
+        if se > 0:
+            slopes.append(s)
+            weights.append(1 / se**2)
+        mid = (i + j) // 2
+        for a, b in ((i, mid), (mid, j)):
+            if b - a >= 4:
+                s2, se2, _ = _line(tm[a:b], vo[a:b] - vs[a:b])
+                halves.append((float(np.mean(vs[a:b])), -s2, se2))
+    if not slopes:
+        return []
+    w = np.asarray(weights)
+    a_ex = -float(np.sum(w * np.asarray(slopes)) / w.sum())
+    se = float(1 / math.sqrt(w.sum()))
+    if abs(a_ex) < Z_REPORT * se:
+        return []
+    vbar = float(np.mean(vs[ok])) if ok.any() else math.nan
+    values = {"excess_deceleration": a_ex, "stderr": se, "mean_speed": vbar}
+    if a_ex < 0:
+        return [Finding("free_flight", run, body, f"{body}: in free flight the observed speed falls {-a_ex:.3g} m/s² slower "
+                        "than simulated (the model loses too much speed)", values, ())]
+    text = (f"{body}: in free flight the observed speed falls {a_ex:.3g} ± {se:.2g} m/s² faster than simulated "
+            f"({a_ex / vbar:.1%} of the mean speed per second)" if vbar > 0 else f"{body}: observed speed falls faster")
+    suggests: tuple[str, ...] = ("linear_drag", "quadratic_drag", "rolling_resistance")
+    pts = [(v, a) for v, a, s in halves if a > 2 * s and v > 0]
+    if len(pts) >= 3 and np.ptp([p[0] for p in pts]) > 0.2 * np.mean([p[0] for p in pts]):
+        lv, la = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
+        n_exp = float(np.polyfit(lv, la, 1)[0])
+        values["speed_exponent"] = n_exp
+        if n_exp < 0.5:
+            suggests, law = ("rolling_resistance",), "about constant (a rolling-resistance-like loss)"
+        elif n_exp < 1.5:
+            suggests, law = ("linear_drag",), "about proportional to the speed (linear drag)"
+        else:
+            suggests, law = ("quadratic_drag",), "about proportional to the squared speed (quadratic drag)"
+        text += f"; the excess grows like speed^{n_exp:.1f}: {law}"
+    return [Finding("free_flight", run, body, text, values, suggests)]
+
+
+def _impacts(run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, pos: Sequence[str]) -> list[Finding]:
+    hit = ev == EVENTS.index("impact")
+    if not hit.any():
+        return []
+    _tm, vo = _speed(obs.t, obs, pos)
+    _, vs = _speed(obs.t, sim, pos)
+    ratios, speeds = [], []
+    for i, j in _segments(hit, 1):
+        before = slice(max(0, i - 4), max(0, i - 1))
+        after = slice(min(vo.size, j + 1), min(vo.size, j + 4))
+        if before.stop - before.start < 2 or after.stop - after.start < 2:
+            continue
+        if np.any(hit[before]) or np.any(hit[after.start : after.stop + 1]):
+            continue
+        vb_o, va_o = float(np.mean(vo[before])), float(np.mean(vo[after]))
+        vb_s, va_s = float(np.mean(vs[before])), float(np.mean(vs[after]))
+        if min(vb_o, vb_s) <= 1e-6:
+            continue
+        ratios.append((va_o / vb_o, va_s / vb_s))
+        speeds.append(vb_o)
+    if len(ratios) < 2:
+        return []
+    r = np.asarray(ratios)
+    short = r[:, 1] - r[:, 0]
+    mean, se = float(short.mean()), float(short.std(ddof=1) / math.sqrt(len(short)))
+    values = {"impacts": float(len(short)), "observed_speed_ratio": float(r[:, 0].mean()), "simulated_speed_ratio": float(r[:, 1].mean())}
+    if abs(mean) < max(Z_REPORT * se, 0.02):
+        return []
+    text = (f"{body}: across {len(short)} impacts the observed speed keeps {r[:, 0].mean():.0%} where the model keeps "
+            f"{r[:, 1].mean():.0%}")
+    if len(short) >= 3 and np.ptp(speeds) > 0:
+        slope, sse, _ = _line(np.asarray(speeds), short)
+        values["shortfall_per_mps"] = slope
+        if abs(slope) > Z_REPORT * sse:
+            text += f"; the shortfall {'grows' if slope > 0 else 'shrinks'} with the impact speed ({slope:+.2g} per m/s)"
+    text += " (energy lost beyond what restitution allows)" if mean > 0 else " (the model loses too much at impacts)"
+    return [Finding("impacts", run, body, text, values, ("velocity_dependent_restitution",))]
+
+
+def _drift(run: str, body: str, obs: Track, sim: Track, pos: Sequence[str]) -> list[Finding]:
+    if len(obs) < 8:
+        return []
+    t = obs.t - obs.t[0]
+    a = np.stack([np.ones_like(t), t, 0.5 * t * t], axis=1)
+    acc, se = {}, {}
+    for f in pos:
+        r = sim.values(f) - obs.values(f)
+        coef, *_ = np.linalg.lstsq(a, r, rcond=None)
+        res = r - a @ coef
+        cov = np.linalg.pinv(a.T @ a) * float(res @ res) / max(t.size - 3, 1)
+        acc[f], se[f] = -float(coef[2]), float(math.sqrt(max(cov[2, 2], 0.0)))
+    z = max(abs(acc[f]) / se[f] if se[f] > 0 else 0.0 for f in pos)
+    if z < 2 * Z_REPORT:
+        return []
+    vec = ", ".join(f"{f} {acc[f]:+.3g}" for f in pos)
+    values = {f"a{f}": acc[f] for f in pos}
+    return [Finding("drift", run, body, f"{body}: the residual drifts as if the model missed a uniform acceleration ({vec} m/s²)",
+                    values, ("constant_force", "table_tilt"))]
+
+
+def _offset(run: str, body: str, obs: Track, sim: Track, fields: Sequence[str]) -> list[Finding]:
+    out = []
+    for f in fields:
+        d = obs.values(f) - sim.values(f)
+        if f == "angle":
+            d = (d + math.pi) % (2 * math.pi) - math.pi
+        if d.size < 8:
+            continue
+        mean, sd = float(d.mean()), float(d.std())
+        if abs(mean) > 0.7 * math.sqrt(mean * mean + sd * sd) and abs(mean) > Z_REPORT * sd / math.sqrt(d.size):
+            unit = "rad" if f == "angle" else "m"
+            out.append(Finding("offset", run, body, f"{body}: observed {f} sits {mean:+.3g} {unit} from the simulated one throughout",
+                               {f"d{f}": mean}, ("sensor_offset",)))
+    return out
+
+
+def _oscillation(run: str, body: str, obs: Track, sim: Track) -> list[Finding]:
+    from physbench.datasets import oscillation_centre, oscillation_periods, swing_peaks
+
+    t = obs.t
+    ao, asim = obs.values("angle"), sim.values("angle")
+    co, cs = oscillation_centre(t, ao), oscillation_centre(t, asim)
+    out: list[Finding] = []
+    _, po = swing_peaks(t, ao, co)
+    _, ps = swing_peaks(t, asim, cs)
+    if po.size >= 4 and ps.size >= 2:
+        d = po[:-1] - po[1:]  # loss per half swing
+        amp = 0.5 * (po[:-1] + po[1:])
+        fits = {}
+        for name, basis in (("coulomb", np.ones_like(amp)), ("viscous", amp), ("quadratic", amp * amp)):
+            c = float(basis @ d / (basis @ basis))
+            fits[name] = float(np.sum((d - c * basis) ** 2))
+        law = min(fits, key=fits.__getitem__)
+        effect = {"coulomb": "joint_coulomb_friction", "viscous": "joint_viscous_damping", "quadratic": "joint_quadratic_damping"}[law]
+        what = {"coulomb": "about constant (dry, Coulomb-like friction)", "viscous": "about proportional to the amplitude (viscous)",
+                "quadratic": "about proportional to the squared amplitude (air-drag-like)"}[law]
+        values = {"observed_first": float(po[0]), "observed_last": float(po[-1]), "simulated_first": float(ps[0]),
+                  "simulated_last": float(ps[-1]), "half_swings": float(po.size)}
+        sim_loss = float(ps[0] - ps[-1]) / max(ps.size - 1, 1)
+        obs_loss = float(po[0] - po[-1]) / max(po.size - 1, 1)
+        if obs_loss > 1.5 * max(sim_loss, 0.0) + 1e-4:
+            text = (f"{body}: the observed amplitude falls from {po[0]:.3g} to {po[-1]:.3g} rad over {po.size - 1} half swings, "
+                    f"the simulated one from {ps[0]:.3g} to {ps[-1]:.3g}; the loss per swing is {what}")
+            out.append(Finding("envelope", run, body, text, values, (effect,)))
+    per_o, per_s = oscillation_periods(t, ao, co), oscillation_periods(t, asim, cs)
+    if per_o.size >= 2 and per_s.size >= 2:
+        ratio = float(np.median(per_o) / np.median(per_s))
+        spread = float(np.std(per_o) / np.sqrt(per_o.size) / np.median(per_s))
+        if abs(ratio - 1) > max(Z_REPORT * spread, 0.002):
+            out.append(Finding("period", run, body, f"{body}: the observed period is {ratio:.4f} × the simulated one",
+                               {"period_ratio": ratio}, ("clock_scale",)))
+    if abs(co - cs) > 0.005:
+        out.append(Finding("centre", run, body, f"{body}: the observed swing is centred {co - cs:+.3g} rad from the simulated one",
+                           {"dangle": co - cs}, ("sensor_offset",)))
+    return out

@@ -1,0 +1,273 @@
+"""Fitting a model's free parameters to the data: a bounded local least-squares fit on the residual
+vector (trust-region reflective, finite-difference Jacobian), optionally started from the best point
+of any registered black-box estimator (ask/tell, as in the correction loop).
+
+Uncertainty comes from the Jacobian at the optimum: ``cov ≈ s² (JᵀJ)⁻¹`` with ``s² = SSR / (n - p)``.
+It assumes independent residuals; tracking errors that are correlated in time, or model error,
+make it optimistic.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from physbench.discover.data import DiscoverError
+from physbench.discover.model import Model, Param
+from physbench.errors import SimulationError
+
+#: Residual given to every entry of a simulation that explodes, in units of the start's RMS.
+FAILED_RESIDUAL = 100.0
+
+
+@dataclass
+class FitResult:
+    """The optimum of one fit. ``values``: every parameter of the model (fitted or not)."""
+
+    values: dict[str, float]
+    free: list[str]
+    stderr: dict[str, float]
+    ssr: float
+    n: int
+    nfev: int
+    simulations: int
+    status: str
+    correlations: dict[str, dict[str, float]] = field(default_factory=dict)
+
+    @property
+    def k(self) -> int:
+        return len(self.free)
+
+    @property
+    def rms(self) -> float:
+        return math.sqrt(self.ssr / self.n) if self.n else math.nan
+
+    def bic(self, extra_k: int = 0) -> float:
+        """Bayesian information criterion with unknown noise: ``n ln(SSR/n) + k ln n``."""
+        n = max(self.n, 1)
+        return n * math.log(max(self.ssr, 1e-300) / n) + (self.k + extra_k) * math.log(n)
+
+
+def _vector(model: Model, keys: Sequence[str]) -> tuple[np.ndarray, list[Param]]:
+    ps = [model.param(k) for k in keys]
+    return np.array([model.values[k] for k in keys], dtype=float), ps
+
+
+def least_squares(
+    model: Model,
+    free: Sequence[str],
+    *,
+    role: str = "fit",
+    runs: Sequence[int] | None = None,
+    max_nfev: int = 40,
+    budget: int | None = None,
+    diff_step: float = 0.3,
+    tol: float = 1e-8,
+    horizons: Sequence[float] = (1.0,),
+    final: bool = True,
+) -> FitResult:
+    """Fit ``free`` (keys) of ``model`` to the parts of ``role``, starting from ``model.values``;
+    the model's values are set to the optimum. ``diff_step`` is the finite-difference step in units
+    of each parameter's scale (:attr:`Param.scale`). ``budget`` caps the simulations of each
+    horizon (the best point so far is kept). ``horizons``: fit the first shares of time in turn,
+    each from the last optimum (continuation: a late bounce cannot pull an early fit into a wrong
+    valley); unless ``final`` is False, the last horizon is 1 whatever ``horizons`` ends with."""
+    sims0 = model.problem.simulations
+    steps = [h for h in horizons if 0 < h < 1] + ([1.0] if final else [])
+    for h in steps[:-1]:
+        _lsq(model, free, role, runs, max_nfev, budget, diff_step, tol, h, covariance_needed=False)
+    fr = _lsq(model, free, role, runs, max_nfev, budget, diff_step, tol, steps[-1], covariance_needed=final)
+    fr.simulations = model.problem.simulations - sims0
+    return fr
+
+
+class _OutOfBudget(Exception):
+    """Raised inside the objective when a fit has used its simulations."""
+
+
+def _lsq(
+    model: Model, free: Sequence[str], role: str, runs: Sequence[int] | None, max_nfev: int, budget: int | None,
+    diff_step: float, tol: float, horizon: float, *, covariance_needed: bool = True,
+) -> FitResult:
+    from scipy.optimize import least_squares as lsq
+
+    sims0 = model.problem.simulations
+    x0, ps = _vector(model, free)
+    scale = np.array([p.scale for p in ps])
+    low = np.array([p.low for p in ps])
+    high = np.array([p.high for p in ps])
+    x0 = np.clip(x0, low, high)
+    try:
+        r0 = model.residuals(role, dict(zip(free, x0, strict=True)), runs, horizon)
+    except SimulationError as exc:
+        raise DiscoverError(f"the model's starting point does not simulate: {exc}") from exc
+    n = r0.size
+    if not free or n == 0:
+        return FitResult(dict(model.values), list(free), {}, float(r0 @ r0), n, 1, model.problem.simulations - sims0, "nothing to fit")
+    bad = FAILED_RESIDUAL * max(float(np.sqrt(np.mean(r0 * r0))), 1e-9)
+    best: list[tuple[float, np.ndarray]] = [(float(r0 @ r0), np.zeros(len(free)))]
+    limit = math.inf if budget is None else sims0 + budget
+
+    def fun(z: np.ndarray) -> np.ndarray:
+        if model.problem.simulations >= limit:
+            raise _OutOfBudget
+        x = np.clip(x0 + z * scale, low, high)
+        try:
+            r = model.residuals(role, dict(zip(free, x, strict=True)), runs, horizon)
+        except SimulationError:
+            return np.full(n, bad)
+        if r.size != n:
+            return np.full(n, bad)
+        s = float(r @ r)
+        if s < best[0][0]:
+            best[0] = (s, z.copy())
+        return r
+
+    lo_z, hi_z = (low - x0) / scale, (high - x0) / scale
+    # least_squares needs a start strictly inside the bounds it is given.
+    lo_z = np.where(lo_z >= 0, -1e-12, lo_z)
+    hi_z = np.where(hi_z <= 0, 1e-12, hi_z)
+
+    def jac(z: np.ndarray) -> np.ndarray:
+        # Forward differences with a fixed step in scaled units (scipy's relative step vanishes at
+        # z = 0, where every fit starts), stepping backwards at an upper bound.
+        f0 = fun(z)
+        out = np.empty((n, z.size))
+        for i in range(z.size):
+            h = diff_step if z[i] + diff_step <= hi_z[i] else -diff_step
+            zi = z.copy()
+            zi[i] += h
+            out[:, i] = (fun(zi) - f0) / h
+        return out
+
+    status, nfev, j = "", 0, None
+    try:
+        res = lsq(fun, np.zeros(len(free)), jac=jac, bounds=(lo_z, hi_z), method="dogbox", x_scale=1.0,
+                  max_nfev=max_nfev, ftol=tol, xtol=tol, gtol=tol)
+        status, nfev = str(res.message), int(res.nfev)
+        if float(res.fun @ res.fun) <= best[0][0]:
+            best[0], j = (float(res.fun @ res.fun), res.x), res.jac
+    except _OutOfBudget:
+        status = f"stopped after {budget} simulations (best point kept)"
+    ssr, z = best[0]
+    x = np.clip(x0 + z * scale, low, high)
+    values = dict(model.values)
+    values.update(zip(free, x.tolist(), strict=True))
+    model.values = values
+    stderr: dict[str, float] = {}
+    corr: dict[str, dict[str, float]] = {}
+    if covariance_needed:
+        if j is None:
+            limit = math.inf
+            j = jac(z)
+        stderr, corr = covariance(j, ssr, n, scale, free)
+    return FitResult(values, list(free), stderr, ssr, n, nfev, model.problem.simulations - sims0, status, corr)
+
+
+def probe_start(
+    model: Model, keys: Sequence[str], *, role: str = "fit", multiples: Sequence[float] = (2.5, 10.0, 25.0)
+) -> float:
+    """Move ``keys`` to the best of a few probe points before a local fit: each key alone at its
+    current value ± ``multiples`` of its scale (:attr:`Param.scale`), then all keys at their best
+    probes together. Local least squares on contact-rich scenes stalls in the nearest valley; a
+    handful of probes finds a better one cheaply. Returns the SSR at the chosen start (the model's
+    values are set to it)."""
+
+    def ssr(vals: dict[str, float]) -> float:
+        try:
+            r = model.residuals(role, vals)
+        except SimulationError:
+            return math.inf
+        return float(r @ r)
+
+    best = ssr({})
+    moves: dict[str, float] = {}
+    for k in keys:
+        p = model.param(k)
+        v0, best_k = model.values[k], best
+        for f in multiples:
+            for sign in (1.0, -1.0):
+                v = v0 + sign * f * p.scale
+                if not p.low <= v <= p.high:
+                    continue
+                s = ssr({k: v})
+                if s < best_k:
+                    best_k, moves[k] = s, v
+    if not moves:
+        return best
+    singles = {k: ssr({k: v}) for k, v in moves.items()}
+    choice, value = min(singles.items(), key=lambda kv: kv[1]), None
+    candidates = [({choice[0]: moves[choice[0]]}, choice[1])]
+    if len(moves) > 1:
+        candidates.append((dict(moves), ssr(dict(moves))))
+    vals, value = min(candidates, key=lambda c: c[1])
+    if value < best:
+        model.values.update(vals)
+        return value
+    return best
+
+
+def covariance(jac: np.ndarray, ssr: float, n: int, scale: np.ndarray, keys: Sequence[str]) -> tuple[dict[str, float], dict[str, dict[str, float]]]:
+    """Standard errors and correlations from the Jacobian (in scaled units) at the optimum."""
+    p = len(keys)
+    if p == 0:
+        return {}, {}
+    dof = max(n - p, 1)
+    s2 = ssr / dof
+    jtj = np.asarray(jac, dtype=float).T @ np.asarray(jac, dtype=float)
+    cov = np.linalg.pinv(jtj, rcond=1e-12) * s2
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    stderr = {k: float(sd[i] * scale[i]) for i, k in enumerate(keys)}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = cov / np.outer(sd, sd)
+    corr = {k: {q: float(c[i, j]) for j, q in enumerate(keys) if j != i and np.isfinite(c[i, j])} for i, k in enumerate(keys)}
+    return stderr, corr
+
+
+def estimator_fit(
+    model: Model,
+    free: Sequence[str],
+    estimator: str,
+    *,
+    iterations: int = 60,
+    seed: int = 0,
+    options: dict[str, object] | None = None,
+) -> dict[str, float]:
+    """Search ``free`` with a registered black-box estimator (``tpe``, ``cmaes``, ``optuna``,
+    ``random``, ...), one simulation per iteration, on the mean squared residual of the fit part;
+    returns the best values found (the model's values are set to them)."""
+    from physbench.params import ParamSpace
+    from physbench.plugins import create
+    from physbench.protocols import Step, Task
+    from physbench.scene import Unknown
+
+    est = create("estimator", estimator, **(options or {}))
+    if getattr(est, "per_object", False):
+        raise DiscoverError(
+            f"estimator {estimator!r} corrects marked objects in images; discovery needs a black-box estimator "
+            "(tpe, cmaes, optuna, random) or 'lsq'"
+        )
+    if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
+        raise DiscoverError(f"estimator iterations = {iterations!r}: expected a whole number >= 1")
+    ps = [model.param(k) for k in free]
+    space = ParamSpace(tuple(Unknown(k.rpartition(".")[0], k.rpartition(".")[2], p.low, p.high) for k, p in zip(free, ps, strict=True)))
+    current = {k: min(max(model.values[k], p.low), p.high) for k, p in zip(free, ps, strict=True)}
+    r0 = model.residuals("fit", current)
+    worst = FAILED_RESIDUAL**2 * max(float(np.mean(r0 * r0)), 1e-18)
+    est.start(Task(scene=model.problem.runs[0].scene, space=space, observation=np.zeros((0, 1, 1, 1), np.float32), initial=current, meta={"iterations": iterations}), seed=seed)
+    best, best_loss = dict(current), float(np.mean(r0 * r0))
+    params = dict(current)
+    for k in range(iterations):
+        try:
+            r = model.residuals("fit", params)
+            loss = float(np.mean(r * r))
+        except SimulationError:
+            loss = worst
+        if loss < best_loss:
+            best, best_loss = dict(params), loss
+        params = dict(est.propose(Step(k, dict(params), np.zeros((0, 1, 1, 1), np.float32), loss)))
+    model.values.update(best)
+    return best

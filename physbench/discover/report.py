@@ -1,0 +1,195 @@
+"""Plots and an HTML page for a discovery: observed vs simulated trajectories (base and extended
+model), residuals over time, residuals per event, the candidates' held-out errors, and the verdict.
+
+matplotlib (Agg backend) is imported inside :func:`write_report` only.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from physbench.discover.residuals import EVENTS
+from physbench.discover.verdict import params_text, text
+
+if TYPE_CHECKING:
+    from physbench.discover.diagnostics import RunView
+    from physbench.discover.select import Discovery
+
+#: Runs and bodies drawn at most (the JSON holds every number).
+MAX_RUNS, MAX_BODIES = 3, 3
+DPI = 80
+
+
+def _field_series(v: RunView, body: str, f: str) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    assert v.recording is not None
+    tr = v.recording.track(body)
+    if f not in tr.fields or (v.recording.fields is not None and f not in v.recording.fields):
+        return None
+    i = v.measured.bodies.index(body)
+    col = {"x": 0, "y": 1, "angle": 2}[f]
+    return tr.t, tr.values(f), v.measured.states[:, i, col]
+
+
+def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path:
+    """Write the figures and ``index.html`` into ``folder``; returns the HTML path."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from physbench.discover.diagnostics import views
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    base_v = views(disc.base)
+    final_v = views(disc.final) if disc.causes else base_v
+    split = disc.split
+    cut = {p.run: p.t_end for p in split.fit} if split.kind == "time" else {p.run: p.t_end for p in split.lead}
+    figures: list[tuple[str, str]] = []
+    shown = list(range(min(len(disc.runs), MAX_RUNS)))
+    ext = " + ".join(disc.causes) or "base"
+
+    # ------------------------------------------------------------------ trajectories and residuals
+    rec_runs = [i for i in shown if disc.runs[i].recording is not None]
+    if rec_runs:
+        rows = []
+        for i in rec_runs:
+            rec = disc.runs[i].recording
+            assert rec is not None
+            for body in rec.bodies[:MAX_BODIES]:
+                for f in ("x", "y", "angle"):
+                    if _field_series(base_v[i], body, f) is not None:
+                        rows.append((i, body, f))
+        rows = rows[:9]
+        fig, axes = plt.subplots(len(rows), 2, figsize=(11, 2.2 * len(rows)), squeeze=False)
+        for (i, body, f), (ax, axr) in zip(rows, axes, strict=True):
+            s_b = _field_series(base_v[i], body, f)
+            s_f = _field_series(final_v[i], body, f)
+            assert s_b is not None and s_f is not None
+            t, obs, sim_b = s_b
+            ax.plot(t, obs, ".", ms=2.5, color="k", label="observed")
+            ax.plot(base_v[i].measured.times, sim_b, "-", lw=1.0, color="tab:blue", label="base")
+            if disc.causes:
+                ax.plot(final_v[i].measured.times, s_f[2], "-", lw=1.0, color="tab:red", label=ext)
+            ax.set_ylabel(f"{body} {f} ({'rad' if f == 'angle' else 'm'})", fontsize=8)
+            ax.set_title(f"run {disc.runs[i].name}", fontsize=8)
+            ax.set_xlim(t[0], t[-1])
+            assert base_v[i].simulated is not None and final_v[i].simulated is not None
+            rb = base_v[i].simulated.track(body).values(f) - obs
+            rf = final_v[i].simulated.track(body).values(f) - obs
+            if f == "angle":
+                rb, rf = (rb + math.pi) % (2 * math.pi) - math.pi, (rf + math.pi) % (2 * math.pi) - math.pi
+            axr.plot(t, rb, "-", lw=0.8, color="tab:blue", label="base")
+            if disc.causes:
+                axr.plot(t, rf, "-", lw=0.8, color="tab:red", label=ext)
+            axr.axhline(0, color="0.6", lw=0.5)
+            axr.set_ylabel("simulated − observed", fontsize=8)
+            for a in (ax, axr):
+                if i in cut:
+                    a.axvline(cut[i], color="0.5", ls="--", lw=0.8)
+                a.tick_params(labelsize=7)
+        axes[0, 0].legend(fontsize=7, loc="best")
+        axes[0, 1].legend(fontsize=7, loc="best")
+        axes[-1, 0].set_xlabel("t (s); dashed: end of the fitted part", fontsize=8)
+        axes[-1, 1].set_xlabel("t (s)", fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / "trajectories.png", dpi=dpi)
+        plt.close(fig)
+        figures.append(("trajectories.png", "Observed vs simulated (left) and residuals (right), base and extended model."))
+
+    # ------------------------------------------------------------------ frames: residual per frame
+    frame_runs = [i for i in shown if disc.runs[i].frames is not None]
+    if frame_runs:
+        fig, ax = plt.subplots(figsize=(7, 3))
+        for label, scored, color in (("base", disc.base, "tab:blue"), (ext, disc.final, "tab:red")):
+            if label != "base" and not disc.causes:
+                continue
+            for i in frame_runs:
+                r = scored.model.residuals("fit" if split.kind == "time" else "held", runs=[i])
+                f = disc.runs[i].frames
+                assert f is not None
+                per = int(np.prod(f.shape[1:]))
+                k = r.size // per
+                ax.plot(np.arange(k) / disc.runs[i].scene.fps, np.sqrt(np.mean(r[: k * per].reshape(k, per) ** 2, axis=1)), color=color, label=label)
+        ax.set_xlabel("t (s), fitted part")
+        ax.set_ylabel("pixel RMS residual")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(out / "frames.png", dpi=dpi)
+        plt.close(fig)
+        figures.append(("frames.png", "Image residual per frame, base and extended model."))
+
+    # ------------------------------------------------------------------ per event
+    bb, bf = disc.breakdowns.get("base"), disc.breakdowns.get("final")
+    if bb is not None and bb.per_event:
+        bodies = list(bb.per_event)[:6]
+        labels = [(b, e) for b in bodies for e in EVENTS if e in bb.per_event[b]]
+        if labels:
+            fig, ax = plt.subplots(figsize=(max(5, 0.8 * len(labels)), 3))
+            x = np.arange(len(labels))
+            ax.bar(x - 0.2, [bb.per_event[b][e] for b, e in labels], 0.4, label="base", color="tab:blue")
+            if disc.causes and bf is not None:
+                ax.bar(x + 0.2, [bf.per_event.get(b, {}).get(e, np.nan) for b, e in labels], 0.4, label=ext, color="tab:red")
+            ax.set_xticks(x, [f"{b}\n{e}" for b, e in labels], fontsize=7)
+            ax.set_ylabel(f"RMS residual ({disc.unit})", fontsize=8)
+            ax.legend(fontsize=7)
+            fig.tight_layout()
+            fig.savefig(out / "events.png", dpi=dpi)
+            plt.close(fig)
+            figures.append(("events.png", "Residual RMS per body and event (whole runs)."))
+
+    # ------------------------------------------------------------------ candidates
+    if disc.candidates:
+        first = [c for c in disc.candidates if c.round == 1]
+        fig, ax = plt.subplots(figsize=(7, 0.35 * len(first) + 1.2))
+        y = np.arange(len(first))
+        ax.barh(y, [c.heldout_error for c in first], color=["tab:red" if c.chosen else "tab:gray" for c in first])
+        ax.axvline(disc.base.heldout, color="tab:blue", ls="--", lw=1, label="base")
+        ax.set_yticks(y, [c.effect for c in first], fontsize=7)
+        ax.set_xlabel(f"held-out error ({disc.unit}), round 1", fontsize=8)
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(out / "candidates.png", dpi=dpi)
+        plt.close(fig)
+        figures.append(("candidates.png", "Held-out error of base + each candidate (red: chosen)."))
+
+    page = out / "index.html"
+    page.write_text(_html(disc, figures), encoding="utf-8")
+    return page
+
+
+def _html(disc: Discovery, figures: list[tuple[str, str]]) -> str:
+    e = html.escape
+    rows = [
+        "<tr><th>round</th><th>effect</th><th>parameters</th><th>held-out error</th><th>gain</th><th>ΔBIC</th><th>verdict</th><th>note</th></tr>",
+        f"<tr><td>0</td><td>base</td><td></td><td>{disc.base.heldout:.5g}</td><td></td><td></td><td></td><td></td></tr>",
+    ]
+    for c in disc.candidates:
+        verdict = "chosen" if c.chosen else ("significant" if c.significant else "")
+        rows.append(
+            f"<tr{' class=chosen' if c.chosen else ''}><td>{c.round}</td><td>{e(c.effect)}</td><td>{e(params_text(c))}</td>"
+            f"<td>{c.heldout_error:.5g}</td><td>{c.gain:+.1%}</td><td>{c.delta_criterion:+.1f}</td><td>{verdict}</td><td>{e(c.note)}</td></tr>"
+        )
+    figs = "\n".join(f'<figure><img src="{f}" alt="{e(cap)}"><figcaption>{e(cap)}</figcaption></figure>' for f, cap in figures)
+    findings: dict[str, Any] = disc.findings
+    items = "".join(f"<li>{e(f.text)}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>" for f in findings.get("base", []))
+    title = "physbench discover: " + (", ".join(disc.causes) if disc.causes else "no cause found")
+    return f"""<!doctype html>
+<html><head><meta charset="utf-8"><title>{e(title)}</title>
+<style>body{{font-family:sans-serif;max-width:1100px;margin:1em auto;}} pre{{background:#f6f6f6;padding:.6em;overflow-x:auto;font-size:12px}}
+table{{border-collapse:collapse;font-size:13px}} td,th{{border:1px solid #ccc;padding:2px 6px}} tr.chosen{{background:#fde2e2}}
+img{{max-width:100%}} figcaption{{font-size:12px;color:#555}}</style></head><body>
+<h1>{e(title)}</h1>
+<p>Gain on held-out data: <b>{disc.gain:.1%}</b> (held-out error {disc.base.heldout:.5g} → {disc.final.heldout:.5g} {e(disc.unit)}).
+Engine {e(disc.engine)}; {e(disc.split.describe(disc.runs))}.</p>
+<h2>What is wrong with the base model</h2><ul>{items or '<li>no summary statistic stands out from the noise</li>'}</ul>
+<h2>Candidates</h2><table>{''.join(rows)}</table>
+<h2>Figures</h2>{figs}
+<h2>Verdict</h2><pre>{e(text(disc))}</pre>
+</body></html>
+"""
