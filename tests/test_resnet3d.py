@@ -146,3 +146,49 @@ def test_shipped_weights_beat_the_random_estimator(info: weights.WeightsInfo) ->
             h = refine(obs, scene, space, sim, renderer, est, iterations=3, seed=seed, initial=initial)
             out.append(h.min_nmse)
     assert np.mean(learned) < np.mean(baseline), (learned, baseline)
+
+
+def test_int8_storage_round_trips_within_a_step_and_is_a_quarter_of_float32(tmp_path: Path) -> None:
+    torch.manual_seed(0)
+    state = dict(build_net(TINY).state_dict())
+    q = weights.quantize(state)
+    assert q["head.weight"].dtype == torch.int8 and q["head.bias"].dtype == torch.float16
+    back = weights.dequantize(q)
+    assert set(back) == set(state)
+    for k, v in state.items():
+        step = v.abs().flatten(1).amax(1).view((-1,) + (1,) * (v.dim() - 1)) / 127 if v.dim() >= 2 else 1e-3 * v.abs().max()
+        assert torch.all((back[k] - v).abs() <= step / 2 + 1e-6), k
+    path = weights.save(tmp_path / "w", q, {"storage": weights.INT8, "net": TINY.to_dict()})
+    loaded, _ = weights.load(path)
+    assert all(loaded[k].dtype == torch.float32 and torch.equal(loaded[k], back[k]) for k in back)
+    # On the shipped architecture int8 is about a quarter of float32 (scales and biases add little).
+    big = dict(build_net(NetConfig(n_outputs=1)).state_dict())
+    f32 = weights.save(tmp_path / "f", big, {})
+    i8 = weights.save(tmp_path / "i", weights.quantize(big), {})
+    assert i8.stat().st_size < 0.26 * f32.stat().st_size
+
+
+def test_blur_augmentation_blurs_the_observed_half_only() -> None:
+    sharp = PairMaker(TINY_DATA).group(4321)
+    blurred = PairMaker(DataSpec(**{**TINY_DATA.__dict__, "blur_max": 3.0, "blur_prob": 1.0})).group(4321)
+    frames = TINY_DATA.frames
+    assert np.array_equal(sharp[1], blurred[1])  # same simulations, same targets
+    assert np.array_equal(sharp[0][:, :, frames:], blurred[0][:, :, frames:])  # simulated half untouched
+    assert not np.allclose(sharp[0][:, :, :frames], blurred[0][:, :, :frames])
+    # Blur smooths: less total variation across the image.
+    def tv(x: np.ndarray) -> float:
+        return float(np.abs(np.diff(x, axis=-1)).sum() + np.abs(np.diff(x, axis=-2)).sum())
+
+    assert tv(blurred[0][:, :, :frames]) < 0.95 * tv(sharp[0][:, :, :frames])
+
+
+def test_learning_rate_follows_the_samples_or_the_wall_clock_whichever_is_further() -> None:
+    from physbench.estimators.resnet3d.train import learning_rate, progress_fraction
+
+    cfg = TrainConfig(samples=1000, minutes=1.0, lr=1e-3)
+    assert progress_fraction(cfg, 500, 0.0) == 0.5
+    assert progress_fraction(cfg, 100, 45.0) == 0.75
+    assert progress_fraction(cfg, 2000, 0.0) == 1.0
+    lrs = [learning_rate(cfg, 0, t) for t in (3.0, 10.0, 30.0, 59.0)]
+    assert lrs[0] == pytest.approx(1e-3) and lrs[1] > lrs[2] > lrs[3] > 0.04e-3
+    assert learning_rate(cfg, 0, 0.0) < 1e-3  # warm-up

@@ -15,6 +15,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--widths", default="16,32,64,128", help="channel widths of the 4 stages (paper: 64,128,256,512)")
     p.add_argument("--resolution", type=int, default=32, help="network input resolution (default 32)")
     p.add_argument("--frames", type=int, default=15, help="frames per sequence after subsampling (default 15)")
+    p.add_argument("--minutes", type=float, default=0.0,
+                   help="wall-clock budget; training ends at this or --samples, whichever comes first (default: none)")
+    p.add_argument("--device", default="cpu", help="torch device to train on, e.g. cuda (default cpu)")
+    p.add_argument("--blur-max", type=float, default=0.0,
+                   help="augment: blur half the observed sequences by sigma ~ U(0, this) pixels (default 0: off)")
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
     p.add_argument("--workers", type=int, default=1, help="data-generating processes (default 1)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (default: torch's choice)")
@@ -46,11 +51,23 @@ def main(args: argparse.Namespace) -> int:
     for name in ("samples", "batch", "resolution", "frames"):
         if getattr(args, name) < 1:
             raise PhysbenchError(f"--{name} {getattr(args, name)}: must be >= 1")
-    spec = DataSpec(args.scene, params, engine=args.engine, resolution=args.resolution, frames=args.frames)
+    for name in ("minutes", "blur_max"):
+        if not getattr(args, name) >= 0:
+            raise PhysbenchError(f"--{name.replace('_', '-')} {getattr(args, name)}: must be >= 0")
+    if args.device != "cpu":
+        import torch
+
+        try:
+            torch.empty(1, device=args.device)
+        except (RuntimeError, AssertionError) as exc:
+            raise PhysbenchError(f"--device {args.device!r} is not usable here ({exc}); use cpu or an available GPU, e.g. cuda") from None
+    spec = DataSpec(args.scene, params, engine=args.engine, resolution=args.resolution, frames=args.frames,
+                    blur_max=args.blur_max)
     n_out = len(params)
     net = NetConfig(n_outputs=n_out, widths=widths, resolution=args.resolution, frames=args.frames)  # type: ignore[arg-type]
     cfg = TrainConfig(samples=args.samples, batch=args.batch, lr=args.lr, val_groups=args.val_groups,
-                      eval_every=args.eval_every, workers=args.workers, threads=args.threads)
+                      eval_every=args.eval_every, workers=args.workers, threads=args.threads,
+                      device=args.device, minutes=args.minutes)
     out = Path(args.out or f"runs/train/{weights_name(spec)}")
     path, meta = train(spec, net, cfg, out, resume=not args.no_resume, progress=not args.quiet)
     print(f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: {meta['val_mse']:.3g}; "

@@ -33,6 +33,11 @@ class DataSpec:
     frames: int = 15
     group: int = 4
     scene_options: dict[str, Any] = field(default_factory=dict)
+    # Camera-blur augmentation of the *observed* sequence only (the simulated one stays sharp, as
+    # at inference): with probability ``blur_prob`` a Gaussian of sigma ~ U(0, blur_max) pixels at
+    # the render resolution, the renderer's own blur.
+    blur_max: float = 0.0
+    blur_prob: float = 0.5
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -75,16 +80,26 @@ class PairMaker:
             except SimulationError:
                 continue
             sims.append((p, {b: self.renderer.render(scene, traj, focus=b) for b in space.bodies}))
+        observed = [self._blurred(frames, rng) for _, frames in sims] if spec.blur_max > 0 else [f for _, f in sims]
         xs, ys = [], []
         for body in space.bodies:
             sub = space.subset(body)
             scale = sub.high - sub.low
-            for i, (pi, fi) in enumerate(sims):
+            for i, (pi, _) in enumerate(sims):
                 for j, (pj, fj) in enumerate(sims):
                     if i != j:
-                        xs.append(make_input(fi[body], fj[body], spec.frames, spec.resolution))
+                        xs.append(make_input(observed[i][body], fj[body], spec.frames, spec.resolution))
                         ys.append((sub.to_vector(pi) - sub.to_vector(pj)) / scale)
         return np.stack(xs), np.asarray(ys, dtype=np.float32)
+
+    def _blurred(self, frames: dict[str, np.ndarray], rng: np.random.Generator) -> dict[str, np.ndarray]:
+        """One simulation's marked views as a blurry camera might see them (one sigma for all)."""
+        from physbench.render.observe import gaussian_blur
+
+        if rng.random() >= self.spec.blur_prob:
+            return frames
+        sigma = float(rng.uniform(0.0, self.spec.blur_max))
+        return {b: gaussian_blur(f, sigma) if sigma > 0 else f for b, f in frames.items()}
 
 
 def validation_set(spec: DataSpec, groups: int) -> tuple[np.ndarray, np.ndarray]:

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 
 def evaluate_weights(
@@ -14,11 +15,14 @@ def evaluate_weights(
     engine: str = "pymunk",
     blur: float = 0.0,
     resolution: int = 64,
+    scene_options: Mapping[str, Any] | None = None,
+    bodies: Sequence[str] | None = None,
 ) -> list[dict[int, float]]:
     """Per seed: ``{n: normalized min MSE after n iterations}`` for n = 1..iterations.
 
     Seeds are scene-instance and problem seeds; training and validation use seeds from 2**24 up,
-    so small seeds are held out.
+    so small seeds are held out. ``scene_options`` override the training ones (e.g. ``n_balls``);
+    ``bodies`` restricts the unknowns to those bodies (the others keep the scene's values).
     """
     from physbench.estimators.resnet3d import weights
     from physbench.estimators.resnet3d.data import DataSpec
@@ -36,8 +40,8 @@ def evaluate_weights(
     observer = create("renderer", "raster", resolution=resolution, mode="mark", blur=blur)
     rows = []
     for seed in seeds:
-        scene = generator(seed, **spec.scene_options)
-        space = ParamSpace.from_scene(scene, spec.params)
+        scene = generator(seed, **{**spec.scene_options, **(scene_options or {})})
+        space = ParamSpace.from_scene(scene, spec.params, bodies)
         truth, initial = draw_problem(space, seed)
         obs = simulate_observation(scene, truth, sim, observer, marked=space.bodies)
         hist = refine(obs, scene, space, sim, model, ResNet3DEstimator(weights=str(path)),

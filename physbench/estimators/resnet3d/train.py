@@ -27,20 +27,32 @@ class TrainConfig:
     workers: int = 1  # data processes beside the training process
     threads: int = 0  # torch threads; 0 = torch's default
     seed: int = 0
+    device: str = "cpu"  # "cuda" trains on a GPU; the weights are the same either way
+    minutes: float = 0.0  # wall-clock budget (0 = none); training stops at whichever budget ends first
 
 
-def learning_rate(cfg: TrainConfig, seen: int) -> float:
+def progress_fraction(cfg: TrainConfig, seen: int, wall_s: float) -> float:
+    """How much of the budget is spent: samples seen, or wall time when ``cfg.minutes`` is set and
+    further along."""
+    frac = seen / cfg.samples
+    if cfg.minutes > 0:
+        frac = max(frac, wall_s / (60.0 * cfg.minutes))
+    return min(1.0, frac)
+
+
+def learning_rate(cfg: TrainConfig, seen: int, wall_s: float = 0.0) -> float:
     """Linear warm-up over the first 5% of the budget, then cosine decay to 5% of ``cfg.lr``.
 
-    A function of samples seen only, so a resumed run (even with a larger budget) needs no
-    scheduler state.
+    A function of the budget spent only (samples, or wall time with ``cfg.minutes``), so a resumed
+    run (even with a larger budget) needs no scheduler state.
     """
     import math
 
-    warm = max(1, cfg.samples // 20)
-    if seen < warm:
-        return cfg.lr * (seen + cfg.batch) / warm
-    frac = min(1.0, (seen - warm) / max(1, cfg.samples - warm))
+    frac = progress_fraction(cfg, seen, wall_s)
+    warm = 0.05
+    if frac < warm:
+        return cfg.lr * max(frac, cfg.batch / cfg.samples) / warm
+    frac = (frac - warm) / (1 - warm)
     return cfg.lr * (0.05 + 0.95 * 0.5 * (1 + math.cos(math.pi * frac)))
 
 
@@ -86,14 +98,15 @@ def _pairs_dataset(spec: DataSpec, start: int) -> Any:
 
 
 def evaluate_net(net: Any, x: np.ndarray, y: np.ndarray, batch: int = 64) -> float:
-    """Mean squared error of normalised Δp over a fixed set (dropout off)."""
+    """Mean squared error of normalised Δp over a fixed set (dropout off, float32)."""
     import torch
 
+    device = next(net.parameters()).device
     net.eval()
     err = 0.0
     with torch.no_grad():
         for i in range(0, len(x), batch):
-            pred = net(torch.from_numpy(x[i : i + batch])).numpy()
+            pred = net(torch.from_numpy(x[i : i + batch]).to(device)).float().cpu().numpy()
             err += float(((pred - y[i : i + batch]) ** 2).sum())
     net.train()
     return err / y.size
@@ -119,7 +132,10 @@ def train(
     if cfg.threads:
         torch.set_num_threads(cfg.threads)
     torch.manual_seed(cfg.seed)
-    net = build_net(net_cfg)
+    device = torch.device(cfg.device)
+    if device.type == "cuda":
+        torch.backends.cudnn.benchmark = True
+    net = build_net(net_cfg).to(device)
     opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     ckpt = out / "checkpoint.safetensors"
     seen, best, history, wall0 = 0, float("inf"), [], 0.0
@@ -132,15 +148,18 @@ def train(
     loader = torch.utils.data.DataLoader(
         _pairs_dataset(spec, seen), batch_size=cfg.batch, num_workers=cfg.workers,
         persistent_workers=cfg.workers > 0, prefetch_factor=4 if cfg.workers else None,
+        pin_memory=device.type == "cuda",
     )
     bar = tqdm(total=cfg.samples, initial=seen, disable=not progress, unit="sample", dynamic_ncols=True)
     t0, ema, next_eval = time.perf_counter(), None, seen + cfg.eval_every
     net.train()
     it = iter(loader)
-    while seen < cfg.samples:
+    while progress_fraction(cfg, seen, wall0 + time.perf_counter() - t0) < 1.0:
         x, y = next(it)
+        x, y = x.to(device, non_blocking=True), y.to(device, non_blocking=True)
+        wall = wall0 + time.perf_counter() - t0
         for group in opt.param_groups:
-            group["lr"] = learning_rate(cfg, seen)
+            group["lr"] = learning_rate(cfg, seen, wall)
         loss = torch.nn.functional.mse_loss(net(x), y)
         opt.zero_grad(set_to_none=True)
         loss.backward()
@@ -150,7 +169,7 @@ def train(
         value = loss.item()
         ema = value if ema is None else 0.98 * ema + 0.02 * value
         bar.update(len(x))
-        if seen >= next_eval or seen >= cfg.samples:
+        if seen >= next_eval or progress_fraction(cfg, seen, wall0 + time.perf_counter() - t0) >= 1.0:
             next_eval += cfg.eval_every
             val = evaluate_net(net, vx, vy)
             wall = wall0 + time.perf_counter() - t0
@@ -177,7 +196,7 @@ def train(
         "physbench_version": physbench.__version__,
         "torch_version": torch.__version__,
     }
-    # Shipped weights are float16 (half the size; inference casts back to float32).
-    final = weights.save(out / weights_name(spec), {k: v.half() for k, v in best_state.items()}, meta)
+    # Shipped weights are int8 per output channel (a quarter of the size; loading dequantises).
+    final = weights.save(out / weights_name(spec), weights.quantize(best_state), {**meta, "storage": weights.INT8})
     (out / "train_log.json").write_text(json.dumps(history, indent=1))
     return final, meta

@@ -17,6 +17,9 @@ from typing import Any
 from physbench.errors import PhysbenchError
 
 SHIPPED = Path(__file__).with_name("weights")
+#: Sidecar ``storage`` value of weights kept as int8 with one float32 scale per output channel.
+INT8 = "int8-per-output-channel"
+_SCALE = ".int8_scale"
 
 
 @dataclass(frozen=True)
@@ -50,14 +53,49 @@ def save(path: str | Path, state: dict[str, Any], meta: dict[str, Any]) -> Path:
 
 
 def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(tensors, meta) from a .safetensors file and its sidecar."""
+    """(tensors, meta) from a .safetensors file and its sidecar; int8 storage comes back as float32."""
     from safetensors.torch import load_file
 
     path = Path(path).with_suffix(".safetensors")
     side = path.with_suffix(".json")
     if not path.is_file() or not side.is_file():
         raise PhysbenchError(f"weights {str(path)!r} need both {path.name} and {side.name}")
-    return load_file(str(path)), json.loads(side.read_text())
+    tensors, meta = load_file(str(path)), json.loads(side.read_text())
+    if meta.get("storage") == INT8:
+        tensors = dequantize(tensors)
+    return tensors, meta
+
+
+def quantize(state: dict[str, Any]) -> dict[str, Any]:
+    """Symmetric int8 per output channel for every weight of 2+ dims (scale = max|w| / 127), float16
+    for the rest: a quarter of float32's size for convolution-heavy nets."""
+    import torch
+
+    out: dict[str, Any] = {}
+    for name, t in state.items():
+        t = t.detach().float().cpu()
+        if t.dim() >= 2:
+            scale = t.abs().flatten(1).amax(dim=1).clamp_min(1e-12) / 127.0
+            shape = (-1,) + (1,) * (t.dim() - 1)
+            out[name] = torch.round(t / scale.view(shape)).clamp(-127, 127).to(torch.int8)
+            out[name + _SCALE] = scale
+        else:
+            out[name] = t.half()
+    return out
+
+
+def dequantize(tensors: dict[str, Any]) -> dict[str, Any]:
+    """Float32 tensors back from :func:`quantize`'s output."""
+    out: dict[str, Any] = {}
+    for name, t in tensors.items():
+        if name.endswith(_SCALE):
+            continue
+        scale = tensors.get(name + _SCALE)
+        if scale is None:
+            out[name] = t.float()
+        else:
+            out[name] = t.float() * scale.float().view((-1,) + (1,) * (t.dim() - 1))
+    return out
 
 
 def search_dirs() -> list[Path]:
