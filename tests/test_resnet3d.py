@@ -192,3 +192,26 @@ def test_learning_rate_follows_the_samples_or_the_wall_clock_whichever_is_furthe
     lrs = [learning_rate(cfg, 0, t) for t in (3.0, 10.0, 30.0, 59.0)]
     assert lrs[0] == pytest.approx(1e-3) and lrs[1] > lrs[2] > lrs[3] > 0.04e-3
     assert learning_rate(cfg, 0, 0.0) < 1e-3  # warm-up
+
+
+@pytest.mark.parametrize("symmetric", [False, True])
+def test_symmetric_option_makes_the_truth_an_exact_fixed_point(symmetric: bool) -> None:
+    from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
+    from physbench.loop import draw_problem, refine
+    from physbench.observation import simulate_observation
+    from physbench.params import ParamSpace
+    from physbench.plugins import create, get_registry
+
+    scene = get_registry().get("scene", "three_circles")(3)
+    space = ParamSpace.from_scene(scene, ("mass",))
+    truth, _ = draw_problem(space, 3)
+    sim, renderer = create("simulator", "pymunk"), create("renderer", "raster", resolution=64)
+    obs = simulate_observation(scene, truth, sim, renderer, marked=space.bodies)
+    # Started at the truth, the simulated frames equal the observed ones.
+    h = refine(obs, scene, space, sim, renderer, ResNet3DEstimator(symmetric=symmetric), iterations=2, seed=3,
+               initial=truth)
+    moved = max(abs(h.records[1].params[k] - truth[k]) for k in truth)
+    if symmetric:
+        assert moved < 1e-9  # f(o, s) - f(s, o) vanishes when o == s
+    else:
+        assert moved > 1e-6  # the plain network has a small bias at zero difference
