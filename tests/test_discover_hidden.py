@@ -5,10 +5,13 @@ effect must produce no cause.
 
 Cases come from seeds (:func:`physbench.discover.synthetic.make_case`). ``PHYSBENCH_DISCOVERY_SEEDS``
 (e.g. ``0,1,2,3``) runs more seeds; the default, one seed, keeps the suite within its CI budget.
+``PHYSBENCH_DISCOVERY_LOG=FILE`` appends one JSON line per case (causes, magnitude error, gain) to
+``FILE``, for the table in docs/discover.md.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 
@@ -46,6 +49,13 @@ def magnitude_error(effect: str, truth: dict[str, float], got: dict[str, float])
     return float(np.linalg.norm(g - t) / np.linalg.norm(t))
 
 
+def _log(**row: object) -> None:
+    path = os.environ.get("PHYSBENCH_DISCOVERY_LOG")
+    if path:
+        with open(path, "a") as f:
+            f.write(json.dumps(row) + "\n")
+
+
 def test_every_effect_in_the_library_has_hidden_effect_scenes():
     assert {c.name for c in BUILTIN_EFFECTS} == set(EFFECT_SCENES)
     assert all(len(s) >= 2 for s in EFFECT_SCENES.values())
@@ -57,9 +67,12 @@ def test_hidden_effect_is_named_with_its_magnitude(effect, scene, engine, seed):
     sim = ENGINES[engine]()
     case = make_case(effect, scene, seed, sim)
     disc = discover([case.run], sim, diagnose=False)
+    found = disc.cause_results[0] if disc.causes[:1] == [effect] else None
+    err = magnitude_error(effect, case.truth, found.params) if found is not None else None
+    _log(effect=effect, scene=scene, engine=engine, seed=seed, causes=disc.causes, error=err, gain=disc.gain,
+         truth=case.truth, fitted=found.params if found is not None else None, seconds=disc.seconds)
     assert disc.causes[:1] == [effect], f"{case.name} [{engine}]: causes {disc.causes}, truth {case.truth}"
-    found = disc.cause_results[0]
-    err = magnitude_error(effect, case.truth, found.params)
+    assert found is not None and err is not None
     assert err <= TOLERANCE, f"{case.name} [{engine}]: fitted {found.params}, truth {case.truth} ({err:.1%} off)"
     assert disc.gain > 0.5
 
@@ -69,6 +82,7 @@ def test_control_without_a_hidden_effect_produces_no_cause(scene, engine, seed):
     sim = ENGINES[engine]()
     case = make_case(None, scene, seed, sim)
     disc = discover([case.run], sim, diagnose=False)
+    _log(effect=None, scene=scene, engine=engine, seed=seed, causes=disc.causes, gain=disc.gain, seconds=disc.seconds)
     assert disc.causes == [], f"{case.name} [{engine}]: false alarm {disc.causes} " + ", ".join(
         f"{c.effect} gain {c.gain:+.1%} ΔBIC {c.delta_criterion:+.1f}" for c in disc.cause_results
     )

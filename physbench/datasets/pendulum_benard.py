@@ -5,7 +5,9 @@ Each file becomes a case from the first extreme of the swing (before it the hand
 rod; the rate there is 0). The scene is a uniform 0.13 m, 0.1 kg rod on a frictionless pivot (the
 plain model); the recording tracks the angle (``fields = ("angle",)``, converted to rad; ``x, y`` are
 the rod centre it implies). Times are the nominal sample index / 1000 s: the logger's real interval
-is >= 1 ms and jitters, so fit :class:`~physbench.effects.ClockScale`.
+is >= 1 ms and jitters. For one pendulum a clock error is a change of its inertia, so leave the
+rod's inertia unknown (discovery offers :class:`~physbench.effects.ClockScale` only with a force of
+known size); a clock that differs from file to file is not modelled.
 """
 
 from __future__ import annotations

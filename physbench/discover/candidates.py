@@ -6,8 +6,14 @@ Rules for the built-ins: translational losses (``linear_drag``, ``quadratic_drag
 ``rolling_resistance``) act on free bodies only: on a body hanging from a pivot they are the joint
 losses again (for one arm, drag on the centre of mass *is* viscous or quadratic joint damping and
 rolling resistance *is* Coulomb friction), which the joint effects describe. Contact laws need
-static geometry or a second body. Any other effect (third-party ones included) is a candidate when
-its ``setup`` accepts the scene.
+static geometry or a second body. ``rolling_resistance`` needs a surface to roll on: a top-down
+scene (gravity 0) or static geometry; a ball falling through air has none. On bodies that all
+have one mass, ``constant_force`` and ``table_tilt`` are the same uniform acceleration: only one
+is offered (``table_tilt`` seen from above, ``constant_force`` in a side view, where it is a
+change of gravity). ``clock_scale`` needs a force of known size (a scheduled kick) in the scene:
+without one, a clock error is a change of gravity (or of a pendulum's inertia) and of the initial
+speeds, which the base model or other candidates already describe. Any other effect
+(third-party ones included) is a candidate when its ``setup`` accepts the scene.
 """
 
 from __future__ import annotations
@@ -73,8 +79,20 @@ def candidates_for(
     free = free_bodies(scene)
     out: list[CandidateSpec] = []
     skipped: list[tuple[str, str]] = []
+    top_down = tuple(scene.gravity) == (0.0, 0.0)
+    one_mass = len({b.mass for b in scene.bodies}) == 1
+    same = {"constant_force": "table_tilt", "table_tilt": "constant_force"}
     for name in chosen:
         options: dict[str, Any] = {}
+        if name == "rolling_resistance" and not top_down and not scene.statics:
+            skipped.append((name, "no surface to roll on (gravity acts in the scene's plane and there is no static geometry)"))
+            continue
+        if name in same and one_mass and same[name] in chosen and name != ("table_tilt" if top_down else "constant_force"):
+            skipped.append((name, f"on bodies of one mass it is {same[name]} again"))
+            continue
+        if name == "clock_scale" and not scene.forces:
+            skipped.append((name, "no force of known size: a clock error would be a change of gravity and initial speeds"))
+            continue
         if name in TRANSLATIONAL_LOSSES and len(free) < len(scene.bodies):
             if not free:
                 skipped.append((name, "no free bodies (on a jointed body this loss is joint damping)"))

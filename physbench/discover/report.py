@@ -51,7 +51,9 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
     split = disc.split
     cut = {p.run: p.t_end for p in split.fit} if split.kind == "time" else {p.run: p.t_end for p in split.lead}
     figures: list[tuple[str, str]] = []
-    shown = list(range(min(len(disc.runs), MAX_RUNS)))
+    # held-out runs first: they show how the models predict data they were not fitted on
+    order = list(split.test_runs) + [i for i in range(len(disc.runs)) if i not in split.test_runs]
+    shown = order[:MAX_RUNS] if split.kind == "runs" else list(range(min(len(disc.runs), MAX_RUNS)))
     ext = " + ".join(disc.causes) or "base"
 
     # ------------------------------------------------------------------ trajectories and residuals
@@ -77,7 +79,8 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
             if disc.causes:
                 ax.plot(final_v[i].measured.times, s_f[2], "-", lw=1.0, color="tab:red", label=ext)
             ax.set_ylabel(f"{body} {f} ({'rad' if f == 'angle' else 'm'})", fontsize=8)
-            ax.set_title(f"run {disc.runs[i].name}", fontsize=8)
+            held = " (held out)" if split.kind == "runs" and i in split.test_runs else ""
+            ax.set_title(f"run {disc.runs[i].name}{held}", fontsize=8)
             ax.set_xlim(t[0], t[-1])
             assert base_v[i].simulated is not None and final_v[i].simulated is not None
             rb = base_v[i].simulated.track(body).values(f) - obs

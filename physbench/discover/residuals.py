@@ -101,9 +101,10 @@ def _static_distance(scene: Scene, p: np.ndarray) -> np.ndarray:
 def frame_events(scene: Scene, traj: Trajectory, *, margin: float = 0.01) -> np.ndarray:
     """``(T, N)`` event index (into :data:`EVENTS`) of every simulated frame and body.
 
-    ``impact``: the velocity jumps between two frames by more than gravity and 5 % of the speed
-    (plus 5 cm/s) explain, on both frames around the jump; ``contact``: within ``margin`` (m) plus
-    the body's size of static geometry or another body; ``jointed``: on a pivot joint; else ``free``.
+    ``impact``: the velocity of a body that is not jointed jumps between two frames by more than
+    gravity and 5 % of the speed (plus 5 cm/s) explain, on both frames around the jump;
+    ``contact``: within ``margin`` (m) plus the body's size of static geometry or another body;
+    ``jointed``: on a pivot joint; else ``free``.
     """
     s = traj.states
     T, n = s.shape[0], s.shape[1]
@@ -121,7 +122,7 @@ def frame_events(scene: Scene, traj: Trajectory, *, margin: float = 0.01) -> np.
             if k != i:
                 near |= np.hypot(*(pos - s[:, k, :2]).T) < ext[i] + ext[k] + margin
         out[near, i] = EVENTS.index("contact")
-        if T > 1:
+        if T > 1 and b.name not in jointed:  # a joint's constraint force is no impact
             v = s[:, i, 3:5]
             jump = np.hypot(*(np.diff(v, axis=0) - g * dt).T)
             speed = np.hypot(*v.T)

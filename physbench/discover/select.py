@@ -257,14 +257,20 @@ def _fit(model: Model, settings: Settings, *, base: bool, free: Sequence[str] | 
     if probe:
         probe_start(model, probe)
     fr = least_squares(model, keys, max_nfev=settings.base_max_nfev if base else settings.max_nfev,
-                       budget=settings.budget * (2 if base else 1), diff_step=settings.diff_step,
+                       budget=_budget(settings, len(keys)) * (2 if base else 1), diff_step=settings.diff_step,
                        horizons=horizons or _horizons(model, settings))
     for i in model.problem.split.test_runs if model.problem.split.kind == "runs" else ():
         own = [p.key for p in model.params if p.kind == "nuisance" and p.run == i]
         if own:
-            least_squares(model, own, role="lead", runs=[i], max_nfev=settings.max_nfev, budget=settings.budget,
-                          diff_step=settings.diff_step)
+            least_squares(model, own, role="lead", runs=[i], max_nfev=settings.max_nfev,
+                          budget=_budget(settings, len(own)), diff_step=settings.diff_step)
     return fr
+
+
+def _budget(settings: Settings, free: int) -> int:
+    """Simulations per fit horizon: ``settings.budget`` for up to 7 free parameters, growing with
+    the Jacobian's cost beyond."""
+    return int(settings.budget * max(1.0, (free + 1) / 8))
 
 
 def _rough(runs: Sequence[Run]) -> bool:
@@ -304,7 +310,7 @@ def _restart_nuisance(model: Model, settings: Settings) -> None:
         if hits.size and part.t_end > t0:
             share = min(share, (float(measured.times[hits[0]]) - t0) / (part.t_end - t0))
     share = min(max(share * 0.9, 0.15), 0.5)
-    least_squares(model, keys, max_nfev=settings.max_nfev, budget=settings.budget, diff_step=settings.diff_step,
+    least_squares(model, keys, max_nfev=settings.max_nfev, budget=_budget(settings, len(keys)), diff_step=settings.diff_step,
                   horizons=(share,), final=False)
 
 
@@ -385,10 +391,15 @@ def discover(
         round_results = [c for c in (_try(spec, current, base, rnd, settings, skipped, quick=contacts) for spec in pool)
                          if c is not None]
         if contacts:
-            # Contact scenes: every candidate got a quick fit from the current optimum; the most
-            # promising ones (by fitted error, never by held-out error) get the full, restarted fit.
+            # Rough scenes: every candidate got a quick fit from the current optimum; the most
+            # promising ones (by fitted error, never by held-out error) and the ones the current
+            # model's residual statistics point at get the full, restarted fit.
+            from physbench.discover.diagnostics import findings, views
+
+            suggested = {e for f in findings(views(current)) for e in f.suggests}
             ranked = sorted((c for c in round_results if c.delta_criterion < 0), key=lambda c: c.criterion)
-            for c in ranked[: settings.screen]:
+            chosen_full = ranked[: settings.screen] + [c for c in round_results if c.name in suggested and c not in ranked[: settings.screen]]
+            for c in chosen_full:
                 spec = next(sp for sp in pool if sp.label == c.effect)
                 full = _try(spec, current, base, rnd, settings, [], quick=False)
                 if full is not None and full.criterion < c.criterion:
@@ -430,7 +441,11 @@ def discover(
         current = best.scored
         ranked = sorted((c for c in round_results if c is not best and c.gain > 0), key=lambda c: -c.gain)
         names = {c.effect for c in ranked[: settings.shortlist]}
-        pool = [s for s in pool if s.label in names]
+        from physbench.discover.diagnostics import findings, views
+
+        # ... and whatever the new model's residual statistics still point at
+        names |= {e for f in findings(views(current)) for e in f.suggests} - {best.name}
+        pool = [s for s in pool if s.label in names or s.name in names]
         if not pool:
             break
     if len(causes) > 1:
@@ -473,7 +488,14 @@ def _try(spec: CandidateSpec, current: Scored, base: Scored, rnd: int, settings:
     fixed = {k.rpartition(".")[2]: model.values[k] for k in own if k not in visible}
     free = [*current.fit.free, *visible]
     rough = _rough(current.model.problem.runs)
-    _rescale(model, {k: _unit_sensitivity(model, k, rough) for k in visible}, current.fit.rms)
+    # The causes already in the model were scaled against the misfit of the model they extended;
+    # near the current, better optimum those steps are far too large for finite differences (the
+    # cause would not move and the new effect could not trade off against it): rescale them too.
+    # Not in rough scenes, whose large steps are meant to average over the contact saw-tooth.
+    earlier = [] if rough else [
+        p.key for p in model.params if p.kind == "effect" and p.target != key and p.key in current.fit.free
+    ]
+    _rescale(model, {k: _unit_sensitivity(model, k, rough) for k in [*visible, *earlier]}, current.fit.rms)
     for k in visible:  # off the bound: a bounded least-squares step from a bound can stall there
         p = model.param(k)
         v = model.values[k]
@@ -483,13 +505,22 @@ def _try(spec: CandidateSpec, current: Scored, base: Scored, rnd: int, settings:
             model.values[k] = max(p.high - p.scale, p.low)
     if quick:
         probe_start(model, visible)
-        fr = least_squares(model, free, max_nfev=settings.max_nfev, budget=settings.quick_budget, diff_step=settings.diff_step)
+        fr = least_squares(model, free, max_nfev=settings.max_nfev, budget=max(settings.quick_budget, 3 * (len(free) + 1)),
+                           diff_step=settings.diff_step)
     else:
         if _rough(current.model.problem.runs):
             # The current optimum's initial state was bent to make up for what the current model
             # lacks; in a contact scene that start traps the extended fit. Start it afresh.
             _restart_nuisance(model, settings)
+        before = dict(model.values)
         fr = _fit(model, settings, base=False, free=free, probe=visible)
+        if fr.ssr > current.fit.ssr and earlier and all(abs(model.values[k] - before[k]) < 1e-3 * model.param(k).scale for k in visible):
+            # Stuck where it started, on top of earlier causes: the step to where the new effect
+            # trades off against them can be too long for a local fit. Once more, from further in.
+            model.values = {**before, **{k: min(before[k] + 3.0 * model.param(k).scale, model.param(k).high) for k in visible}}
+            again = _fit(model, settings, base=False, free=free)
+            if again.ssr < fr.ssr:
+                fr = again
     if fr.ssr > current.fit.ssr:
         # Worse than the model it extends (the fit stalled away from the effect's neutral start):
         # the extended model can always do at least as well with the effect switched off.
