@@ -215,3 +215,16 @@ def test_symmetric_option_makes_the_truth_an_exact_fixed_point(symmetric: bool) 
         assert moved < 1e-9  # f(o, s) - f(s, o) vanishes when o == s
     else:
         assert moved > 1e-6  # the plain network has a small bias at zero difference
+
+
+def test_init_fine_tunes_from_weights_and_refuses_another_architecture(tmp_path: Path) -> None:
+    cfg = TrainConfig(samples=16, batch=8, eval_every=16, val_groups=1, workers=0, threads=1)
+    first, _ = train(TINY_DATA, TINY, cfg, tmp_path / "a", progress=False)
+    # lr = 0: nothing moves, so the fine-tuned weights are the ones it started from.
+    same, _ = train(TINY_DATA, TINY, TrainConfig(**{**cfg.__dict__, "lr": 0.0, "init": str(first)}), tmp_path / "b",
+                    progress=False)
+    a, b = weights.load(first)[0], weights.load(same)[0]
+    assert all(torch.allclose(a[k], b[k], atol=1e-6) for k in a)
+    other = NetConfig(**{**TINY.to_dict(), "widths": (4, 8, 8, 16)})
+    with pytest.raises(PhysbenchError, match="architecture"):
+        train(TINY_DATA, other, TrainConfig(**{**cfg.__dict__, "init": str(first)}), tmp_path / "c", progress=False)

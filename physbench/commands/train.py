@@ -20,6 +20,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--device", default="cpu", help="torch device to train on, e.g. cuda (default cpu)")
     p.add_argument("--blur-max", type=float, default=0.0,
                    help="augment: blur half the observed sequences by sigma ~ U(0, this) pixels (default 0: off)")
+    p.add_argument("--init", default="", help="fine-tune: start from these weights (.safetensors) instead of a fresh network")
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
     p.add_argument("--workers", type=int, default=1, help="data-generating processes (default 1)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (default: torch's choice)")
@@ -67,7 +68,7 @@ def main(args: argparse.Namespace) -> int:
     net = NetConfig(n_outputs=n_out, widths=widths, resolution=args.resolution, frames=args.frames)  # type: ignore[arg-type]
     cfg = TrainConfig(samples=args.samples, batch=args.batch, lr=args.lr, val_groups=args.val_groups,
                       eval_every=args.eval_every, workers=args.workers, threads=args.threads,
-                      device=args.device, minutes=args.minutes)
+                      device=args.device, minutes=args.minutes, init=args.init)
     out = Path(args.out or f"runs/train/{weights_name(spec)}")
     path, meta = train(spec, net, cfg, out, resume=not args.no_resume, progress=not args.quiet)
     print(f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: {meta['val_mse']:.3g}; "

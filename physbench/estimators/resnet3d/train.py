@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from physbench.errors import PhysbenchError
 from physbench.estimators.resnet3d import weights
 from physbench.estimators.resnet3d.data import DataSpec, stream, validation_set
 from physbench.estimators.resnet3d.model import NetConfig, build_net
@@ -29,6 +30,7 @@ class TrainConfig:
     seed: int = 0
     device: str = "cpu"  # "cuda" trains on a GPU; the weights are the same either way
     minutes: float = 0.0  # wall-clock budget (0 = none); training stops at whichever budget ends first
+    init: str = ""  # start from these weights (fine-tuning) instead of a fresh network
 
 
 def progress_fraction(cfg: TrainConfig, seen: int, wall_s: float) -> float:
@@ -139,6 +141,11 @@ def train(
     opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     ckpt = out / "checkpoint.safetensors"
     seen, best, history, wall0 = 0, float("inf"), [], 0.0
+    if cfg.init and not (resume and ckpt.is_file()):
+        state, meta = weights.load(cfg.init)
+        if NetConfig.from_dict(meta["net"]) != net_cfg:
+            raise PhysbenchError(f"--init {cfg.init!r} has architecture {meta['net']}, expected {net_cfg.to_dict()}")
+        net.load_state_dict({k: v.float() for k, v in state.items()})
     if resume and ckpt.is_file():
         tensors, meta = weights.load(ckpt)
         net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
