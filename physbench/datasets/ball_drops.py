@@ -109,7 +109,7 @@ def load(
                 {"ball": Track(t, np.zeros_like(t), h)},
                 run=f"{stem}/{drop}",
                 fields=("y",),
-                source=str(folder / f"{stem}.csv"),
+                source=f"{FOLDER}/{stem}.csv",
                 meta={"ball": stem, "drop": drop, "samples_clipped": rows.shape[0] - keep},
             )
             scene = Scene(
