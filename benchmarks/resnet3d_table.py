@@ -17,23 +17,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from physbench.bench.tables import PAPER
+from physbench.bench.tables import paper_value, ratio_ci
 
 KEYS = ["scene", "unknowns", "bodies"]
-BOOTSTRAP = 4000
 FIRST_TEN = 10
-
-
-def ratio_interval(num: np.ndarray, den: np.ndarray, *, level: float = 0.9, seed: int = 0) -> tuple[float, float, float]:
-    """``mean(num) / mean(den)`` and its paired percentile-bootstrap interval over seeds."""
-    num, den = np.asarray(num, float), np.asarray(den, float)
-    idx = np.random.default_rng(seed).integers(0, len(num), size=(BOOTSTRAP, len(num)))
-    boot = num[idx].mean(axis=1) / den[idx].mean(axis=1)
-    lo, hi = np.quantile(boot, [(1 - level) / 2, (1 + level) / 2])
-    return float(num.mean() / den.mean()), float(lo), float(hi)
 
 
 def _at(g: pd.DataFrame, n: int, column: str = "best_nmse") -> pd.Series:
@@ -58,13 +47,13 @@ def criteria(ok: pd.DataFrame) -> list[str]:
         sharp, blur = g[g.blur == 0], g[g.blur > 0]
         a2, a11, b11 = _at(sharp, 2), _at(sharp, 11), _at(blur, 11)
         common = a11.index.intersection(b11.index)
-        paper = PAPER.get((scene, frozenset(unknowns.split("+"))), {}).get("NN") if bodies == "all" else None
+        paper = paper_value(scene, unknowns, "NN") if bodies == "all" else None
         first = common[common < FIRST_TEN]
         rows.append(
             f"| {scene} | {unknowns} | {bodies} | {f'{paper[0]:.1e}' if paper else '–'} | {a2.mean():.2e} | "
             f"{a11.mean():.2e} | {('yes' if a11.mean() <= paper[0] else 'no') if paper else '–'} | "
-            f"{_fmt_ratio(ratio_interval(a2.values, a11.values))} | {b11.mean():.2e} | "
-            f"{_fmt_ratio(ratio_interval(b11[common].values, a11[common].values))} | "
+            f"{_fmt_ratio(ratio_ci(a2.values, a11.values))} | {b11.mean():.2e} | "
+            f"{_fmt_ratio(ratio_ci(b11[common].values, a11[common].values))} | "
             f"{b11[first].mean() / a11[first].mean():.2f} | "
             f"{_at(blur, 11, 'nmse')[common].mean() / _at(sharp, 11, 'nmse')[common].mean():.2f} | {len(a11)} |"
         )

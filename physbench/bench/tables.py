@@ -162,6 +162,16 @@ def bootstrap_ci(values: Sequence[float], *, level: float = 0.95, n: int = BOOTS
     return float(lo), float(hi)
 
 
+def ratio_ci(num: Sequence[float], den: Sequence[float], *, level: float = 0.9, n: int = BOOTSTRAP,
+             seed: int = 0) -> tuple[float, float, float]:
+    """``mean(num) / mean(den)`` of paired values (the same seeds) and its percentile-bootstrap
+    interval, resampling the pairs together so shared per-seed difficulty cancels."""
+    a, b = np.asarray(num, dtype=float), np.asarray(den, dtype=float)
+    idx = np.random.default_rng(seed).integers(0, a.size, size=(n, a.size))
+    lo, hi = np.quantile(a[idx].mean(axis=1) / b[idx].mean(axis=1), [(1 - level) / 2, (1 + level) / 2])
+    return float(a.mean() / b.mean()), float(lo), float(hi)
+
+
 def _ordered_groups(df: pd.DataFrame, cols: Sequence[str]) -> list[tuple[Any, ...]]:
     """Distinct values of ``cols`` in the order they first appear in the spec (cell index)."""
     first = df.sort_values("cell_index").drop_duplicates(list(cols))
