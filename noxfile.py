@@ -39,5 +39,14 @@ def regression(session: nox.Session) -> None:
     session.install("-e", ".")
     out = Path(session.create_tmp()) / "smoke"
     # --fresh: resuming would reuse the cells of the last session instead of testing this code
-    session.run("physbench", "bench", "benchmarks/smoke.toml", "--out", str(out), "--fresh", "-q", external=True)
+    session.run(
+        "physbench",
+        "bench",
+        "benchmarks/smoke.toml",
+        "--out",
+        str(out),
+        "--fresh",
+        "-q",
+        external=True,
+    )
     session.run("physbench", "compare", str(out), "results/baseline", external=True)

@@ -114,13 +114,18 @@ def sensitivity(name: str, seed: int, engine: str, shift: float = 1e-3) -> Compa
         return None
     sim = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}[engine]()
     b0 = scene.bodies[0]
-    moved = replace(scene, bodies=(replace(b0, position=(b0.position[0] + shift, b0.position[1])), *scene.bodies[1:]))
+    moved = replace(
+        scene,
+        bodies=(replace(b0, position=(b0.position[0] + shift, b0.position[1])), *scene.bodies[1:]),
+    )
     return _diff(name, seed, sim.simulate(scene), sim.simulate(moved), {})
 
 
 def _diff(name: str, seed: int, a: Trajectory, b: Trajectory, secs: dict[str, float]) -> Comparison:
     dist = np.linalg.norm(a.states[:, :, 0:2] - b.states[:, :, 0:2], axis=2)  # (T, N)
-    return Comparison(name, seed, dist[-1], dist.max(axis=0), same_outcome(outcome(a), outcome(b)), secs)
+    return Comparison(
+        name, seed, dist[-1], dist.max(axis=0), same_outcome(outcome(a), outcome(b)), secs
+    )
 
 
 def _row(label: str, rows: list[Comparison]) -> str:
@@ -146,15 +151,22 @@ def main() -> None:
     }
     print("final-position difference per body (m) over seeds: mean, 90th percentile, max;")
     print("path: max over frames; same: seeds with the same qualitative outcome\n")
-    header = f"{'scene / comparison':24s} {'mean':>7s} {'p90':>7s} {'max':>7s} {'path':>7s} {'same':>9s}"
+    header = (
+        f"{'scene / comparison':24s} {'mean':>7s} {'p90':>7s} {'max':>7s} {'path':>7s} {'same':>9s}"
+    )
     for name in args.scenes.split(","):
-        results = {label: [c for s in range(args.seeds) if (c := fn(name, s)) is not None] for label, fn in runs.items()}
+        results = {
+            label: [c for s in range(args.seeds) if (c := fn(name, s)) is not None]
+            for label, fn in runs.items()
+        }
         if not results["pymunk vs box2d"]:
             print(f"{name}: scene not available\n")
             continue
         base = results["pymunk vs box2d"]
         ms = {e: 1e3 * float(np.median([c.seconds[e] for c in base])) for e in ("pymunk", "box2d")}
-        print(f"{name} ({len(base)} seeds; median simulate {ms['pymunk']:.1f} ms pymunk, {ms['box2d']:.1f} ms box2d)")
+        print(
+            f"{name} ({len(base)} seeds; median simulate {ms['pymunk']:.1f} ms pymunk, {ms['box2d']:.1f} ms box2d)"
+        )
         print(header)
         for label, rows in results.items():
             print(_row(label, rows))

@@ -20,11 +20,19 @@ def main(seeds: int = 10) -> int:
     info = weights.find("bouncing_balls", ("mass",))
     print("| unknown balls (of 6) | after 2 | after 11 | 2 / 11 | seeds |\n|---|---|---|---|---|")
     for k in range(1, 7):
-        rows = evaluate_weights(info.path, range(seeds), iterations=11, scene_options={"n_balls": 6},
-                                bodies=[f"b{i}" for i in range(k)])
+        rows = evaluate_weights(
+            info.path,
+            range(seeds),
+            iterations=11,
+            scene_options={"n_balls": 6},
+            bodies=[f"b{i}" for i in range(k)],
+        )
         a2, a11 = (np.array([r[n] for r in rows]) for n in (2, 11))
-        print(f"| {k} | {a2.mean():.2e} ± {a2.std(ddof=1):.1e} | {a11.mean():.2e} ± {a11.std(ddof=1):.1e} | "
-              f"{a2.mean() / a11.mean():.2f} | {seeds} |", flush=True)
+        print(
+            f"| {k} | {a2.mean():.2e} ± {a2.std(ddof=1):.1e} | {a11.mean():.2e} ± {a11.std(ddof=1):.1e} | "
+            f"{a2.mean() / a11.mean():.2f} | {seeds} |",
+            flush=True,
+        )
     return 0
 
 

@@ -63,10 +63,16 @@ def criteria(ok: pd.DataFrame) -> list[str]:
 def table(folder: str | Path) -> str:
     df = pd.read_parquet(Path(folder) / "results.parquet")
     ok = df[df.status == "ok"]
-    rows = ["## resnet3d against the issue's criteria", "", *criteria(ok), "",
-            "## Every estimator at equal iterations", "",
-            "| scene | unknowns | bodies | blur | estimator | after 2 | after 11 | 2 / 11 | seeds |",
-            "|---|---|---|---|---|---|---|---|---|"]
+    rows = [
+        "## resnet3d against the issue's criteria",
+        "",
+        *criteria(ok),
+        "",
+        "## Every estimator at equal iterations",
+        "",
+        "| scene | unknowns | bodies | blur | estimator | after 2 | after 11 | 2 / 11 | seeds |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     keys = [*KEYS, "blur", "estimator_name"]
     for key, g in ok.groupby(keys, sort=True):
         a2, a11 = _at(g, 2), _at(g, 11)
@@ -78,7 +84,9 @@ def table(folder: str | Path) -> str:
     if len(failed):
         rows.append("")
         for key, g in failed.groupby(keys):
-            rows.append(f"failed: {' '.join(map(str, key))}: {len(g)} cells ({g.error.iloc[0][:120]})")
+            rows.append(
+                f"failed: {' '.join(map(str, key))}: {len(g)} cells ({g.error.iloc[0][:120]})"
+            )
     return "\n".join(rows)
 
 

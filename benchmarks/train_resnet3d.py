@@ -33,8 +33,21 @@ ROWS: list[tuple[str, str]] = [
     ("bouncing_balls", "mass"),
 ]
 #: Training options shared by every row (recorded in each sidecar).
-COMMON = ["--batch", "32", "--lr", "1e-3", "--blur-max", "4", "--val-groups", "16", "--eval-every", "20000",
-          "--eval-seeds", "0", "--quiet"]
+COMMON = [
+    "--batch",
+    "32",
+    "--lr",
+    "1e-3",
+    "--blur-max",
+    "4",
+    "--val-groups",
+    "16",
+    "--eval-every",
+    "20000",
+    "--eval-seeds",
+    "0",
+    "--quiet",
+]
 
 
 def name(scene: str, params: str) -> str:
@@ -51,12 +64,34 @@ def launch(args: argparse.Namespace) -> int:
             scene, params = todo.pop(0)
             out = Path(args.out) / name(scene, params)
             out.mkdir(parents=True, exist_ok=True)
-            cmd = [sys.executable, "-m", "physbench", "train", "--scene", scene, "--params", params, "--out", str(out),
-                   "--samples", str(args.samples), "--minutes", str(args.minutes), "--device", args.device,
-                   "--workers", str(args.workers), "--threads", "1", *COMMON]
+            cmd = [
+                sys.executable,
+                "-m",
+                "physbench",
+                "train",
+                "--scene",
+                scene,
+                "--params",
+                params,
+                "--out",
+                str(out),
+                "--samples",
+                str(args.samples),
+                "--minutes",
+                str(args.minutes),
+                "--device",
+                args.device,
+                "--workers",
+                str(args.workers),
+                "--threads",
+                "1",
+                *COMMON,
+            ]
             log = (out / "log.txt").open("a")
             print(" ".join(cmd[1:]), flush=True)
-            running.append((name(scene, params), subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT)))
+            running.append(
+                (name(scene, params), subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT))
+            )
         time.sleep(5)
         for item in list(running):
             code = item[1].poll()
@@ -82,9 +117,16 @@ def pack(args: argparse.Namespace) -> int:
             shutil.copy(final.with_suffix(".json"), stage / f"{run.name}.json")
         elif (run / "best.safetensors").is_file():
             state, _ = weights.load(run / "best.safetensors")
-            ck = json.loads((run / "checkpoint.json").read_text()) if (run / "checkpoint.json").is_file() else {}
-            weights.save(stage / f"{run.name}.partial", weights.quantize(state),
-                         {"storage": weights.INT8, "history": ck.get("history", []), "unfinished": True})
+            ck = (
+                json.loads((run / "checkpoint.json").read_text())
+                if (run / "checkpoint.json").is_file()
+                else {}
+            )
+            weights.save(
+                stage / f"{run.name}.partial",
+                weights.quantize(state),
+                {"storage": weights.INT8, "history": ck.get("history", []), "unfinished": True},
+            )
         else:
             continue
         if (run / "log.txt").is_file():
@@ -118,7 +160,9 @@ def install(args: argparse.Namespace) -> int:
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--out", default="runs/train", help="folder of the per-row training folders")
     ap.add_argument("--only", nargs="*", help="row names (SCENE__PARAMS) to train or install")
     ap.add_argument("--device", default="cpu")
@@ -126,8 +170,12 @@ def main() -> int:
     ap.add_argument("--samples", type=int, default=5_000_000, help="sample budget per row")
     ap.add_argument("--workers", type=int, default=1, help="data processes per row")
     ap.add_argument("--parallel", type=int, default=1, help="rows trained at once")
-    ap.add_argument("--pack", help="write int8 tar files of the weights so far into this folder and exit")
-    ap.add_argument("--install", action="store_true", help="copy finished weights into the package and exit")
+    ap.add_argument(
+        "--pack", help="write int8 tar files of the weights so far into this folder and exit"
+    )
+    ap.add_argument(
+        "--install", action="store_true", help="copy finished weights into the package and exit"
+    )
     args = ap.parse_args()
     if args.pack:
         return pack(args)

@@ -12,13 +12,22 @@ from collections.abc import Sequence
 COMMANDS: dict[str, tuple[str, str]] = {
     "scenes": ("scenes", "list the registered scenes and their unknowns"),
     "plugins": ("plugins", "list every discovered component and any plugin that failed to load"),
-    "simulate": ("simulate", "simulate a scene, save trajectory + frames (.npz), preview as GIF/PNG"),
+    "simulate": (
+        "simulate",
+        "simulate a scene, save trajectory + frames (.npz), preview as GIF/PNG",
+    ),
     "run": ("run", "identify parameters: the correction loop on a simulated or given observation"),
     "train": ("train", "train the resnet3d correction network for a scene and parameter set"),
     "bench": ("bench", "run a benchmark sweep spec (TOML) into tables of normalized min MSE"),
     "plot": ("plot", "plots and an HTML report for a benchmark output folder"),
-    "compare": ("compare", "flag estimator x scene cells that got significantly worse than a baseline"),
-    "discover": ("discover", "find the missing physical effect behind a recording's disagreement with the model"),
+    "compare": (
+        "compare",
+        "flag estimator x scene cells that got significantly worse than a baseline",
+    ),
+    "discover": (
+        "discover",
+        "find the missing physical effect behind a recording's disagreement with the model",
+    ),
 }
 
 

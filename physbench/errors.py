@@ -34,7 +34,13 @@ class SceneError(PhysbenchError, ValueError):
         source: str | None = None,
         line: int | None = None,
     ) -> None:
-        self.key, self.value, self.source, self.line, self.reason = key, value, source, line, message
+        self.key, self.value, self.source, self.line, self.reason = (
+            key,
+            value,
+            source,
+            line,
+            message,
+        )
         where = ""
         if source is not None:
             where = f"{source}:{line}: " if line is not None else f"{source}: "
@@ -49,7 +55,9 @@ class SimulationError(PhysbenchError, RuntimeError):
 
     def __init__(self, message: str, *, engine: str, frame: int, body: str | None = None) -> None:
         self.engine, self.frame, self.body = engine, frame, body
-        super().__init__(f"[{engine}] frame {frame}" + (f", body {body!r}" if body else "") + f": {message}")
+        super().__init__(
+            f"[{engine}] frame {frame}" + (f", body {body!r}" if body else "") + f": {message}"
+        )
 
 
 class PluginError(PhysbenchError):

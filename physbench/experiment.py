@@ -77,7 +77,9 @@ def make_estimator(name: str, options: Mapping[str, Any]) -> Any:
         return cls(**dict(options))
     except TypeError as exc:
         try:
-            accepted = [q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")]
+            accepted = [
+                q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")
+            ]
         except (TypeError, ValueError):
             accepted = []
         raise PhysbenchError(
@@ -91,7 +93,9 @@ def case_space(case: Case, scene: Scene | None = None) -> ParamSpace:
     from physbench.scenes import resolve_scene
 
     scene = resolve_scene(case.scene, case.seed) if scene is None else scene
-    return ParamSpace.from_scene(scene, list(case.params), None if case.bodies is None else list(case.bodies))
+    return ParamSpace.from_scene(
+        scene, list(case.params), None if case.bodies is None else list(case.bodies)
+    )
 
 
 def run_case(
@@ -126,18 +130,36 @@ def run_case(
     else:
         observer = create("simulator", case.observer_engine)
         obs_renderer = create(
-            "renderer", "raster", resolution=case.resolution, mode=case.render_mode,
-            blur=case.blur, noise=case.noise, seed=case.seed,
+            "renderer",
+            "raster",
+            resolution=case.resolution,
+            mode=case.render_mode,
+            blur=case.blur,
+            noise=case.noise,
+            seed=case.seed,
         )
-        obs = simulate_observation(scene, truth, observer, obs_renderer, marked=space.bodies if per_object else ())
+        obs = simulate_observation(
+            scene, truth, observer, obs_renderer, marked=space.bodies if per_object else ()
+        )
     if save_observation:
         save_obs(save_observation, obs)
     history = refine(
-        obs, scene, space, simulator, model_renderer, estimator,
-        iterations=case.iterations, seed=case.seed, initial=initial, callback=callback,
+        obs,
+        scene,
+        space,
+        simulator,
+        model_renderer,
+        estimator,
+        iterations=case.iterations,
+        seed=case.seed,
+        initial=initial,
+        callback=callback,
     )
     history.meta.update(
         observe_engine=None if case.observation else case.observer_engine,
-        blur=case.blur, noise=case.noise, resolution=case.resolution, render_mode=case.render_mode,
+        blur=case.blur,
+        noise=case.noise,
+        resolution=case.resolution,
+        render_mode=case.render_mode,
     )
     return history

@@ -63,7 +63,9 @@ def derive_seeds(seed: int) -> Seeds:
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise PhysbenchError(f"seed = {seed!r}: expected a whole number >= 0")
     truth, initial, est = np.random.SeedSequence(int(seed)).spawn(3)
-    return Seeds(np.random.default_rng(truth), np.random.default_rng(initial), int(est.generate_state(1)[0]))
+    return Seeds(
+        np.random.default_rng(truth), np.random.default_rng(initial), int(est.generate_state(1)[0])
+    )
 
 
 def draw_problem(space: ParamSpace, seed: int) -> tuple[Params, Params]:
@@ -195,7 +197,9 @@ def _check_proposal(name: str, space: ParamSpace, proposal: object, iteration: i
     if missing or extra:
         raise EstimatorError(
             f"estimator {name!r} proposed keys {sorted(proposal)} in iteration {iteration}; expected exactly "
-            f"{list(space.keys)}" + (f" (missing {missing})" if missing else "") + (f" (extra {extra})" if extra else "")
+            f"{list(space.keys)}"
+            + (f" (missing {missing})" if missing else "")
+            + (f" (extra {extra})" if extra else "")
         )
     out: Params = {}
     for u in space.unknowns:
@@ -245,10 +249,18 @@ def refine(
     (sharp); an observation model (blur, noise) belongs to whoever made ``observation``.
     ``callback`` is called with each :class:`Record` as it completes (progress displays).
     """
-    if isinstance(iterations, bool) or not isinstance(iterations, int | np.integer) or iterations < 1:
+    if (
+        isinstance(iterations, bool)
+        or not isinstance(iterations, int | np.integer)
+        or iterations < 1
+    ):
         raise PhysbenchError(f"iterations = {iterations!r}: expected a whole number >= 1")
     space = _space(scene, unknowns)
-    obs = observation if isinstance(observation, Observation) else Observation(np.asarray(observation))
+    obs = (
+        observation
+        if isinstance(observation, Observation)
+        else Observation(np.asarray(observation))
+    )
     name = str(getattr(type(estimator), "name", type(estimator).__name__))
     per_object = bool(getattr(estimator, "per_object", False))
     obs = validate(obs, expected_shape(renderer, scene), bodies=space.bodies if per_object else ())
@@ -256,7 +268,9 @@ def refine(
     if obs.truth is not None:
         missing = [k for k in space.keys if k not in obs.truth]
         if missing:
-            raise PhysbenchError(f"the observation's true parameters {dict(obs.truth)} lack {missing}")
+            raise PhysbenchError(
+                f"the observation's true parameters {dict(obs.truth)} lack {missing}"
+            )
         truth = {k: float(obs.truth[k]) for k in space.keys}
 
     seeds = derive_seeds(seed)
@@ -265,7 +279,9 @@ def refine(
     else:
         if not set(space.keys) <= set(initial) or not space.contains(initial):
             ranges = ", ".join(f"{u.key} in [{u.low:g}, {u.high:g}]" for u in space.unknowns)
-            raise PhysbenchError(f"initial guess {dict(initial)}: expected a value for each unknown with {ranges}")
+            raise PhysbenchError(
+                f"initial guess {dict(initial)}: expected a value for each unknown with {ranges}"
+            )
         params = {k: float(initial[k]) for k in space.keys}
     first = dict(params)
 
@@ -314,8 +330,22 @@ def refine(
         nmse = None if truth is None else space.normalized_mse(params, truth)
         if k == 0 or loss < records[best].loss:  # ties keep the earlier iterate
             best = k
-        best_loss, best_nmse = (loss, nmse) if best == k else (records[best].loss, records[best].nmse)
-        rec = Record(k, dict(params), loss, nmse, best, best_loss, best_nmse, t1 - t0, t2 - t1, t3 - t2, failed)
+        best_loss, best_nmse = (
+            (loss, nmse) if best == k else (records[best].loss, records[best].nmse)
+        )
+        rec = Record(
+            k,
+            dict(params),
+            loss,
+            nmse,
+            best,
+            best_loss,
+            best_nmse,
+            t1 - t0,
+            t2 - t1,
+            t3 - t2,
+            failed,
+        )
         records.append(rec)
         if callback is not None:
             callback(rec)
@@ -329,6 +359,11 @@ def refine(
         initial=first,
         truth=truth,
         options=dict(getattr(estimator, "options", {}) or {}),
-        meta={"scene": scene.name, "simulator": getattr(simulator, "name", ""), "per_object": per_object,
-              "observation": obs.source, "t_start": t_start},
+        meta={
+            "scene": scene.name,
+            "simulator": getattr(simulator, "name", ""),
+            "per_object": per_object,
+            "observation": obs.source,
+            "t_start": t_start,
+        },
     )

@@ -27,7 +27,9 @@ def image_mse(a: np.ndarray, b: np.ndarray) -> float:
     return float(d.sum() / d.size)
 
 
-def normalized_mse(space: ParamSpace, estimate: Mapping[str, float], truth: Mapping[str, float]) -> float:
+def normalized_mse(
+    space: ParamSpace, estimate: Mapping[str, float], truth: Mapping[str, float]
+) -> float:
     """The paper's parameter error; see the module docstring."""
     return space.normalized_mse(estimate, truth)
 

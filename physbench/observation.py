@@ -66,7 +66,9 @@ def expected_shape(renderer: Renderer, scene: Scene) -> tuple[int, int, int, int
     return (scene.frames, *frame.shape[1:])  # type: ignore[return-value]
 
 
-def check_frames(frames: object, expected: Sequence[int], *, what: str = "observation") -> np.ndarray:
+def check_frames(
+    frames: object, expected: Sequence[int], *, what: str = "observation"
+) -> np.ndarray:
     """``frames`` as float32 ``(T, C, H, W)``, or :class:`ObservationError` naming expected vs got."""
     arr = np.asarray(frames)
     if arr.dtype.kind not in "fiub":
@@ -76,7 +78,9 @@ def check_frames(frames: object, expected: Sequence[int], *, what: str = "observ
         names = "(T, C, H, W)"
         detail = ""
         if arr.ndim == 4:
-            diffs = [f"{n} {g} != {e}" for n, g, e in zip("TCHW", arr.shape, exp, strict=True) if g != e]
+            diffs = [
+                f"{n} {g} != {e}" for n, g, e in zip("TCHW", arr.shape, exp, strict=True) if g != e
+            ]
             detail = " (" + ", ".join(diffs) + ")"
         raise ObservationError(
             f"{what}: frames have shape {arr.shape}, expected {names} = {exp}{detail}; T is the scene's "
@@ -87,15 +91,22 @@ def check_frames(frames: object, expected: Sequence[int], *, what: str = "observ
         raise ObservationError(f"{what}: frames contain NaN or inf")
     lo, hi = float(arr.min()), float(arr.max())
     if lo < -1e-6 or hi > 1 + 1e-6:
-        raise ObservationError(f"{what}: frame values span [{lo:g}, {hi:g}], expected values in [0, 1]")
+        raise ObservationError(
+            f"{what}: frame values span [{lo:g}, {hi:g}], expected values in [0, 1]"
+        )
     return arr
 
 
-def validate(obs: Observation, expected: Sequence[int], *, bodies: Iterable[str] = ()) -> Observation:
+def validate(
+    obs: Observation, expected: Sequence[int], *, bodies: Iterable[str] = ()
+) -> Observation:
     """Check ``obs`` against the model's frame shape; ``bodies`` lists the marked frames required."""
     what = obs.source or "observation"
     frames = check_frames(obs.frames, expected, what=what)
-    marked = {b: check_frames(f, expected, what=f"{what} [{MARK_PREFIX}{b}]") for b, f in obs.marked.items()}
+    marked = {
+        b: check_frames(f, expected, what=f"{what} [{MARK_PREFIX}{b}]")
+        for b, f in obs.marked.items()
+    }
     missing = [b for b in bodies if b not in marked]
     if missing:
         have = ", ".join(sorted(marked)) or "none"
@@ -120,7 +131,9 @@ def simulate_observation(
     traj = simulator.simulate(scene, dict(truth), effects=effects)
     frames = renderer.render(scene, traj)
     focus = {b: renderer.render(scene, traj, focus=b) for b in marked}
-    return Observation(frames, dict(truth), focus, source=f"simulated ({getattr(simulator, 'name', '?')})")
+    return Observation(
+        frames, dict(truth), focus, source=f"simulated ({getattr(simulator, 'name', '?')})"
+    )
 
 
 def save_observation(path: str | Path, obs: Observation) -> None:
@@ -147,6 +160,8 @@ def load_observation(path: str | Path) -> Observation:
         )
     frames = arrays.pop("frames")
     if frames.ndim != 4:
-        raise ObservationError(f"{p}: 'frames' has shape {frames.shape}; expected 4 axes (T, C, H, W)")
+        raise ObservationError(
+            f"{p}: 'frames' has shape {frames.shape}; expected 4 axes (T, C, H, W)"
+        )
     marked = {k[len(MARK_PREFIX) :]: v for k, v in arrays.items() if k.startswith(MARK_PREFIX)}
     return Observation(frames, None, marked, source=str(p))

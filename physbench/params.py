@@ -50,7 +50,9 @@ class ParamSpace:
             known = sorted({u.body for u in unknowns})
             for b in bodies:
                 if b not in known:
-                    raise UnknownNameError("body", b, known, where=f"with unknowns in scene {scene.name!r}")
+                    raise UnknownNameError(
+                        "body", b, known, where=f"with unknowns in scene {scene.name!r}"
+                    )
             unknowns = [u for u in unknowns if u.body in bodies]
         return cls(tuple(unknowns))
 
@@ -83,7 +85,9 @@ class ParamSpace:
     def from_vector(self, vec: Sequence[float] | np.ndarray) -> Params:
         vec = np.asarray(vec, dtype=float).reshape(-1)
         if vec.shape[0] != len(self):
-            raise PhysbenchError(f"expected {len(self)} values for {list(self.keys)}, got {vec.shape[0]}")
+            raise PhysbenchError(
+                f"expected {len(self)} values for {list(self.keys)}, got {vec.shape[0]}"
+            )
         return {k: float(v) for k, v in zip(self.keys, vec, strict=True)}
 
     def to_unit(self, params: Mapping[str, float]) -> np.ndarray:

@@ -52,7 +52,9 @@ class FailedPlugin:
 
 @dataclass
 class Registry:
-    components: dict[str, dict[str, Component]] = field(default_factory=lambda: {k: {} for k in KINDS.values()})
+    components: dict[str, dict[str, Component]] = field(
+        default_factory=lambda: {k: {} for k in KINDS.values()}
+    )
     failed: list[FailedPlugin] = field(default_factory=list)
 
     def names(self, kind: str) -> list[str]:
@@ -91,7 +93,9 @@ def _dist_of(ep: md.EntryPoint) -> tuple[str, str]:
     return dist.metadata["Name"] or dist.name, dist.version
 
 
-def _register(pm: pluggy.PluginManager, reg: Registry, plugin: object, name: str, pkg: str, ver: str) -> bool:
+def _register(
+    pm: pluggy.PluginManager, reg: Registry, plugin: object, name: str, pkg: str, ver: str
+) -> bool:
     try:
         pm.register(plugin, name=name)
         pm.check_pending()
@@ -124,13 +128,17 @@ def discover(
             if _register(pm, reg, plugin, ep.name, pkg, ver):
                 origin[ep.name] = (pkg, ver)
     if env:
-        for spec in filter(None, (s.strip() for s in os.environ.get("PHYSBENCH_PLUGINS", "").split(","))):
+        for spec in filter(
+            None, (s.strip() for s in os.environ.get("PHYSBENCH_PLUGINS", "").split(","))
+        ):
             try:
                 modname, _, attr = spec.partition(":")
                 mod: ModuleType | Any = importlib.import_module(modname)
                 plugin = getattr(mod, attr) if attr else mod
             except Exception as exc:
-                reg.failed.append(FailedPlugin(spec, "PHYSBENCH_PLUGINS", "-", f"{type(exc).__name__}: {exc}"))
+                reg.failed.append(
+                    FailedPlugin(spec, "PHYSBENCH_PLUGINS", "-", f"{type(exc).__name__}: {exc}")
+                )
                 continue
             if _register(pm, reg, plugin, spec, "PHYSBENCH_PLUGINS", "-"):
                 origin[spec] = ("PHYSBENCH_PLUGINS", "-")
@@ -144,12 +152,23 @@ def discover(
             try:
                 items = list(impl.function() or [])
             except Exception as exc:
-                reg.failed.append(FailedPlugin(impl.plugin_name, pkg, ver, f"{hook} raised {type(exc).__name__}: {exc}"))
+                reg.failed.append(
+                    FailedPlugin(
+                        impl.plugin_name, pkg, ver, f"{hook} raised {type(exc).__name__}: {exc}"
+                    )
+                )
                 continue
             for obj in items:
                 name = getattr(obj, "name", None)
                 if not isinstance(name, str) or not name:
-                    reg.failed.append(FailedPlugin(impl.plugin_name, pkg, ver, f"{hook} returned {obj!r} without a string 'name'"))
+                    reg.failed.append(
+                        FailedPlugin(
+                            impl.plugin_name,
+                            pkg,
+                            ver,
+                            f"{hook} returned {obj!r} without a string 'name'",
+                        )
+                    )
                     continue
                 reg.add(Component(kind, name, obj, impl.plugin_name, pkg, ver))
     return reg

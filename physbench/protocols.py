@@ -93,7 +93,12 @@ class Renderer(Protocol):
     name: ClassVar[str]
 
     def render(
-        self, scene: Scene, traj: Trajectory, *, focus: str | None = None, out: np.ndarray | None = None
+        self,
+        scene: Scene,
+        traj: Trajectory,
+        *,
+        focus: str | None = None,
+        out: np.ndarray | None = None,
     ) -> np.ndarray:
         """Called after every simulation. ``focus`` names the marked object (for renderers
         that mark one); ``out`` is an optional buffer of the right shape to render into."""

@@ -53,7 +53,13 @@ class RecordingError(PhysbenchError, ValueError):
         row: int | None = None,
         column: str | None = None,
     ) -> None:
-        self.source, self.line, self.row, self.column, self.reason = source, line, row, column, message
+        self.source, self.line, self.row, self.column, self.reason = (
+            source,
+            line,
+            row,
+            column,
+            message,
+        )
         where = []
         if line is not None:
             where.append(f"line {line} ({'header' if row is None else f'data row {row}'})")
@@ -80,17 +86,25 @@ class Track:
         for name, arr in arrays.items():
             a = np.asarray(arr, dtype=float)
             if a.ndim != 1 or a.size == 0 or (n is not None and a.size != n):
-                raise RecordingError(f"track {name} must be a non-empty 1-D array as long as t, got shape {a.shape}")
+                raise RecordingError(
+                    f"track {name} must be a non-empty 1-D array as long as t, got shape {a.shape}"
+                )
             if not np.isfinite(a).all():
-                raise RecordingError(f"track {name} has NaN/inf at sample {int(np.argmin(np.isfinite(a)))}")
+                raise RecordingError(
+                    f"track {name} has NaN/inf at sample {int(np.argmin(np.isfinite(a)))}"
+                )
             n = a.size
             object.__setattr__(self, name, a)
         bad = np.nonzero(np.diff(self.t) <= 0)[0]
         if bad.size:
             i = int(bad[0]) + 1
-            raise RecordingError(f"track times must increase strictly; t[{i}] = {self.t[i]!r} follows {self.t[i - 1]!r}")
+            raise RecordingError(
+                f"track times must increase strictly; t[{i}] = {self.t[i]!r} follows {self.t[i - 1]!r}"
+            )
         if self.t[0] < 0:
-            raise RecordingError(f"track times must be >= 0 (simulations start at t = 0), got {self.t[0]!r}")
+            raise RecordingError(
+                f"track times must be >= 0 (simulations start at t = 0), got {self.t[0]!r}"
+            )
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -193,7 +207,13 @@ class Recording:
                 p, v = _STATE_COLUMN[f]
                 vals[f] = _interpolate(times, state[:, p], state[:, v], tr.t, method == "hermite")
             tracks[body] = Track(tr.t, vals["x"], vals["y"], vals.get("angle"))
-        return Recording(tracks, run=self.run, fields=self.fields, source=f"simulated ({traj.engine})", meta=self.meta)
+        return Recording(
+            tracks,
+            run=self.run,
+            fields=self.fields,
+            source=f"simulated ({traj.engine})",
+            meta=self.meta,
+        )
 
     def residuals(
         self,
@@ -221,9 +241,14 @@ class Recording:
                 parts.append(d)
         return np.concatenate(parts) if parts else np.zeros(0)
 
-    def rms(self, traj: Trajectory, *, fields: Sequence[str] | None = None, method: str = "hermite") -> dict[str, float]:
+    def rms(
+        self, traj: Trajectory, *, fields: Sequence[str] | None = None, method: str = "hermite"
+    ) -> dict[str, float]:
         """Root-mean-square residual per field over all bodies (m or rad)."""
-        return {f: float(np.sqrt(np.mean(self.residuals(traj, fields=[f], method=method) ** 2))) for f in self._fields(fields)}
+        return {
+            f: float(np.sqrt(np.mean(self.residuals(traj, fields=[f], method=method) ** 2)))
+            for f in self._fields(fields)
+        }
 
     # ------------------------------------------------------------------ construction
 
@@ -242,20 +267,27 @@ class Recording:
         for all bodies or one per body), e.g. to make synthetic data for a discovery test."""
         names = traj.bodies if bodies is None else tuple(bodies)
         if times is None:
-            tracks = {b: Track(traj.times, traj.body(b)[:, 0], traj.body(b)[:, 1], traj.body(b)[:, 2]) for b in names}
+            tracks = {
+                b: Track(traj.times, traj.body(b)[:, 0], traj.body(b)[:, 1], traj.body(b)[:, 2])
+                for b in names
+            }
         else:
             tracks = {}
             for b in names:
                 tb = np.asarray(times[b] if isinstance(times, Mapping) else times, dtype=float)
                 zero = np.zeros_like(tb)
-                tracks[b] = Track(tb, zero, zero, zero if angle else None)  # times only: resampled below
+                tracks[b] = Track(
+                    tb, zero, zero, zero if angle else None
+                )  # times only: resampled below
             tracks = dict(cls(tracks).sample(traj).tracks)
         if not angle:
             tracks = {b: Track(tr.t, tr.x, tr.y) for b, tr in tracks.items()}
         return cls(tracks, run=run, fields=fields, source=f"simulated ({traj.engine})")
 
 
-def _interpolate(times: np.ndarray, p: np.ndarray, v: np.ndarray, tq: np.ndarray, hermite: bool) -> np.ndarray:
+def _interpolate(
+    times: np.ndarray, p: np.ndarray, v: np.ndarray, tq: np.ndarray, hermite: bool
+) -> np.ndarray:
     if times.size == 1:
         return np.full(tq.shape, p[0])
     k = np.clip(np.searchsorted(times, tq, side="right") - 1, 0, times.size - 2)
@@ -332,9 +364,16 @@ def parse_recordings(
         row_no += 1
         if len(cells) != len(header):
             column = header[len(cells)] if len(cells) < len(header) else f"#{len(header) + 1}"
-            raise err(f"expected {len(header)} values ({', '.join(header)}), got {len(cells)}", column, line, row_no)
+            raise err(
+                f"expected {len(header)} values ({', '.join(header)}), got {len(cells)}",
+                column,
+                line,
+                row_no,
+            )
 
-        def number(name: str, cells: list[str] = cells, line: int = line, row_no: int = row_no) -> float:
+        def number(
+            name: str, cells: list[str] = cells, line: int = line, row_no: int = row_no
+        ) -> float:
             raw = cells[col[name]]
             try:
                 v = float(raw)
@@ -348,13 +387,20 @@ def parse_recordings(
         if not body:
             raise err("empty body name", "body", line, row_no)
         if known is not None and body not in known:
-            raise err(f"unknown body {body!r}; the scene's bodies are {', '.join(known)}", "body", line, row_no)
+            raise err(
+                f"unknown body {body!r}; the scene's bodies are {', '.join(known)}",
+                "body",
+                line,
+                row_no,
+            )
         run = cells[col["run"]] if "run" in col else ""
         if "run" in col and not run:
             raise err("empty run label", "run", line, row_no)
         t = number("t")
         if t < 0:
-            raise err(f"t = {t!r}: times must be >= 0 (simulations start at t = 0)", "t", line, row_no)
+            raise err(
+                f"t = {t!r}: times must be >= 0 (simulations start at t = 0)", "t", line, row_no
+            )
         x, y = number("x"), number("y")
         has_angle = "angle" in col and cells[col["angle"]] != ""
         a = number("angle") if has_angle else math.nan
@@ -385,7 +431,12 @@ def parse_recordings(
         g["angle"].append(a)
 
     if header is None:
-        raise err(f"empty file; expected a header with columns {','.join(REQUIRED_COLUMNS)} (optionally angle, run)", "t", 1, None)
+        raise err(
+            f"empty file; expected a header with columns {','.join(REQUIRED_COLUMNS)} (optionally angle, run)",
+            "t",
+            1,
+            None,
+        )
     if not groups:
         raise err("no data rows after the header", "t", header_line + 1, 1)
 
@@ -394,11 +445,15 @@ def parse_recordings(
         t = np.asarray(g["t"])
         order = np.argsort(t, kind="stable")
         ang = np.asarray(g["angle"])[order] if angle_state[(run, body)][0] else None
-        runs.setdefault(run, {})[body] = Track(t[order], np.asarray(g["x"])[order], np.asarray(g["y"])[order], ang)
+        runs.setdefault(run, {})[body] = Track(
+            t[order], np.asarray(g["x"])[order], np.asarray(g["y"])[order], ang
+        )
     return [Recording(tracks, run=run, source=source) for run, tracks in runs.items()]
 
 
-def read_recordings(path: str | Path, *, bodies: Scene | Iterable[str] | None = None) -> list[Recording]:
+def read_recordings(
+    path: str | Path, *, bodies: Scene | Iterable[str] | None = None
+) -> list[Recording]:
     """Read a recording CSV file: one :class:`Recording` per run (see the module docstring)."""
     p = Path(path)
     try:
@@ -415,12 +470,17 @@ def read_recording(
     recs = read_recordings(path, bodies=bodies)
     if run is None:
         if len(recs) != 1:
-            raise RecordingError(f"file holds {len(recs)} runs ({', '.join(r.run for r in recs)}); pass run=...", source=str(path))
+            raise RecordingError(
+                f"file holds {len(recs)} runs ({', '.join(r.run for r in recs)}); pass run=...",
+                source=str(path),
+            )
         return recs[0]
     for r in recs:
         if r.run == run:
             return r
-    raise RecordingError(f"no run {run!r}; runs: {', '.join(r.run for r in recs)}", source=str(path))
+    raise RecordingError(
+        f"no run {run!r}; runs: {', '.join(r.run for r in recs)}", source=str(path)
+    )
 
 
 def format_recordings(recordings: Sequence[Recording]) -> str:
@@ -430,11 +490,15 @@ def format_recordings(recordings: Sequence[Recording]) -> str:
     labels = [r.run for r in recordings]
     with_run = len(recordings) > 1 or labels[0] != ""
     if with_run and (len(set(labels)) != len(labels) or "" in labels):
-        raise RecordingError(f"each run needs a distinct, non-empty label to share a file; labels: {labels}")
+        raise RecordingError(
+            f"each run needs a distinct, non-empty label to share a file; labels: {labels}"
+        )
     with_angle = any(tr.angle is not None for r in recordings for tr in r.tracks.values())
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["t", "body", "x", "y", *(["angle"] if with_angle else []), *(["run"] if with_run else [])])
+    w.writerow(
+        ["t", "body", "x", "y", *(["angle"] if with_angle else []), *(["run"] if with_run else [])]
+    )
     for r in recordings:
         for body, tr in r.tracks.items():
             for i in range(len(tr)):

@@ -233,7 +233,12 @@ class Scene:
                 return u
         from physbench.errors import UnknownNameError
 
-        raise UnknownNameError("unknown parameter", key, [u.key for u in self.unknowns], where=f"of scene {self.name!r}")
+        raise UnknownNameError(
+            "unknown parameter",
+            key,
+            [u.key for u in self.unknowns],
+            where=f"of scene {self.name!r}",
+        )
 
     def with_params(self, params: Mapping[str, float]) -> Scene:
         """A copy with ``{"body.param": value}`` applied. Called once per simulation."""
@@ -253,7 +258,9 @@ class Scene:
                 from physbench.errors import UnknownNameError
 
                 raise UnknownNameError("body", body, names)
-        bodies = tuple(replace(b, **changes[b.name]) if b.name in changes else b for b in self.bodies)
+        bodies = tuple(
+            replace(b, **changes[b.name]) if b.name in changes else b for b in self.bodies
+        )
         return replace(self, bodies=bodies)
 
     def validate(self) -> Scene:
@@ -311,7 +318,11 @@ def validate_scene(scene: Scene) -> None:
         raise SceneError("must be a non-empty string", key="name", value=scene.name)
     xmin, ymin, xmax, ymax = (_finite(f"bounds[{i}]", v) for i, v in enumerate(scene.bounds))
     if not (xmin < xmax and ymin < ymax):
-        raise SceneError("bounds must be [xmin, ymin, xmax, ymax] with min < max", key="bounds", value=scene.bounds)
+        raise SceneError(
+            "bounds must be [xmin, ymin, xmax, ymax] with min < max",
+            key="bounds",
+            value=scene.bounds,
+        )
     _vec("gravity", scene.gravity)
     if _finite("fps", scene.fps) <= 0:
         raise SceneError("must be > 0", key="fps", value=scene.fps)
@@ -326,7 +337,9 @@ def validate_scene(scene: Scene) -> None:
     for i, b in enumerate(scene.bodies):
         k = f"bodies[{i}]"
         if not isinstance(b.name, str) or not b.name or "." in b.name or b.name == "world":
-            raise SceneError("must be a non-empty name without '.', not 'world'", key=f"{k}.name", value=b.name)
+            raise SceneError(
+                "must be a non-empty name without '.', not 'world'", key=f"{k}.name", value=b.name
+            )
         if b.name in seen:
             raise SceneError("duplicate body name", key=f"{k}.name", value=b.name)
         seen.add(b.name)
@@ -334,7 +347,9 @@ def validate_scene(scene: Scene) -> None:
         x, y = _vec(f"{k}.position", b.position)
         hx, hy = b.shape.half_extents(_finite(f"{k}.angle", b.angle))
         eps = 1e-9
-        if not (xmin + hx - eps <= x <= xmax - hx + eps and ymin + hy - eps <= y <= ymax - hy + eps):
+        if not (
+            xmin + hx - eps <= x <= xmax - hx + eps and ymin + hy - eps <= y <= ymax - hy + eps
+        ):
             raise SceneError(
                 f"body (half size {hx:g} x {hy:g} m) must lie inside the world bounds {tuple(scene.bounds)}",
                 key=f"{k}.position",
@@ -367,9 +382,13 @@ def validate_scene(scene: Scene) -> None:
     for i, f in enumerate(scene.forces):
         k = f"forces[{i}]"
         if f.body not in seen:
-            raise SceneError(f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=f.body)
+            raise SceneError(
+                f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=f.body
+            )
         if f.kind not in ("force", "impulse"):
-            raise SceneError("unknown force kind; known: force, impulse", key=f"{k}.kind", value=f.kind)
+            raise SceneError(
+                "unknown force kind; known: force, impulse", key=f"{k}.kind", value=f.kind
+            )
         _vec(f"{k}.vector", f.vector)
         start, end = _finite(f"{k}.start", f.start), _finite(f"{k}.end", f.end)
         if start < 0:
@@ -399,22 +418,36 @@ def validate_scene(scene: Scene) -> None:
     for i, u in enumerate(scene.unknowns):
         k = f"unknowns[{i}]"
         if u.body not in seen:
-            raise SceneError(f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=u.body)
+            raise SceneError(
+                f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=u.body
+            )
         if u.param not in BODY_PARAMS:
-            raise SceneError(f"unknown parameter; known: {', '.join(BODY_PARAMS)}", key=f"{k}.param", value=u.param)
+            raise SceneError(
+                f"unknown parameter; known: {', '.join(BODY_PARAMS)}",
+                key=f"{k}.param",
+                value=u.param,
+            )
         lo, hi = _finite(f"{k}.range[0]", u.low), _finite(f"{k}.range[1]", u.high)
         if not lo < hi:
-            raise SceneError("range must be [low, high] with low < high", key=f"{k}.range", value=[u.low, u.high])
+            raise SceneError(
+                "range must be [low, high] with low < high", key=f"{k}.range", value=[u.low, u.high]
+            )
         _check_param(f"{k}.range[0]", u.param, lo)
         _check_param(f"{k}.range[1]", u.param, hi)
         if u.key in keys:
             raise SceneError("parameter declared unknown twice", key=f"{k}.param", value=u.param)
         keys.add(u.key)
         if u.body == scene.test_body:
-            raise SceneError("the test body's parameters are fixed by definition", key=f"{k}.body", value=u.body)
+            raise SceneError(
+                "the test body's parameters are fixed by definition", key=f"{k}.body", value=u.body
+            )
 
     if scene.test_body is not None and scene.test_body not in seen:
-        raise SceneError(f"no such body; bodies: {', '.join(sorted(seen))}", key="test_body", value=scene.test_body)
+        raise SceneError(
+            f"no such body; bodies: {', '.join(sorted(seen))}",
+            key="test_body",
+            value=scene.test_body,
+        )
 
 
 def _check_shape(key: str, shape: object) -> None:
@@ -436,4 +469,6 @@ def _check_points(key: str, points: object) -> None:
         raise SceneError("a polygon needs at least 3 points", key=key, value=points)
     pts = tuple(_vec(f"{key}[{i}]", p) for i, p in enumerate(points))
     if not _is_convex_ccw(pts):
-        raise SceneError("polygon must be convex with counter-clockwise points", key=key, value=points)
+        raise SceneError(
+            "polygon must be convex with counter-clockwise points", key=key, value=points
+        )

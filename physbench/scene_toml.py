@@ -75,7 +75,11 @@ _JOINT_KEYS = {"kind", "a", "b", "anchor"}
 _UNKNOWN_KEYS = {"body", "param", "range"}
 _SEGMENT_KEYS = {"kind", "a", "b", "radius", "elasticity", "friction"}
 _SPOLY_KEYS = {"kind", "points", "elasticity", "friction"}
-_SHAPE_KEYS = {"circle": {"kind", "radius"}, "box": {"kind", "width", "height"}, "polygon": {"kind", "points"}}
+_SHAPE_KEYS = {
+    "circle": {"kind", "radius"},
+    "box": {"kind", "width", "height"},
+    "polygon": {"kind", "points"},
+}
 
 
 # --------------------------------------------------------------------------- loading
@@ -97,7 +101,9 @@ def loads_scene(text: str, *, source: str = "<scene>") -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"line (\d+)", str(exc))
-        raise SceneError(f"not valid TOML: {exc}", source=source, line=int(m.group(1)) if m else None) from exc
+        raise SceneError(
+            f"not valid TOML: {exc}", source=source, line=int(m.group(1)) if m else None
+        ) from exc
     try:
         return scene_from_dict(data).validate()
     except SceneError as exc:
@@ -117,7 +123,11 @@ def _check_keys(key: str, table: object, allowed: set[str]) -> dict[str, Any]:
         raise SceneError("must be a table", key=key, value=table)
     for k in table:
         if k not in allowed:
-            raise SceneError(f"unknown key; allowed: {', '.join(sorted(allowed))}", key=f"{key}.{k}" if key else k, value=table[k])
+            raise SceneError(
+                f"unknown key; allowed: {', '.join(sorted(allowed))}",
+                key=f"{key}.{k}" if key else k,
+                value=table[k],
+            )
     return table
 
 
@@ -127,10 +137,14 @@ def _points(v: Any) -> Any:
 
 def _shape(key: str, raw: object) -> Shape:
     if not isinstance(raw, dict):
-        raise SceneError("must be a table like { kind = \"circle\", radius = 0.3 }", key=key, value=raw)
+        raise SceneError(
+            'must be a table like { kind = "circle", radius = 0.3 }', key=key, value=raw
+        )
     kind = raw.get("kind")
     if kind not in _SHAPE_KEYS:
-        raise SceneError(f"unknown shape; known: {', '.join(SHAPE_KINDS)}", key=f"{key}.kind", value=kind)
+        raise SceneError(
+            f"unknown shape; known: {', '.join(SHAPE_KINDS)}", key=f"{key}.kind", value=kind
+        )
     _check_keys(key, raw, _SHAPE_KEYS[kind])
     try:
         if kind == "circle":
@@ -172,12 +186,27 @@ def scene_from_dict(data: dict[str, Any]) -> Scene:
         kind = raw.get("kind", "segment")
         if kind == "segment":
             _check_keys(k, raw, _SEGMENT_KEYS)
-            statics.append(Segment(**{n: _vec_or_raw(v) for n, v in raw.items()} | {"a": _vec_or_raw(_require(k, raw, "a")), "b": _vec_or_raw(_require(k, raw, "b"))}))
+            statics.append(
+                Segment(
+                    **{n: _vec_or_raw(v) for n, v in raw.items()}
+                    | {
+                        "a": _vec_or_raw(_require(k, raw, "a")),
+                        "b": _vec_or_raw(_require(k, raw, "b")),
+                    }
+                )
+            )
         elif kind == "polygon":
             _check_keys(k, raw, _SPOLY_KEYS)
-            statics.append(StaticPolygon(**{n: v for n, v in raw.items()} | {"points": _points(_require(k, raw, "points"))}))
+            statics.append(
+                StaticPolygon(
+                    **{n: v for n, v in raw.items()}
+                    | {"points": _points(_require(k, raw, "points"))}
+                )
+            )
         else:
-            raise SceneError("unknown static kind; known: segment, polygon", key=f"{k}.kind", value=kind)
+            raise SceneError(
+                "unknown static kind; known: segment, polygon", key=f"{k}.kind", value=kind
+            )
     forces = []
     for i, raw in enumerate(_list_of_tables(data, "forces")):
         k = f"forces[{i}]"
@@ -202,8 +231,28 @@ def scene_from_dict(data: dict[str, Any]) -> Scene:
         rng = _require(k, raw, "range")
         if not isinstance(rng, list) or len(rng) != 2:
             raise SceneError("must be [low, high]", key=f"{k}.range", value=rng)
-        unknowns.append(Unknown(body=_require(k, raw, "body"), param=_require(k, raw, "param"), low=rng[0], high=rng[1]))
-    top = {n: _vec_or_raw(data[n]) for n in ("name", "description", "bounds", "gravity", "fps", "frames", "substeps", "test_body") if n in data}
+        unknowns.append(
+            Unknown(
+                body=_require(k, raw, "body"),
+                param=_require(k, raw, "param"),
+                low=rng[0],
+                high=rng[1],
+            )
+        )
+    top = {
+        n: _vec_or_raw(data[n])
+        for n in (
+            "name",
+            "description",
+            "bounds",
+            "gravity",
+            "fps",
+            "frames",
+            "substeps",
+            "test_body",
+        )
+        if n in data
+    }
     if "name" not in top:
         raise SceneError("missing required key 'name'", key="name", value=None)
     meta = data.get("meta", {})
@@ -307,17 +356,43 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     d["bodies"] = bodies
     if scene.statics:
         d["statics"] = [
-            {"kind": "segment", "a": _clean(s.a), "b": _clean(s.b), "radius": s.radius, "elasticity": s.elasticity, "friction": s.friction}
+            {
+                "kind": "segment",
+                "a": _clean(s.a),
+                "b": _clean(s.b),
+                "radius": s.radius,
+                "elasticity": s.elasticity,
+                "friction": s.friction,
+            }
             if isinstance(s, Segment)
-            else {"kind": "polygon", "points": _clean(s.points), "elasticity": s.elasticity, "friction": s.friction}
+            else {
+                "kind": "polygon",
+                "points": _clean(s.points),
+                "elasticity": s.elasticity,
+                "friction": s.friction,
+            }
             for s in scene.statics
         ]
     if scene.forces:
-        d["forces"] = [{"body": f.body, "kind": f.kind, "vector": _clean(f.vector), "start": f.start, "end": f.end} for f in scene.forces]
+        d["forces"] = [
+            {
+                "body": f.body,
+                "kind": f.kind,
+                "vector": _clean(f.vector),
+                "start": f.start,
+                "end": f.end,
+            }
+            for f in scene.forces
+        ]
     if scene.joints:
-        d["joints"] = [{"kind": j.kind, "a": j.a, "b": j.b or "world", "anchor": _clean(j.anchor)} for j in scene.joints]
+        d["joints"] = [
+            {"kind": j.kind, "a": j.a, "b": j.b or "world", "anchor": _clean(j.anchor)}
+            for j in scene.joints
+        ]
     if scene.unknowns:
-        d["unknowns"] = [{"body": u.body, "param": u.param, "range": [u.low, u.high]} for u in scene.unknowns]
+        d["unknowns"] = [
+            {"body": u.body, "param": u.param, "range": [u.low, u.high]} for u in scene.unknowns
+        ]
     return d
 
 

@@ -71,7 +71,9 @@ def toy_scene(frames: int = 12) -> Scene:
         Body("b", Circle(0.3), (2.4, 1.0)),
     )
     unknowns = tuple(
-        Unknown(n, p, lo, hi) for n in ("a", "b") for p, lo, hi in (("mass", 1.0, 10.0), ("elasticity", 0.1, 1.0))
+        Unknown(n, p, lo, hi)
+        for n in ("a", "b")
+        for p, lo, hi in (("mass", 1.0, 10.0), ("elasticity", 0.1, 1.0))
     )
     return Scene("toy", bodies, frames=frames, unknowns=unknowns, test_body="test")
 
@@ -83,7 +85,11 @@ class ToySimulator:
     name: ClassVar[str] = "toy"
 
     def simulate(
-        self, scene: Scene, params: Mapping[str, float] | None = None, *, effects: Sequence[Effect] = ()
+        self,
+        scene: Scene,
+        params: Mapping[str, float] | None = None,
+        *,
+        effects: Sequence[Effect] = (),
     ) -> Trajectory:
         scene = scene.with_params(params or {})
         t = np.arange(scene.frames) / scene.fps
@@ -109,7 +115,12 @@ class ToyRenderer:
         return (scene.frames, 2, self.size, self.size)
 
     def render(
-        self, scene: Scene, traj: Trajectory, *, focus: str | None = None, out: np.ndarray | None = None
+        self,
+        scene: Scene,
+        traj: Trajectory,
+        *,
+        focus: str | None = None,
+        out: np.ndarray | None = None,
     ) -> np.ndarray:
         xmin, ymin, xmax, ymax = scene.bounds
         c = (np.arange(self.size) + 0.5) / self.size
@@ -117,7 +128,13 @@ class ToyRenderer:
         frames = np.zeros((traj.frames, 2, self.size, self.size), np.float32)
         for i, name in enumerate(traj.bodies):
             x, y = traj.states[:, i, 0], traj.states[:, i, 1]
-            blob = np.exp(-((gy[None, :, None] - y[:, None, None]) ** 2 + (gx[None, None, :] - x[:, None, None]) ** 2) / 0.18)
+            blob = np.exp(
+                -(
+                    (gy[None, :, None] - y[:, None, None]) ** 2
+                    + (gx[None, None, :] - x[:, None, None]) ** 2
+                )
+                / 0.18
+            )
             ch = 1 if name == focus else 0
             np.maximum(frames[:, ch], blob.astype(np.float32), out=frames[:, ch])
         if out is not None:
@@ -135,7 +152,9 @@ class ToyTask:
     observation: Observation
 
 
-def toy_task(params: Sequence[str] = ("mass",), bodies: Sequence[str] | None = None, *, seed: int = 0) -> ToyTask:
+def toy_task(
+    params: Sequence[str] = ("mass",), bodies: Sequence[str] | None = None, *, seed: int = 0
+) -> ToyTask:
     """The toy problem for ``seed``: truth from :func:`~physbench.loop.draw_problem`, observation
     simulated and rendered, with marked frames for every unknown body."""
     scene = toy_scene()
@@ -147,12 +166,26 @@ def toy_task(params: Sequence[str] = ("mass",), bodies: Sequence[str] | None = N
 
 
 def run_toy(
-    cls: type, options: Mapping[str, Any], *, seed: int = 0, iterations: int = 8,
-    params: Sequence[str] = ("mass",), bodies: Sequence[str] | None = None,
+    cls: type,
+    options: Mapping[str, Any],
+    *,
+    seed: int = 0,
+    iterations: int = 8,
+    params: Sequence[str] = ("mass",),
+    bodies: Sequence[str] | None = None,
 ) -> History:
     """One small :func:`~physbench.loop.refine` of ``cls(**options)`` on :func:`toy_task`."""
     t = toy_task(params, bodies, seed=seed)
-    return refine(t.observation, t.scene, t.space, t.simulator, t.renderer, cls(**options), iterations=iterations, seed=seed)
+    return refine(
+        t.observation,
+        t.scene,
+        t.space,
+        t.simulator,
+        t.renderer,
+        cls(**options),
+        iterations=iterations,
+        seed=seed,
+    )
 
 
 # --------------------------------------------------------------------------- checks
@@ -167,19 +200,27 @@ def check_protocol(cls: type, **options: Any) -> None:
     builds an object with ``start(task, *, seed)`` and ``propose(step)``."""
     name = getattr(cls, "name", None)
     if not isinstance(name, str) or not name.strip():
-        raise ConformanceError(f"{_label(cls)}: class attribute 'name' must be a non-empty string, got {name!r}")
+        raise ConformanceError(
+            f"{_label(cls)}: class attribute 'name' must be a non-empty string, got {name!r}"
+        )
     per_object = getattr(cls, "per_object", None)
     if not isinstance(per_object, bool):
-        raise ConformanceError(f"{_label(cls)}: class attribute 'per_object' must be True or False, got {per_object!r}")
+        raise ConformanceError(
+            f"{_label(cls)}: class attribute 'per_object' must be True or False, got {per_object!r}"
+        )
     try:
         est = cls(**options)
     except Exception as exc:
-        raise ConformanceError(f"{_label(cls)}: {cls.__name__}(**{options!r}) raised {type(exc).__name__}: {exc}") from exc
+        raise ConformanceError(
+            f"{_label(cls)}: {cls.__name__}(**{options!r}) raised {type(exc).__name__}: {exc}"
+        ) from exc
     for meth in ("start", "propose"):
         if not callable(getattr(est, meth, None)):
             raise ConformanceError(f"{_label(cls)}: instances need a method {meth}()")
     if not isinstance(est, CorrectionEstimator):
-        raise ConformanceError(f"{_label(cls)}: instances do not satisfy physbench.protocols.CorrectionEstimator")
+        raise ConformanceError(
+            f"{_label(cls)}: instances do not satisfy physbench.protocols.CorrectionEstimator"
+        )
 
 
 def check_respects_ranges(cls: type, **options: Any) -> None:
@@ -211,7 +252,9 @@ def check_deterministic(cls: type, **options: Any) -> None:
     a = _trace(run_toy(cls, options, seed=3, params=("mass", "elasticity")))
     b = _trace(run_toy(cls, options, seed=3, params=("mass", "elasticity")))
     if a != b:
-        raise ConformanceError(f"{_label(cls)}: two runs with seed 3 differ at {_first_difference(a, b)}")
+        raise ConformanceError(
+            f"{_label(cls)}: two runs with seed 3 differ at {_first_difference(a, b)}"
+        )
 
 
 def _import_path(cls: type) -> str:
@@ -226,18 +269,34 @@ def _import_path(cls: type) -> str:
 def check_deterministic_in_subprocess(cls: type, **options: Any) -> None:
     """The same seed in a fresh Python process (another hash seed) gives the identical history.
     Options must be JSON values; the class must be importable at module level."""
-    spec = {"cls": _import_path(cls), "options": options, "seed": 5, "params": ["mass", "elasticity"]}
+    spec = {
+        "cls": _import_path(cls),
+        "options": options,
+        "seed": 5,
+        "params": ["mass", "elasticity"],
+    }
     try:
         arg = json.dumps(spec)
     except TypeError as exc:
-        raise ConformanceError(f"{_label(cls)}: options {options!r} must be JSON values for this check ({exc})") from exc
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p), "PYTHONHASHSEED": "12345"}
+        raise ConformanceError(
+            f"{_label(cls)}: options {options!r} must be JSON values for this check ({exc})"
+        ) from exc
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(p for p in sys.path if p),
+        "PYTHONHASHSEED": "12345",
+    }
     proc = subprocess.run(
         [sys.executable, "-c", "from physbench.testing import _child; _child()", arg],
-        capture_output=True, text=True, env=env, timeout=300,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
     )
     if proc.returncode != 0:
-        raise ConformanceError(f"{_label(cls)}: the run in another process failed:\n{proc.stderr.strip()[-2000:]}")
+        raise ConformanceError(
+            f"{_label(cls)}: the run in another process failed:\n{proc.stderr.strip()[-2000:]}"
+        )
     theirs = json.loads(proc.stdout)
     ours = _trace(run_toy(cls, options, seed=5, params=("mass", "elasticity")))
     if ours != theirs:
@@ -253,23 +312,33 @@ def _child() -> None:
     obj: Any = importlib.import_module(mod)
     for part in qual.split("."):
         obj = getattr(obj, part)
-    print(json.dumps(_trace(run_toy(obj, spec["options"], seed=spec["seed"], params=tuple(spec["params"])))))
+    print(
+        json.dumps(
+            _trace(run_toy(obj, spec["options"], seed=spec["seed"], params=tuple(spec["params"])))
+        )
+    )
 
 
 def _names(exc: BaseException, key: str) -> bool:
     return key in str(exc)
 
 
-def check_bad_input(cls: type, bad_options: Sequence[Mapping[str, Any]] = (), **options: Any) -> None:
+def check_bad_input(
+    cls: type, bad_options: Sequence[Mapping[str, Any]] = (), **options: Any
+) -> None:
     """Clear errors: an unknown option, ``propose`` before ``start``, and each of ``bad_options``
     raise an exception (not a crash deep inside) whose message names the problem."""
     try:
         cls(**options, no_such_option_xyz=1)
     except Exception as exc:
         if not _names(exc, "no_such_option_xyz"):
-            raise ConformanceError(f"{_label(cls)}: an unknown option raised {type(exc).__name__}: {exc!s} without naming it") from exc
+            raise ConformanceError(
+                f"{_label(cls)}: an unknown option raised {type(exc).__name__}: {exc!s} without naming it"
+            ) from exc
     else:
-        raise ConformanceError(f"{_label(cls)}: an unknown option 'no_such_option_xyz' was accepted silently")
+        raise ConformanceError(
+            f"{_label(cls)}: an unknown option 'no_such_option_xyz' was accepted silently"
+        )
 
     t = toy_task()
     est = cls(**options)
@@ -278,7 +347,9 @@ def check_bad_input(cls: type, bad_options: Sequence[Mapping[str, Any]] = (), **
         est.propose(step)
     except (PhysbenchError, RuntimeError) as exc:
         if "start" not in str(exc):
-            raise ConformanceError(f"{_label(cls)}: propose() before start() raised {exc!s}; say that start() must come first") from exc
+            raise ConformanceError(
+                f"{_label(cls)}: propose() before start() raised {exc!s}; say that start() must come first"
+            ) from exc
     except Exception as exc:
         raise ConformanceError(
             f"{_label(cls)}: propose() before start() raised {type(exc).__name__}: {exc}; raise PhysbenchError "
@@ -290,16 +361,28 @@ def check_bad_input(cls: type, bad_options: Sequence[Mapping[str, Any]] = (), **
     for bad in bad_options:
         try:
             est = cls(**{**options, **bad})
-            est.start(Task(t.scene, t.space, t.observation.frames, draw_problem(t.space, 0)[1], t.renderer), seed=0)
+            est.start(
+                Task(
+                    t.scene, t.space, t.observation.frames, draw_problem(t.space, 0)[1], t.renderer
+                ),
+                seed=0,
+            )
         except (PhysbenchError, ValueError, TypeError) as exc:
             if not any(_names(exc, k) for k in bad):
-                raise ConformanceError(f"{_label(cls)}: bad options {dict(bad)} raised {exc!s} without naming the option") from exc
+                raise ConformanceError(
+                    f"{_label(cls)}: bad options {dict(bad)} raised {exc!s} without naming the option"
+                ) from exc
         else:
             raise ConformanceError(f"{_label(cls)}: bad options {dict(bad)} were accepted")
 
 
 def check_estimator(
-    cls: type, /, *, bad_options: Sequence[Mapping[str, Any]] = (), subprocess: bool = True, **options: Any
+    cls: type,
+    /,
+    *,
+    bad_options: Sequence[Mapping[str, Any]] = (),
+    subprocess: bool = True,
+    **options: Any,
 ) -> None:
     """All checks; raises one :class:`ConformanceError` listing every failure."""
     checks: list[tuple[str, Any]] = [
@@ -309,7 +392,12 @@ def check_estimator(
         ("bad input", lambda: check_bad_input(cls, bad_options, **options)),
     ]
     if subprocess:
-        checks.append(("deterministic in another process", lambda: check_deterministic_in_subprocess(cls, **options)))
+        checks.append(
+            (
+                "deterministic in another process",
+                lambda: check_deterministic_in_subprocess(cls, **options),
+            )
+        )
     failures = []
     for label, fn in checks:
         try:
@@ -321,7 +409,9 @@ def check_estimator(
         except Exception as exc:
             failures.append(f"- {label}: unexpected {type(exc).__name__}: {exc}")
     if failures:
-        raise ConformanceError(f"{_label(cls)} fails {len(failures)} conformance check(s):\n" + "\n".join(failures))
+        raise ConformanceError(
+            f"{_label(cls)} fails {len(failures)} conformance check(s):\n" + "\n".join(failures)
+        )
 
 
 class EstimatorConformance:
@@ -350,4 +440,3 @@ class EstimatorConformance:
 
     def test_bad_input(self) -> None:
         check_bad_input(self._cls(), self.bad_options, **self.options)
-

@@ -50,7 +50,9 @@ def _variant(baseline: Path, tmp_path: Path, change: str) -> Path:
     return new
 
 
-def test_unchanged_run_is_not_flagged(baseline: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_unchanged_run_is_not_flagged(
+    baseline: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     rerun = tmp_path / "rerun"
     run_sweep(parse_spec(SPEC), rerun, executor="serial", progress=False)  # a fresh run, not a copy
     assert main(["compare", str(rerun), str(baseline)]) == 0
@@ -58,19 +60,30 @@ def test_unchanged_run_is_not_flagged(baseline: Path, tmp_path: Path, capsys: py
     assert "compared 16 cells in 2 configurations: 2 identical" in out and "REGRESSION" not in out
 
 
-def test_injected_regression_is_flagged(baseline: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_injected_regression_is_flagged(
+    baseline: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     new = _variant(baseline, tmp_path, "regressed")
     assert main(["compare", str(new), str(baseline)]) == 1
     out = capsys.readouterr().out
-    assert "REGRESSION: random on three_circles [mass]" in out and "optuna" not in out.split("REGRESSION")[1]
-    row = next(line for line in out.splitlines() if line.startswith("| three_circles | mass | random"))
-    assert "| 3.000 |" in row and "| 0.00391 | 0.00781 | worse |" in row  # gm ratio 3, p = 2^-8, Holm x2
+    assert (
+        "REGRESSION: random on three_circles [mass]" in out
+        and "optuna" not in out.split("REGRESSION")[1]
+    )
+    row = next(
+        line for line in out.splitlines() if line.startswith("| three_circles | mass | random")
+    )
+    assert (
+        "| 3.000 |" in row and "| 0.00391 | 0.00781 | worse |" in row
+    )  # gm ratio 3, p = 2^-8, Holm x2
     # the reverse direction is an improvement, which passes
     assert main(["compare", str(baseline), str(new)]) == 0
     assert "1 better, 1 identical" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize(("change", "verdict"), [("one_seed", "ok"), ("improved", "better"), ("failing", "worse")])
+@pytest.mark.parametrize(
+    ("change", "verdict"), [("one_seed", "ok"), ("improved", "better"), ("failing", "worse")]
+)
 def test_verdicts(baseline: Path, tmp_path: Path, change: str, verdict: str) -> None:
     new = pd.read_parquet(_variant(baseline, tmp_path, change) / "results.parquet")
     res = compare(new, pd.read_parquet(baseline / "results.parquet"))
@@ -78,7 +91,9 @@ def test_verdicts(baseline: Path, tmp_path: Path, change: str, verdict: str) -> 
     assert got == {"random": verdict, "optuna(sampler=random)": "identical"}
 
 
-def test_tolerance_and_errors(baseline: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_tolerance_and_errors(
+    baseline: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     base = pd.read_parquet(baseline / "results.parquet")
     new = base.copy()
     new.loc[new["estimator"] == "random", "best_nmse"] *= 1.1  # consistent but below --min-ratio

@@ -64,12 +64,25 @@ def _env() -> dict[str, str]:
 
 
 def _bench(spec: Path, out: Path) -> list[str]:
-    return [sys.executable, "-m", "physbench.cli", "bench", str(spec), "--out", str(out), "--executor", "serial", "-q"]
+    return [
+        sys.executable,
+        "-m",
+        "physbench.cli",
+        "bench",
+        str(spec),
+        "--out",
+        str(out),
+        "--executor",
+        "serial",
+        "-q",
+    ]
 
 
 def _kill_after(spec: Path, out: Path, files: int) -> int:
     """Start a sweep, SIGKILL it once ``files`` cell files exist; returns how many exist then."""
-    proc = subprocess.Popen(_bench(spec, out), env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        _bench(spec, out), env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
+    )
     cells = out / "cells"
     deadline = time.monotonic() + 120
     try:
@@ -81,7 +94,9 @@ def _kill_after(spec: Path, out: Path, files: int) -> int:
         if proc.poll() is None:
             os.kill(proc.pid, signal.SIGKILL)
         _, err = proc.communicate()
-    assert proc.returncode == -signal.SIGKILL, f"the sweep ended before it was killed: {err.decode()[-2000:]}"
+    assert proc.returncode == -signal.SIGKILL, (
+        f"the sweep ended before it was killed: {err.decode()[-2000:]}"
+    )
     return len(list(cells.glob("*.json")))
 
 
@@ -92,7 +107,9 @@ def test_killed_sweep_resumes_to_the_uninterrupted_table(tmp_path: Path) -> None
     out = tmp_path / "killed"
     first = _kill_after(spec, out, 1)
     assert 1 <= first < CELLS and not (out / "results.parquet").exists()
-    second = _kill_after(spec, out, first + 3)  # the resumed run skips the saved cells, then dies again
+    second = _kill_after(
+        spec, out, first + 3
+    )  # the resumed run skips the saved cells, then dies again
     assert first < second < CELLS
     done = subprocess.run(_bench(spec, out), env=_env(), capture_output=True, text=True)
     assert done.returncode == 0, done.stderr

@@ -63,16 +63,26 @@ def flaky_registry() -> Iterator[None]:
 
 
 def test_long_table_summary_and_failed_cells(tmp_path: Path, flaky_registry: None) -> None:
-    spec = parse_spec({**TINY, "estimators": ["random", {"name": "flaky", "label": "bad", "options": {"fail": True}}]})
+    spec = parse_spec(
+        {
+            **TINY,
+            "estimators": ["random", {"name": "flaky", "label": "bad", "options": {"fail": True}}],
+        }
+    )
     res = run_sweep(spec, tmp_path, executor="serial", progress=False)
     df = pd.read_parquet(tmp_path / "results.parquet")
     assert list(df.columns) == list(SCHEMA) and res.failed == 4 and res.ran == 8
     ok, bad = df[df["status"] == "ok"], df[df["status"] == "failed"]
     assert len(ok) == 4 * 3 and len(bad) == 4  # one row per iteration; one row per failed cell
-    assert bad["iteration"].isna().all() and (bad["error"] == "PhysbenchError: flaky: asked to fail").all()
+    assert (
+        bad["iteration"].isna().all()
+        and (bad["error"] == "PhysbenchError: flaky: asked to fail").all()
+    )
     assert ok["iteration"].tolist() == [0, 1, 2] * 4
     first = ok.iloc[0]
-    assert json.loads(first["keys"]) == ["a.mass", "b.mass"] and set(json.loads(first["params"])) == {"a.mass", "b.mass"}
+    assert json.loads(first["keys"]) == ["a.mass", "b.mass"] and set(
+        json.loads(first["params"])
+    ) == {"a.mass", "b.mass"}
     assert json.loads(ok.iloc[6]["keys"]) == ["a.mass", "a.elasticity", "b.mass", "b.elasticity"]
     assert (ok["best_nmse"] <= ok.groupby("cell")["nmse"].transform("max")).all()
     assert json.loads(first["versions"])["physbench"] and first["t_cell"] > 0
@@ -80,16 +90,29 @@ def test_long_table_summary_and_failed_cells(tmp_path: Path, flaky_registry: Non
     st = pd.read_csv(tmp_path / "stats.csv")
     row = st[(st["estimator"] == "random") & (st["unknowns"] == "mass")].iloc[0]
     finals = ok[(ok["unknowns"] == "mass") & (ok["iteration"] == 2)]["best_nmse"]
-    assert row["n"] == 2 and row["mean"] == pytest.approx(finals.mean()) and row["median"] == pytest.approx(finals.median())
+    assert (
+        row["n"] == 2
+        and row["mean"] == pytest.approx(finals.mean())
+        and row["median"] == pytest.approx(finals.median())
+    )
     assert row["ci_low"] <= row["mean"] <= row["ci_high"] and row["paper_nn"] == "(2.6 ± 0.9)e-03"
     assert st[st["estimator"] == "bad"]["failed"].tolist() == [2, 2]
     md = (tmp_path / "summary.md").read_text()
-    assert "| 3 circles | paper NN | (2.6 ± 0.9)e-03 | (1.4 ± 0.5)e-02 |" in md and "failed (2)" in md
+    assert (
+        "| 3 circles | paper NN | (2.6 ± 0.9)e-03 | (1.4 ± 0.5)e-02 |" in md and "failed (2)" in md
+    )
     assert "flaky: asked to fail" in md
     assert r"$(2.6 \pm 0.9) \times 10^{-3}$" in (tmp_path / "summary.tex").read_text()
-    assert pd.read_csv(tmp_path / "summary.csv").columns.tolist() == ["scene", "estimator", "Mass", "Mass + Elasticity"]
+    assert pd.read_csv(tmp_path / "summary.csv").columns.tolist() == [
+        "scene",
+        "estimator",
+        "Mass",
+        "Mass + Elasticity",
+    ]
 
-    again = run_sweep(spec, tmp_path, executor="serial", progress=False)  # everything is done: nothing runs
+    again = run_sweep(
+        spec, tmp_path, executor="serial", progress=False
+    )  # everything is done: nothing runs
     assert (again.ran, again.skipped) == (0, 8)
     pd.testing.assert_frame_equal(again.table, df)
     retried = run_sweep(spec, tmp_path, executor="serial", progress=False, retry_failed=True)
@@ -124,7 +147,9 @@ def test_executors_give_identical_tables(tmp_path: Path) -> None:
         pd.testing.assert_frame_equal(without_timings(on_disk), base, check_exact=True)
 
 
-def test_cli_prints_table_and_final_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_prints_table_and_final_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     spec = tmp_path / "s.toml"
     spec.write_text(
         'name = "cli"\nestimators = ["random"]\nseeds = 2\niterations = 2\nresolution = 16\n'
@@ -135,5 +160,19 @@ def test_cli_prints_table_and_final_line(tmp_path: Path, capsys: pytest.CaptureF
     assert "| second order | paper NN | (4 ± 2)e-03 |" in out
     assert out.splitlines()[-1].startswith("cli: 2 cells (2 run, 0 already done, 0 failed) in ")
     assert (tmp_path / "o" / "spec.toml").read_text() == spec.read_text()
-    assert main(["bench", str(spec), "--out", str(tmp_path / "o"), "--executor", "serial", "-q", "--fresh"]) == 0
+    assert (
+        main(
+            [
+                "bench",
+                str(spec),
+                "--out",
+                str(tmp_path / "o"),
+                "--executor",
+                "serial",
+                "-q",
+                "--fresh",
+            ]
+        )
+        == 0
+    )
     assert "(2 run, 0 already done" in capsys.readouterr().out

@@ -13,7 +13,10 @@ from physbench.cli import main
 
 GOOD = {
     "name": "t",
-    "estimators": ["random", {"name": "optuna", "label": "optuna-rs", "options": {"sampler": "random"}}],
+    "estimators": [
+        "random",
+        {"name": "optuna", "label": "optuna-rs", "options": {"sampler": "random"}},
+    ],
     "seeds": 3,
     "iterations": [2, 3],
     "resolution": 32,
@@ -28,10 +31,18 @@ def test_product_order_and_seeds() -> None:
     assert len(cells) == 3 * 2 * 2 * 3
     assert [c.index for c in cells] == list(range(len(cells)))
     first = cells[0].case
-    assert (first.scene, first.params, first.iterations, first.estimator, first.seed) == ("three_circles", ("mass",), 2, "random", 0)
+    assert (first.scene, first.params, first.iterations, first.estimator, first.seed) == (
+        "three_circles",
+        ("mass",),
+        2,
+        "random",
+        0,
+    )
     assert [c.case.seed for c in cells[:3]] == [0, 1, 2]  # the run seed is the seed value
     assert cells[3].label == "optuna-rs" and cells[3].case.options == {"sampler": "random"}
-    assert cells[-1].case.params == ("mass",) and cells[-1].scene == "second_order"  # the default unknowns
+    assert (
+        cells[-1].case.params == ("mass",) and cells[-1].scene == "second_order"
+    )  # the default unknowns
     assert len({c.key for c in cells}) == len(cells)
     assert parse_spec(GOOD).cells()[5].key == cells[5].key  # keys are stable
 
@@ -49,15 +60,27 @@ def test_seed_forms(seeds: object, expected: tuple[int, ...]) -> None:
     [
         ({"temperature": 3}, "unknown axis or key 'temperature'; known: name, description, scenes"),
         ({"estimators": ["random", "nope"]}, "unknown estimator 'nope'; known estimators: "),
-        ({"estimators": [{"name": "optuna", "options": {"temperature": 1}}]}, "estimator 'optuna' does not take options"),
+        (
+            {"estimators": [{"name": "optuna", "options": {"temperature": 1}}]},
+            "estimator 'optuna' does not take options",
+        ),
         ({"scenes": ["no_such_scene"]}, "unknown scene 'no_such_scene'"),
-        ({"scenes": [{"name": "three_circles", "unknowns": ["friction"]}]}, "unknown parameter 'friction' of scene 'three_circles'"),
-        ({"scenes": [{"name": "three_circles", "colour": "red"}]}, "scenes[0]: unknown key 'colour'; known keys: name, unknowns, bodies"),
+        (
+            {"scenes": [{"name": "three_circles", "unknowns": ["friction"]}]},
+            "unknown parameter 'friction' of scene 'three_circles'",
+        ),
+        (
+            {"scenes": [{"name": "three_circles", "colour": "red"}]},
+            "scenes[0]: unknown key 'colour'; known keys: name, unknowns, bodies",
+        ),
         ({"engine": ["pymunk", "bullet"]}, "unknown simulator 'bullet'"),
         ({"seeds": []}, "empty product: the axis 'seeds' has no values"),
         ({"estimators": []}, "empty product: the axis 'estimators' has no values"),
         ({"blur": []}, "empty product: the axis 'blur' has no values"),
-        ({"scenes": [{"name": "three_circles", "unknowns": []}]}, "empty product: the scene lists no unknown-parameter set"),
+        (
+            {"scenes": [{"name": "three_circles", "unknowns": []}]},
+            "empty product: the scene lists no unknown-parameter set",
+        ),
         ({"seeds": -1}, "seeds = -1: expected a count"),
         ({"iterations": 0}, "iterations = 0: expected a whole number >= 1"),
         ({"blur": -1.0}, "blur = -1.0: expected a finite number >= 0"),
@@ -71,20 +94,29 @@ def test_bad_specs(change: dict[str, object], message: str) -> None:
 
 
 def test_missing_axis_and_duplicate_cells() -> None:
-    with pytest.raises(SpecError, match="seeds: missing; a spec needs scenes, estimators and seeds"):
+    with pytest.raises(
+        SpecError, match="seeds: missing; a spec needs scenes, estimators and seeds"
+    ):
         parse_spec({k: v for k, v in GOOD.items() if k != "seeds"})
-    with pytest.raises(SpecError, match=r"cells 0 and 12 are the same run \(scene 'three_circles', unknowns mass"):
+    with pytest.raises(
+        SpecError, match=r"cells 0 and 12 are the same run \(scene 'three_circles', unknowns mass"
+    ):
         parse_spec({**GOOD, "scenes": ["three_circles", "three_circles"]})
 
 
 def test_cli_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = tmp_path / "s.toml"
-    spec.write_text('name = "s"\nestimators = ["random"]\nseeds = 1\niterations = 1\nresolution = 16\nscenes = ["three_circles"]\n')
+    spec.write_text(
+        'name = "s"\nestimators = ["random"]\nseeds = 1\niterations = 1\nresolution = 16\nscenes = ["three_circles"]\n'
+    )
     blocker = tmp_path / "file.txt"
     blocker.write_text("")
     cases = [
         ([str(tmp_path / "missing.toml")], "spec file"),
-        ([str(spec), "--executor", "serial", "--out", str(blocker / "sub")], "cannot write results there"),
+        (
+            [str(spec), "--executor", "serial", "--out", str(blocker / "sub")],
+            "cannot write results there",
+        ),
         ([str(spec), "--executor", "serial", "--address", "tcp://x:1"], "needs --executor dask"),
         ([str(spec), "--workers", "0"], "--workers 0: expected a whole number >= 1"),
     ]
@@ -106,9 +138,14 @@ def test_shipped_specs_load() -> None:
     assert t1.seeds == tuple(range(50)) and t1.axes["iterations"] == (11,)
     assert {e.name for e in t1.estimators} >= {"tpe", "cmaes", "optuna", "random", "resnet3d"}
     assert {(s.name, u) for s in t1.scenes for u in s.unknowns} == {
-        ("three_circles", ("mass",)), ("three_circles", ("elasticity",)), ("three_circles", ("mass", "elasticity")),
-        ("second_order", ("mass",)), ("second_order", ("elasticity",)),
-        ("stacked_boxes", ("mass",)), ("stacked_boxes", ("friction",)), ("bouncing_balls", ("mass",)),
+        ("three_circles", ("mass",)),
+        ("three_circles", ("elasticity",)),
+        ("three_circles", ("mass", "elasticity")),
+        ("second_order", ("mass",)),
+        ("second_order", ("elasticity",)),
+        ("stacked_boxes", ("mass",)),
+        ("stacked_boxes", ("friction",)),
+        ("bouncing_balls", ("mass",)),
     }
     assert len(load_spec(root / "smoke.toml").seeds) >= 5  # the compare test needs >= 5 seeds
     gap = load_spec(root / "reality_gap.toml")

@@ -14,7 +14,12 @@ from physbench.cli import main
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "physbench.cli", *args], capture_output=True, text=True, env=os.environ)
+    return subprocess.run(
+        [sys.executable, "-m", "physbench.cli", *args],
+        capture_output=True,
+        text=True,
+        env=os.environ,
+    )
 
 
 def test_help_is_fast_and_imports_nothing_heavy() -> None:
@@ -26,10 +31,16 @@ def test_help_is_fast_and_imports_nothing_heavy() -> None:
         "print(time.perf_counter() - t, heavy)"
     )
     best = min(
-        float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()[0])
+        float(
+            subprocess.run(
+                [sys.executable, "-c", code], capture_output=True, text=True, check=True
+            ).stdout.split()[0]
+        )
         for _ in range(3)
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
     assert out.strip().endswith("[]"), out
     assert best < 0.5
     t = time.perf_counter()
@@ -40,7 +51,11 @@ def test_help_is_fast_and_imports_nothing_heavy() -> None:
 def test_unknown_scene_lists_known_ones(capsys) -> None:
     assert main(["simulate", "--scene", "no_such_scene"]) == 2
     err = capsys.readouterr().err
-    assert "unknown scene 'no_such_scene'" in err and "three_circles" in err and "bouncing_balls" in err
+    assert (
+        "unknown scene 'no_such_scene'" in err
+        and "three_circles" in err
+        and "bouncing_balls" in err
+    )
 
 
 def test_unknown_engine_lists_known_ones(capsys) -> None:
@@ -60,7 +75,14 @@ def test_bad_override_is_explained(capsys) -> None:
 def test_scenes_lists_unknowns(capsys) -> None:
     assert main(["scenes"]) == 0
     out = capsys.readouterr().out
-    for name in ("three_circles", "second_order", "stacked_boxes", "bouncing_balls", "pendulum", "ball_drop"):
+    for name in (
+        "three_circles",
+        "second_order",
+        "stacked_boxes",
+        "bouncing_balls",
+        "pendulum",
+        "ball_drop",
+    ):
         assert name in out
     assert "unknown mass:" in out
 
@@ -68,11 +90,32 @@ def test_scenes_lists_unknowns(capsys) -> None:
 def test_simulate_writes_npz_and_previews(tmp_path: Path, capsys) -> None:
     out, gif, png = tmp_path / "run.npz", tmp_path / "p.gif", tmp_path / "p.png"
     for engine in ("pymunk", "box2d"):
-        assert main(["simulate", "--scene", "three_circles", "--engine", engine, "--seed", "2",
-                     "--out", str(out), "--preview", str(gif), "--resolution", "32"]) == 0
+        assert (
+            main(
+                [
+                    "simulate",
+                    "--scene",
+                    "three_circles",
+                    "--engine",
+                    engine,
+                    "--seed",
+                    "2",
+                    "--out",
+                    str(out),
+                    "--preview",
+                    str(gif),
+                    "--resolution",
+                    "32",
+                ]
+            )
+            == 0
+        )
         data = np.load(out)
         assert data["states"].shape[1:] == (3, 6)
-        assert data["frames"].shape[0] == data["states"].shape[0] and data["frames"].shape[2:] == (32, 32)
+        assert data["frames"].shape[0] == data["states"].shape[0] and data["frames"].shape[2:] == (
+            32,
+            32,
+        )
         assert str(data["engine"]) == engine
     assert gif.stat().st_size > 0
     assert main(["simulate", "--scene", "three_circles", "--preview", str(png)]) == 0

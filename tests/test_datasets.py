@@ -38,7 +38,10 @@ def check_case(case: Case) -> None:
 def early(rec: Recording, body: str, until: float) -> Recording:
     tr = rec.track(body)
     m = tr.t <= until
-    return Recording({body: Track(tr.t[m], tr.x[m], tr.y[m], None if tr.angle is None else tr.angle[m])}, fields=rec.fields)
+    return Recording(
+        {body: Track(tr.t[m], tr.x[m], tr.y[m], None if tr.angle is None else tr.angle[m])},
+        fields=rec.fields,
+    )
 
 
 def test_registry_and_data_folder_errors(tmp_path):
@@ -82,7 +85,12 @@ def test_ball_drops_show_drag_that_grows_for_light_balls(drops):
 
     for name in ("golf_ball/1", "baseball/1", "bowling_ball/2"):
         assert 9.0 < apparent_g(drops[name]) < 9.8
-    for name in ("whiffle_ball_1/1", "whiffle_ball_2/2", "yellow_whiffle_ball/1", "orange_whiffle_ball/2"):
+    for name in (
+        "whiffle_ball_1/1",
+        "whiffle_ball_2/2",
+        "yellow_whiffle_ball/1",
+        "orange_whiffle_ball/2",
+    ):
         assert 2.9 < apparent_g(drops[name]) < 4.7
 
 
@@ -109,12 +117,23 @@ def test_billiards_shots_are_top_down_tables_with_a_cue_strike(shots):
     for case in shots:
         check_case(case)
         s = case.scene
-        assert s.gravity == (0.0, 0.0) and len(s.statics) == 4 and s.body_names == ("white", "yellow", "red")
+        assert (
+            s.gravity == (0.0, 0.0)
+            and len(s.statics) == 4
+            and s.body_names == ("white", "yellow", "red")
+        )
         for b in s.bodies:
             r = b.shape.radius
-            assert r - 1e-9 <= b.position[0] <= TABLE[0] - r + 1e-9 and r - 1e-9 <= b.position[1] <= TABLE[1] - r + 1e-9
+            assert (
+                r - 1e-9 <= b.position[0] <= TABLE[0] - r + 1e-9
+                and r - 1e-9 <= b.position[1] <= TABLE[1] - r + 1e-9
+            )
         assert case.notes["cue"] in ("white", "yellow")
-        assert len(s.forces) == 1 and s.forces[0].kind == "impulse" and s.forces[0].body == case.notes["cue"]
+        assert (
+            len(s.forces) == 1
+            and s.forces[0].kind == "impulse"
+            and s.forces[0].body == case.notes["cue"]
+        )
         assert 0.5 < case.notes["strike"]["speed_mps"] < 8.0
         assert 1.0 < case.recording.t_end < 17.0
 
@@ -164,8 +183,15 @@ def test_kaheman_double_pendulum_windows_are_chained_arms():
         assert [(j.a, j.b) for j in s.joints] == [("arm1", None), ("arm2", "arm1")]
         traj = PymunkSimulator().simulate(replace(s, frames=2))
         # frame 0 reproduces the recorded first sample exactly: angles and implied positions
-        first = Recording({b: Track(tr.t[:1], tr.x[:1], tr.y[:1], tr.angle[:1]) for b, tr in case.recording.tracks.items()})
-        np.testing.assert_allclose(first.residuals(traj, fields=["x", "y", "angle"]), 0.0, atol=1e-9)
+        first = Recording(
+            {
+                b: Track(tr.t[:1], tr.x[:1], tr.y[:1], tr.angle[:1])
+                for b, tr in case.recording.tracks.items()
+            }
+        )
+        np.testing.assert_allclose(
+            first.residuals(traj, fields=["x", "y", "angle"]), 0.0, atol=1e-9
+        )
 
 
 def test_benard_rod_pendulum_starts_at_the_first_extreme():
@@ -183,7 +209,9 @@ def test_benard_rod_pendulum_starts_at_the_first_extreme():
     # from 136° and 157° the real rod loses a third of its amplitude in the first swing.
     case = cases[2]
     tr = case.recording.track("rod")
-    sim_periods = oscillation_periods(*_angle(PymunkSimulator().simulate(replace(case.scene, frames=301))))
+    sim_periods = oscillation_periods(
+        *_angle(PymunkSimulator().simulate(replace(case.scene, frames=301)))
+    )
     assert sim_periods[0] == pytest.approx(oscillation_periods(tr.t, tr.angle)[0], rel=0.08)
 
 

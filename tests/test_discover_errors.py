@@ -54,32 +54,105 @@ GOOD_SCENE = SCENE.replace("MASS", "1.0")
 CASES = [
     # id, files {name: text}, extra args, expected message (regex)
     ("missing recording", {}, ["nope.csv"], r"recording file .*nope\.csv' does not exist"),
-    ("unknown format", {"r.txt": recording()}, ["r.txt"], r"unknown format '\.txt'; expected \.csv"),
-    ("unknown body", {"r.csv": recording(body="ghost")}, ["r.csv"], r"line 2 .*column 'body'.*unknown body 'ghost'"),
-    ("missing column", {"r.csv": "t,body,x\n0,ball,1\n"}, ["r.csv"], r"missing required column.*'y'|column 'y'"),
+    (
+        "unknown format",
+        {"r.txt": recording()},
+        ["r.txt"],
+        r"unknown format '\.txt'; expected \.csv",
+    ),
+    (
+        "unknown body",
+        {"r.csv": recording(body="ghost")},
+        ["r.csv"],
+        r"line 2 .*column 'body'.*unknown body 'ghost'",
+    ),
+    (
+        "missing column",
+        {"r.csv": "t,body,x\n0,ball,1\n"},
+        ["r.csv"],
+        r"missing required column.*'y'|column 'y'",
+    ),
     ("negative time", {"r.csv": recording(t0=-0.1)}, ["r.csv"], r"t = -0\.1: times must be >= 0"),
-    ("bad scene value", {"r.csv": recording(), "s.toml": SCENE.replace("MASS", "-1.0")}, ["r.csv"],
-     r"s\.toml:\d+: bodies\[0\]\.mass = -1\.0: mass must be > 0"),
-    ("missing scene", {"r.csv": recording()}, ["r.csv", "--scene", "none.toml"], r"cannot read scene file"),
-    ("unknown effect", {"r.csv": recording()}, ["r.csv", "--effects", "nope"], r"unknown effect 'nope'.*linear_drag"),
-    ("effect that does not apply", {"r.csv": recording()}, ["r.csv", "--effects", "joint_viscous_damping"],
-     r"none of the requested effects applies.*joint_viscous_damping.*needs a scene with joints"),
-    ("holdout out of range", {"r.csv": recording()}, ["r.csv", "--holdout", "0.95"], r"holdout = 0\.95: expected a fraction in \[0\.05, 0\.8\]"),
-    ("recording too short", {"r.csv": recording(n=6)}, ["r.csv"], r"leaves \d samples to fit and \d to score"),
-    ("bad nuisance", {"r.csv": recording()}, ["r.csv", "--nuisance", "ball.z0"], r"nuisance 'ball\.z0'.*x0, y0, angle0"),
+    (
+        "bad scene value",
+        {"r.csv": recording(), "s.toml": SCENE.replace("MASS", "-1.0")},
+        ["r.csv"],
+        r"s\.toml:\d+: bodies\[0\]\.mass = -1\.0: mass must be > 0",
+    ),
+    (
+        "missing scene",
+        {"r.csv": recording()},
+        ["r.csv", "--scene", "none.toml"],
+        r"cannot read scene file",
+    ),
+    (
+        "unknown effect",
+        {"r.csv": recording()},
+        ["r.csv", "--effects", "nope"],
+        r"unknown effect 'nope'.*linear_drag",
+    ),
+    (
+        "effect that does not apply",
+        {"r.csv": recording()},
+        ["r.csv", "--effects", "joint_viscous_damping"],
+        r"none of the requested effects applies.*joint_viscous_damping.*needs a scene with joints",
+    ),
+    (
+        "holdout out of range",
+        {"r.csv": recording()},
+        ["r.csv", "--holdout", "0.95"],
+        r"holdout = 0\.95: expected a fraction in \[0\.05, 0\.8\]",
+    ),
+    (
+        "recording too short",
+        {"r.csv": recording(n=6)},
+        ["r.csv"],
+        r"leaves \d samples to fit and \d to score",
+    ),
+    (
+        "bad nuisance",
+        {"r.csv": recording()},
+        ["r.csv", "--nuisance", "ball.z0"],
+        r"nuisance 'ball\.z0'.*x0, y0, angle0",
+    ),
     ("no such run", {"r.csv": recording(run="a")}, ["r.csv", "--run", "b"], r"no run 'b'; runs: a"),
-    ("unknown engine", {"r.csv": recording()}, ["r.csv", "--engine", "nope"], r"unknown simulator 'nope'.*box2d"),
-    ("unknown estimator", {"r.csv": recording()}, ["r.csv", "--estimator", "nope"], r"unknown estimator 'nope'"),
-    ("simulation leaves the world", {"r.csv": recording(n=400)}, ["r.csv"], r"does not simulate over the recording.*left the world"),
+    (
+        "unknown engine",
+        {"r.csv": recording()},
+        ["r.csv", "--engine", "nope"],
+        r"unknown simulator 'nope'.*box2d",
+    ),
+    (
+        "unknown estimator",
+        {"r.csv": recording()},
+        ["r.csv", "--estimator", "nope"],
+        r"unknown estimator 'nope'",
+    ),
+    (
+        "simulation leaves the world",
+        {"r.csv": recording(n=400)},
+        ["r.csv"],
+        r"does not simulate over the recording.*left the world",
+    ),
 ]
 FRAME_CASES = [
     ("frames without frames key", {"x": np.zeros((4, 1, 8, 8))}, r"no 'frames' array \(found: x\)"),
-    ("frames with three channels", {"frames": np.zeros((21, 3, 36, 48), np.float32)}, r"frames have 3 channels"),
-    ("frames of the wrong size", {"frames": np.zeros((21, 1, 10, 48), np.float32)}, r"\(C, H, W\) = \(1, 10, 48\).*\(1, 36, 48\)"),
+    (
+        "frames with three channels",
+        {"frames": np.zeros((21, 3, 36, 48), np.float32)},
+        r"frames have 3 channels",
+    ),
+    (
+        "frames of the wrong size",
+        {"frames": np.zeros((21, 1, 10, 48), np.float32)},
+        r"\(C, H, W\) = \(1, 10, 48\).*\(1, 36, 48\)",
+    ),
 ]
 
 
-@pytest.mark.parametrize(("files", "args", "message"), [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+@pytest.mark.parametrize(
+    ("files", "args", "message"), [c[1:] for c in CASES], ids=[c[0] for c in CASES]
+)
 def test_bad_input_gives_a_named_error(tmp_path, monkeypatch, capsys, files, args, message):
     monkeypatch.chdir(tmp_path)
     write(tmp_path, "s.toml", GOOD_SCENE)
@@ -96,7 +169,9 @@ def test_bad_input_gives_a_named_error(tmp_path, monkeypatch, capsys, files, arg
     assert re.search(message, err, re.S), err
 
 
-@pytest.mark.parametrize(("arrays", "message"), [c[1:] for c in FRAME_CASES], ids=[c[0] for c in FRAME_CASES])
+@pytest.mark.parametrize(
+    ("arrays", "message"), [c[1:] for c in FRAME_CASES], ids=[c[0] for c in FRAME_CASES]
+)
 def test_bad_frames_give_a_named_error(tmp_path, capsys, arrays, message):
     write(tmp_path, "s.toml", GOOD_SCENE)
     assert cli(["discover", npz(tmp_path, **arrays), "--scene", str(tmp_path / "s.toml")]) == 2

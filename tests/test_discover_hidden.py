@@ -28,7 +28,13 @@ SEEDS = [int(s) for s in os.environ.get("PHYSBENCH_DISCOVERY_SEEDS", "0").split(
 ENGINES = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}
 TOLERANCE = 0.15
 
-HIDDEN = [(e, sc, eng, seed) for e, scenes in EFFECT_SCENES.items() for sc in scenes for eng in ENGINES for seed in SEEDS]
+HIDDEN = [
+    (e, sc, eng, seed)
+    for e, scenes in EFFECT_SCENES.items()
+    for sc in scenes
+    for eng in ENGINES
+    for seed in SEEDS
+]
 CONTROLS = [(sc, eng, seed) for sc in sorted(SCENES) for eng in ENGINES for seed in SEEDS]
 
 
@@ -62,27 +68,53 @@ def test_every_effect_in_the_library_has_hidden_effect_scenes():
     assert len(CONTROLS) >= 20
 
 
-@pytest.mark.parametrize(("effect", "scene", "engine", "seed"), HIDDEN, ids=["/".join(map(str, h)) for h in HIDDEN])
+@pytest.mark.parametrize(
+    ("effect", "scene", "engine", "seed"), HIDDEN, ids=["/".join(map(str, h)) for h in HIDDEN]
+)
 def test_hidden_effect_is_named_with_its_magnitude(effect, scene, engine, seed):
     sim = ENGINES[engine]()
     case = make_case(effect, scene, seed, sim)
     disc = discover([case.run], sim, diagnose=False)
     found = disc.cause_results[0] if disc.causes[:1] == [effect] else None
     err = magnitude_error(effect, case.truth, found.params) if found is not None else None
-    _log(effect=effect, scene=scene, engine=engine, seed=seed, causes=disc.causes, error=err, gain=disc.gain,
-         truth=case.truth, fitted=found.params if found is not None else None, seconds=disc.seconds)
-    assert disc.causes[:1] == [effect], f"{case.name} [{engine}]: causes {disc.causes}, truth {case.truth}"
+    _log(
+        effect=effect,
+        scene=scene,
+        engine=engine,
+        seed=seed,
+        causes=disc.causes,
+        error=err,
+        gain=disc.gain,
+        truth=case.truth,
+        fitted=found.params if found is not None else None,
+        seconds=disc.seconds,
+    )
+    assert disc.causes[:1] == [effect], (
+        f"{case.name} [{engine}]: causes {disc.causes}, truth {case.truth}"
+    )
     assert found is not None and err is not None
-    assert err <= TOLERANCE, f"{case.name} [{engine}]: fitted {found.params}, truth {case.truth} ({err:.1%} off)"
+    assert err <= TOLERANCE, (
+        f"{case.name} [{engine}]: fitted {found.params}, truth {case.truth} ({err:.1%} off)"
+    )
     assert disc.gain > 0.5
 
 
-@pytest.mark.parametrize(("scene", "engine", "seed"), CONTROLS, ids=["/".join(map(str, c)) for c in CONTROLS])
+@pytest.mark.parametrize(
+    ("scene", "engine", "seed"), CONTROLS, ids=["/".join(map(str, c)) for c in CONTROLS]
+)
 def test_control_without_a_hidden_effect_produces_no_cause(scene, engine, seed):
     sim = ENGINES[engine]()
     case = make_case(None, scene, seed, sim)
     disc = discover([case.run], sim, diagnose=False)
-    _log(effect=None, scene=scene, engine=engine, seed=seed, causes=disc.causes, gain=disc.gain, seconds=disc.seconds)
+    _log(
+        effect=None,
+        scene=scene,
+        engine=engine,
+        seed=seed,
+        causes=disc.causes,
+        gain=disc.gain,
+        seconds=disc.seconds,
+    )
     assert disc.causes == [], f"{case.name} [{engine}]: false alarm {disc.causes} " + ", ".join(
         f"{c.effect} gain {c.gain:+.1%} ΔBIC {c.delta_criterion:+.1f}" for c in disc.cause_results
     )

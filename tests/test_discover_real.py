@@ -33,7 +33,9 @@ def test_verdict_json_has_the_documented_layout(name):
         assert {"effect", "params", "heldout_error", "gain", "criterion"} <= set(c)
     assert [c["effect"] for c in d["candidates"] if c["chosen"]] == d["causes"]
     if d["causes"]:  # the reported gain is the final model's against the base
-        assert d["gain"] == pytest.approx(1 - d["final"]["heldout_error"] / d["base"]["heldout_error"], rel=1e-6)
+        assert d["gain"] == pytest.approx(
+            1 - d["final"]["heldout_error"] / d["base"]["heldout_error"], rel=1e-6
+        )
     assert (RESULTS / name / "verdict.txt").is_file()
 
 

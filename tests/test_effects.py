@@ -48,7 +48,9 @@ def run_both(scene: Scene, make_effects) -> list[Trajectory]:
     return out
 
 
-def assert_engines_agree(trajs: list[Trajectory], pose_tol: float = 5e-4, vel_tol: float = 1e-3) -> None:
+def assert_engines_agree(
+    trajs: list[Trajectory], pose_tol: float = 5e-4, vel_tol: float = 1e-3
+) -> None:
     """Both engines give the same poses (m, rad) and velocities, to Box2D's float32 precision."""
     a, b = trajs
     assert np.abs(a.states[:, :, :3] - b.states[:, :, :3]).max() <= pose_tol
@@ -62,14 +64,28 @@ def assert_pose(tr: Trajectory, scene: Scene, field: int, expected: np.ndarray, 
     v = tr.states[:, 0, 3 + field]
     err = np.abs(tr.states[:, 0, field] - expected)
     slack = tol + h * np.abs(v - v[0])
-    assert np.all(err <= slack), f"[{tr.engine}] worst excess {np.max(err - slack):.3g} at frame {np.argmax(err - slack)}"
+    assert np.all(err <= slack), (
+        f"[{tr.engine}] worst excess {np.max(err - slack):.3g} at frame {np.argmax(err - slack)}"
+    )
 
 
-def ball_scene(velocity=(0.0, 0.0), gravity=(0.0, 0.0), seconds=3.0, fps=30, position=(1.0, 1.0),
-               bounds=(0.0, 0.0, 20.0, 20.0), mass=2.0) -> Scene:
+def ball_scene(
+    velocity=(0.0, 0.0),
+    gravity=(0.0, 0.0),
+    seconds=3.0,
+    fps=30,
+    position=(1.0, 1.0),
+    bounds=(0.0, 0.0, 20.0, 20.0),
+    mass=2.0,
+) -> Scene:
     return Scene(
-        "ball", (Body("ball", Circle(0.05), position, velocity=velocity, mass=mass),), bounds=bounds,
-        gravity=gravity, fps=fps, frames=int(seconds * fps) + 1, substeps=10,
+        "ball",
+        (Body("ball", Circle(0.05), position, velocity=velocity, mass=mass),),
+        bounds=bounds,
+        gravity=gravity,
+        fps=fps,
+        frames=int(seconds * fps) + 1,
+        substeps=10,
     ).validate()
 
 
@@ -83,9 +99,16 @@ def test_every_builtin_effect_is_registered_and_follows_the_protocol():
         assert isinstance(cls(), Effect)
         for p in cls.params:
             assert p.low <= p.default <= p.high and p.doc
-    expected = {"linear_drag", "quadratic_drag", "rolling_resistance", "constant_force",
-                "joint_viscous_damping", "joint_coulomb_friction", "velocity_dependent_restitution",
-                "sensor_offset"}
+    expected = {
+        "linear_drag",
+        "quadratic_drag",
+        "rolling_resistance",
+        "constant_force",
+        "joint_viscous_damping",
+        "joint_coulomb_friction",
+        "velocity_dependent_restitution",
+        "sensor_offset",
+    }
     assert expected <= set(names)
 
 
@@ -111,8 +134,13 @@ def test_values_combine_and_bad_values_are_named():
 
 def test_body_selection_leaves_other_bodies_alone():
     scene = Scene(
-        "two", (Body("a", Circle(0.05), (1, 1), velocity=(1, 0)), Body("b", Circle(0.05), (1, 2), velocity=(1, 0))),
-        gravity=(0, 0), bounds=(0, 0, 10, 10),
+        "two",
+        (
+            Body("a", Circle(0.05), (1, 1), velocity=(1, 0)),
+            Body("b", Circle(0.05), (1, 2), velocity=(1, 0)),
+        ),
+        gravity=(0, 0),
+        bounds=(0, 0, 10, 10),
     )
     e = LinearDrag(c=1.0, bodies=["a"])
     e.setup(scene, {})
@@ -138,7 +166,9 @@ def test_linear_drag_decays_velocity_exponentially():
 def test_quadratic_drag_reaches_terminal_velocity():
     m, vt = 0.5, 4.0
     c = m * G / vt**2
-    scene = ball_scene(gravity=(0.0, -G), seconds=3.0, position=(1.0, 38.0), bounds=(0, 0, 2, 40), mass=m)
+    scene = ball_scene(
+        gravity=(0.0, -G), seconds=3.0, position=(1.0, 38.0), bounds=(0, 0, 2, 40), mass=m
+    )
     trajs = run_both(scene, lambda: [QuadraticDrag(c=c)])
     t = trajs[0].times
     for tr in trajs:
@@ -190,7 +220,14 @@ MGD = M * G * L / 2
 def pendulum(seconds: float = 4.0, theta0: float = THETA0) -> Scene:
     centre = (PIVOT[0] + math.sin(theta0) * L / 2, PIVOT[1] - math.cos(theta0) * L / 2)
     arm = Body("arm", Box(W, L), centre, angle=theta0, mass=M)
-    return Scene("pendulum", (arm,), fps=60, frames=int(seconds * 60) + 1, substeps=10, joints=(Joint("arm", PIVOT),)).validate()
+    return Scene(
+        "pendulum",
+        (arm,),
+        fps=60,
+        frames=int(seconds * 60) + 1,
+        substeps=10,
+        joints=(Joint("arm", PIVOT),),
+    ).validate()
 
 
 def peaks(tr: Trajectory) -> tuple[np.ndarray, np.ndarray]:
@@ -223,7 +260,9 @@ def test_coulomb_joint_friction_decays_amplitude_linearly():
         _, ap = peaks(tr)
         assert len(ap) >= 3
         per_cycle = -np.diff(ap)
-        np.testing.assert_allclose(per_cycle, 4 * tau / MGD, rtol=0.03)  # loses 2·tau/(m g d) per half swing
+        np.testing.assert_allclose(
+            per_cycle, 4 * tau / MGD, rtol=0.03
+        )  # loses 2·tau/(m g d) per half swing
     assert_engines_agree(trajs)
     np.testing.assert_allclose(peaks(trajs[0])[1], peaks(trajs[1])[1], atol=1e-3)
 
@@ -244,7 +283,9 @@ def test_coulomb_joint_friction_creeps_below_breakaway_without_chatter(sim):
     c = tau / eps
     s1, s2 = ((-c + sgn * math.sqrt(c * c - 4 * I_PIVOT * MGD)) / (2 * I_PIVOT) for sgn in (1, -1))
     t = tr.times
-    np.testing.assert_allclose(a, theta0 * (s2 * np.exp(s1 * t) - s1 * np.exp(s2 * t)) / (s2 - s1), atol=0.03 * theta0)  # sign is not exactly linear at |w| ~ eps
+    np.testing.assert_allclose(
+        a, theta0 * (s2 * np.exp(s1 * t) - s1 * np.exp(s2 * t)) / (s2 - s1), atol=0.03 * theta0
+    )  # sign is not exactly linear at |w| ~ eps
 
 
 def test_quadratic_joint_damping_loses_more_per_swing_at_large_amplitude():
@@ -260,8 +301,10 @@ def test_quadratic_joint_damping_loses_more_per_swing_at_large_amplitude():
 
 def test_joint_between_bodies_gets_equal_and_opposite_torques():
     scene = Scene(
-        "double", (Body("a", Box(0.03, 0.4), (1, 0.8)), Body("b", Box(0.03, 0.4), (1, 0.4))),
-        bounds=(0, 0, 2, 2), joints=(Joint("a", (1, 1.0)), Joint("b", (1, 0.6), "a")),
+        "double",
+        (Body("a", Box(0.03, 0.4), (1, 0.8)), Body("b", Box(0.03, 0.4), (1, 0.4))),
+        bounds=(0, 0, 2, 2),
+        joints=(Joint("a", (1, 1.0)), Joint("b", (1, 0.6), "a")),
     )
     e = JointViscousDamping(c=0.1, joints=[1])
     e.setup(scene, {})
@@ -295,7 +338,9 @@ def test_restitution_law_and_its_hook():
     assert restitution_law(2.0, 0.9, 0.1) == pytest.approx(0.7)
     assert restitution_law(-2.0, 0.9, 0.1) == pytest.approx(0.7)  # speed, not sign
     assert restitution_law(20.0, 0.9, 0.1) == 0.0
-    np.testing.assert_allclose(restitution_law(np.array([0.0, 1.0, 3.0]), 1.0, 0.2), [1.0, 0.8, 0.4])
+    np.testing.assert_allclose(
+        restitution_law(np.array([0.0, 1.0, 3.0]), 1.0, 0.2), [1.0, 0.8, 0.4]
+    )
     e = VelocityDependentRestitution(e0=0.95, k=0.1, statics_only=True)
     scene = ball_scene()
     e.setup(scene, {})
@@ -308,15 +353,28 @@ def test_restitution_law_and_its_hook():
 def test_damping_between_bodies_stops_their_relative_spin_and_keeps_angular_momentum():
     # Two rods pinned end to end in free space, spinning in opposite directions: internal damping
     # must bring them to a common rate without creating net angular momentum (which stays 0).
-    rods = (Body("a", Box(0.03, 0.4), (1.0, 1.2), angular_velocity=1.0), Body("b", Box(0.03, 0.4), (1.0, 0.8), angular_velocity=-1.0))
-    scene = Scene("rods", rods, bounds=(0, 0, 2, 2), gravity=(0, 0), fps=60, frames=121, substeps=10,
-                  joints=(Joint("b", (1.0, 1.0), "a"),)).validate()
+    rods = (
+        Body("a", Box(0.03, 0.4), (1.0, 1.2), angular_velocity=1.0),
+        Body("b", Box(0.03, 0.4), (1.0, 0.8), angular_velocity=-1.0),
+    )
+    scene = Scene(
+        "rods",
+        rods,
+        bounds=(0, 0, 2, 2),
+        gravity=(0, 0),
+        fps=60,
+        frames=121,
+        substeps=10,
+        joints=(Joint("b", (1.0, 1.0), "a"),),
+    ).validate()
     trajs = run_both(scene, lambda: [JointViscousDamping(c=0.02)])
     inertia = rods[0].inertia()
     for tr in trajs:
         s = tr.states
         rel = s[:, 0, 5] - s[:, 1, 5]
         assert abs(rel[-1]) < 0.05 * abs(rel[0])
-        spin = inertia * s[:, :, 5].sum(axis=1) + (s[:, :, 0] * s[:, :, 4] - s[:, :, 1] * s[:, :, 3]).sum(axis=1)  # m = 1
+        spin = inertia * s[:, :, 5].sum(axis=1) + (
+            s[:, :, 0] * s[:, :, 4] - s[:, :, 1] * s[:, :, 3]
+        ).sum(axis=1)  # m = 1
         assert np.abs(spin).max() < 1e-3 * inertia
     assert_engines_agree(trajs, pose_tol=2e-3, vel_tol=1e-2)

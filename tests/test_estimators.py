@@ -40,7 +40,17 @@ def _three_circles(name: str, seed: int, params: list[str], **options: Any):  # 
     truth, initial = draw_problem(space, seed)
     sim, ren = create("simulator", "pymunk"), create("renderer", "raster", resolution=32)
     obs = simulate_observation(scene, truth, sim, ren)
-    return refine(obs, scene, space, sim, ren, create("estimator", name, **options), iterations=11, seed=seed, initial=initial)
+    return refine(
+        obs,
+        scene,
+        space,
+        sim,
+        ren,
+        create("estimator", name, **options),
+        iterations=11,
+        seed=seed,
+        initial=initial,
+    )
 
 
 def test_builtins_are_registered_through_entry_points() -> None:
@@ -67,7 +77,13 @@ def test_same_seed_same_history_in_a_fresh_process() -> None:
         "print(json.dumps(_three_circles('tpe', 4, ['mass', 'elasticity']).to_dict(timings=False)))"
     )
     env = {**os.environ, "PYTHONHASHSEED": "99"}
-    out = subprocess.run([sys.executable, "-c", code, os.path.dirname(__file__)], capture_output=True, text=True, env=env, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", code, os.path.dirname(__file__)],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=True,
+    )
     assert json.loads(out.stdout) == json.loads(json.dumps(ours))
 
 
@@ -93,7 +109,9 @@ def test_startup_is_a_setting_with_a_small_budget_default() -> None:
     # default the proposals after the start-up phase differ from those random draws.
     lib = run_toy(TPE, {"startup": 20}, seed=1, iterations=11)
     ours = run_toy(TPE, {"startup": DEFAULT_STARTUP}, seed=1, iterations=11)
-    assert [r.params for r in lib.records[:DEFAULT_STARTUP]] == [r.params for r in ours.records[:DEFAULT_STARTUP]]
+    assert [r.params for r in lib.records[:DEFAULT_STARTUP]] == [
+        r.params for r in ours.records[:DEFAULT_STARTUP]
+    ]
     assert lib.records[-1].params != ours.records[-1].params
     assert ours.options == {"startup": DEFAULT_STARTUP, "candidates": 24, "gamma": 0.25}
 
@@ -111,10 +129,16 @@ def test_first_point_told_is_the_initial_guess() -> None:
         (TPE, {"startup": -1}, r"tpe: startup = -1: expected a whole number >= 0"),
         (TPE, {"gamma": "high"}, r"tpe: gamma = 'high': expected a number in \(0, 1\]"),
         (CMAES, {"sigma": 2.0}, r"cmaes: sigma = 2.0: expected a number in \(0, 1\]"),
-        (Optuna, {"sampler": "grid"}, r"optuna: sampler = 'grid': expected one of tpe, cmaes, random, qmc"),
+        (
+            Optuna,
+            {"sampler": "grid"},
+            r"optuna: sampler = 'grid': expected one of tpe, cmaes, random, qmc",
+        ),
     ],
 )
-def test_bad_options_name_the_option_and_the_accepted_values(cls: type, options: dict[str, Any], message: str) -> None:
+def test_bad_options_name_the_option_and_the_accepted_values(
+    cls: type, options: dict[str, Any], message: str
+) -> None:
     with pytest.raises(EstimatorOptionError, match=message):
         cls(**options)
 

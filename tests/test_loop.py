@@ -63,8 +63,14 @@ class CountingSimulator(ToySimulator):
 def _run(estimator, *, iterations: int = 6, params=("mass",), sim=None, obs=None, seed: int = 0):  # type: ignore[no-untyped-def]
     t = toy_task(params, seed=seed)
     return refine(
-        obs if obs is not None else t.observation, t.scene, t.space, sim or t.simulator, t.renderer, estimator,
-        iterations=iterations, seed=seed,
+        obs if obs is not None else t.observation,
+        t.scene,
+        t.space,
+        sim or t.simulator,
+        t.renderer,
+        estimator,
+        iterations=iterations,
+        seed=seed,
     )
 
 
@@ -79,7 +85,11 @@ def test_one_simulation_and_one_propose_per_iteration() -> None:
     assert sim.calls[1:] == points[:6]  # iteration k simulates proposal k-1
     assert [s.iteration for s in est.steps] == list(range(7))
     for s, r in zip(est.steps, h.records, strict=True):
-        assert s.params == r.params and s.loss == r.loss and s.frames.shape == t.observation.frames.shape
+        assert (
+            s.params == r.params
+            and s.loss == r.loss
+            and s.frames.shape == t.observation.frames.shape
+        )
         assert r.t_simulate >= 0 and r.t_render >= 0 and r.t_estimator >= 0
 
 
@@ -92,7 +102,10 @@ def test_best_is_chosen_by_image_mse_without_peeking_at_the_truth() -> None:
     h = _run(Scripted([truly_right, looks_right, truly_right]), iterations=4, obs=obs)
     assert h.records[1].nmse == 0.0 and h.records[2].loss == 0.0
     assert h.best.iteration == 2 and h.best.params == looks_right
-    assert h.min_nmse == pytest.approx(t.space.normalized_mse(looks_right, truly_right)) and h.min_nmse > 0
+    assert (
+        h.min_nmse == pytest.approx(t.space.normalized_mse(looks_right, truly_right))
+        and h.min_nmse > 0
+    )
     losses = [r.loss for r in h.records]
     assert [r.best_iteration for r in h.records] == running_best(losses)
     assert all(r.best_nmse == h.records[r.best_iteration].nmse for r in h.records)
@@ -102,7 +115,9 @@ def test_normalized_mse_divides_by_the_range_maximum() -> None:
     t = toy_task(("mass", "elasticity"), seed=0)
     est = {"a.mass": 4.0, "a.elasticity": 0.5, "b.mass": 10.0, "b.elasticity": 1.0}
     truth = {"a.mass": 2.0, "a.elasticity": 0.3, "b.mass": 10.0, "b.elasticity": 1.0}
-    assert t.space.normalized_mse(est, truth) == pytest.approx(((2 / 10) ** 2 + (0.2 / 1.0) ** 2) / 4)
+    assert t.space.normalized_mse(est, truth) == pytest.approx(
+        ((2 / 10) ** 2 + (0.2 / 1.0) ** 2) / 4
+    )
 
 
 def test_history_round_trips_through_json_and_pandas() -> None:
@@ -137,7 +152,10 @@ def test_impossible_iteration_counts_are_refused(bad: object) -> None:
 @pytest.mark.parametrize(
     ("proposal", "message"),
     [
-        ({"a.mass": 11.0, "b.mass": 5.0}, r"a.mass = 11.0 .* expected a finite number in \[1, 10\]"),
+        (
+            {"a.mass": 11.0, "b.mass": 5.0},
+            r"a.mass = 11.0 .* expected a finite number in \[1, 10\]",
+        ),
         ({"a.mass": float("nan"), "b.mass": 5.0}, r"a.mass = nan"),
         ({"a.mass": 5.0}, r"missing \['b.mass'\]"),
         ({"a.mass": 5.0, "b.mass": 5.0, "c.mass": 1.0}, r"extra \['c.mass'\]"),
@@ -153,24 +171,53 @@ def test_bad_proposals_name_the_estimator_key_and_range(proposal: object, messag
 def test_initial_guess_outside_the_ranges_is_refused() -> None:
     t = toy_task()
     with pytest.raises(PhysbenchError, match=r"a.mass in \[1, 10\]"):
-        refine(t.observation, t.scene, t.space, t.simulator, t.renderer, RandomSearch(), iterations=2,
-               initial={"a.mass": 0.5, "b.mass": 2.0})
+        refine(
+            t.observation,
+            t.scene,
+            t.space,
+            t.simulator,
+            t.renderer,
+            RandomSearch(),
+            iterations=2,
+            initial={"a.mass": 0.5, "b.mass": 2.0},
+        )
 
 
 def test_unknowns_can_be_given_as_parameter_names() -> None:
     t = toy_task(("mass", "elasticity"))
-    h = refine(t.observation, t.scene, ["elasticity"], t.simulator, t.renderer, RandomSearch(), iterations=2)
+    h = refine(
+        t.observation,
+        t.scene,
+        ["elasticity"],
+        t.simulator,
+        t.renderer,
+        RandomSearch(),
+        iterations=2,
+    )
     assert h.keys == ("a.elasticity", "b.elasticity")
     with pytest.raises(PhysbenchError, match="unknown parameter 'friction' of scene 'toy'"):
-        refine(t.observation, t.scene, ["friction"], t.simulator, t.renderer, RandomSearch(), iterations=2)
+        refine(
+            t.observation,
+            t.scene,
+            ["friction"],
+            t.simulator,
+            t.renderer,
+            RandomSearch(),
+            iterations=2,
+        )
 
 
 def test_observation_of_the_wrong_shape_names_expected_and_got() -> None:
     t = toy_task()
     bad = t.observation.frames[:, :1]
-    with pytest.raises(ObservationError, match=r"shape \(12, 1, 16, 16\), expected .* \(12, 2, 16, 16\) \(C 1 != 2\)"):
+    with pytest.raises(
+        ObservationError,
+        match=r"shape \(12, 1, 16, 16\), expected .* \(12, 2, 16, 16\) \(C 1 != 2\)",
+    ):
         _run(RandomSearch(), obs=bad)
-    with pytest.raises(ObservationError, match=r"values span \[0, 1.98.*expected values in \[0, 1\]"):
+    with pytest.raises(
+        ObservationError, match=r"values span \[0, 1.98.*expected values in \[0, 1\]"
+    ):
         _run(RandomSearch(), obs=t.observation.frames * 2)
 
 
@@ -183,7 +230,11 @@ def test_a_failed_simulation_costs_an_iteration_with_the_worst_loss() -> None:
 
     est = Scripted([{"a.mass": 9.0, "b.mass": 2.0}, {"a.mass": 2.0, "b.mass": 2.0}])
     h = _run(est, iterations=3, sim=Fragile())
-    assert h.records[1].failed and "exploded" in h.records[1].failed and h.records[1].loss == FAILED_LOSS
+    assert (
+        h.records[1].failed
+        and "exploded" in h.records[1].failed
+        and h.records[1].loss == FAILED_LOSS
+    )
     assert h.records[2].failed is None and len(est.steps) == 3
 
 
@@ -208,7 +259,9 @@ def test_any_number_of_unknown_bodies() -> None:
     from physbench.scene import Body, Circle, Scene, Unknown
 
     bodies = tuple(Body(f"b{i}", Circle(0.2), (0.5 + 0.5 * i, 1.0)) for i in range(6))
-    scene = Scene("six", bodies, frames=8, unknowns=tuple(Unknown(b.name, "mass", 1.0, 10.0) for b in bodies))
+    scene = Scene(
+        "six", bodies, frames=8, unknowns=tuple(Unknown(b.name, "mass", 1.0, 10.0) for b in bodies)
+    )
     space = ParamSpace.from_scene(scene)
     sim, ren = ToySimulator(), ToyRenderer()
     obs = simulate_observation(scene, draw_problem(space, 0)[0], sim, ren)

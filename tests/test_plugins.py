@@ -15,7 +15,7 @@ from physbench import hookspecs
 from physbench.errors import PluginError, UnknownNameError
 from physbench.plugins import KINDS, discover
 
-GOOD = '''
+GOOD = """
 from physbench.hookspecs import hookimpl
 
 class EchoEstimator:
@@ -29,10 +29,12 @@ class EchoEstimator:
 @hookimpl
 def register_estimators():
     return [EchoEstimator]
-'''
+"""
 
 
-def make_dist(root: Path, dist: str, version: str, entry_points: dict[str, str], modules: dict[str, str]) -> None:
+def make_dist(
+    root: Path, dist: str, version: str, entry_points: dict[str, str], modules: dict[str, str]
+) -> None:
     """Write an installed-looking distribution (dist-info + modules) under ``root``."""
     info = root / f"{dist.replace('-', '_')}-{version}.dist-info"
     info.mkdir(parents=True)
@@ -58,15 +60,26 @@ def test_builtins_register_through_entry_points() -> None:
     assert not reg.failed, reg.failed
     assert {"pymunk", "box2d"} <= set(reg.names("simulator"))
     assert "raster" in reg.names("renderer")
-    assert {"three_circles", "second_order", "stacked_boxes", "bouncing_balls", "pendulum", "ball_drop"} <= set(
-        reg.names("scene")
-    )
+    assert {
+        "three_circles",
+        "second_order",
+        "stacked_boxes",
+        "bouncing_balls",
+        "pendulum",
+        "ball_drop",
+    } <= set(reg.names("scene"))
     info = reg.info("simulator", "pymunk")
     assert info.package == "physbench" and info.plugin == "pymunk"
 
 
 def test_third_party_plugin_is_discovered_with_its_package(site: Path) -> None:
-    make_dist(site, "pbtest-good", "1.2.3", {"good": "pbtest_good"}, {"pbtest_good": GOOD.format(tag="good")})
+    make_dist(
+        site,
+        "pbtest-good",
+        "1.2.3",
+        {"good": "pbtest_good"},
+        {"pbtest_good": GOOD.format(tag="good")},
+    )
     reg = discover(env=False)
     comp = reg.info("estimator", "echo_good")
     assert (comp.package, comp.version, comp.plugin) == ("pbtest-good", "1.2.3", "good")
@@ -74,8 +87,16 @@ def test_third_party_plugin_is_discovered_with_its_package(site: Path) -> None:
 
 
 def test_plugin_failing_to_import_is_reported_and_skipped(site: Path) -> None:
-    make_dist(site, "pbtest-broken", "0.1", {"broken": "pbtest_broken"}, {"pbtest_broken": "raise RuntimeError('boom at import')\n"})
-    make_dist(site, "pbtest-good", "1.0", {"good": "pbtest_good"}, {"pbtest_good": GOOD.format(tag="ok")})
+    make_dist(
+        site,
+        "pbtest-broken",
+        "0.1",
+        {"broken": "pbtest_broken"},
+        {"pbtest_broken": "raise RuntimeError('boom at import')\n"},
+    )
+    make_dist(
+        site, "pbtest-good", "1.0", {"good": "pbtest_good"}, {"pbtest_good": GOOD.format(tag="ok")}
+    )
     reg = discover(env=False)
     failed = {f.plugin: f for f in reg.failed}
     assert "broken" in failed
@@ -107,7 +128,9 @@ def test_duplicate_component_name_fails_loudly(site: Path) -> None:
         discover(env=False)
 
 
-def test_explicit_module_fallback_via_environment(site: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_explicit_module_fallback_via_environment(
+    site: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     (site / "pbtest_env.py").write_text(textwrap.dedent(GOOD.format(tag="env")))
     monkeypatch.setenv("PHYSBENCH_PLUGINS", "pbtest_env, pbtest_missing_module")
     reg = discover()
@@ -117,7 +140,9 @@ def test_explicit_module_fallback_via_environment(site: Path, monkeypatch: pytes
 
 def test_unknown_name_lists_known_ones() -> None:
     reg = discover(env=False)
-    with pytest.raises(UnknownNameError, match="unknown simulator 'bullet'; known simulators: box2d, pymunk"):
+    with pytest.raises(
+        UnknownNameError, match="unknown simulator 'bullet'; known simulators: box2d, pymunk"
+    ):
         reg.get("simulator", "bullet")
 
 
@@ -130,10 +155,18 @@ def test_every_hookspec_is_documented_and_mapped_to_a_kind() -> None:
 
 
 def test_plugins_command_lists_components_and_failures(site: Path) -> None:
-    make_dist(site, "pbtest-broken", "0.1", {"broken": "pbtest_broken"}, {"pbtest_broken": "import not_a_module_xyz\n"})
+    make_dist(
+        site,
+        "pbtest-broken",
+        "0.1",
+        {"broken": "pbtest_broken"},
+        {"pbtest_broken": "import not_a_module_xyz\n"},
+    )
     out = subprocess.run(
         [sys.executable, "-m", "physbench.cli", "plugins"],
-        capture_output=True, text=True, check=True,
+        capture_output=True,
+        text=True,
+        check=True,
         env={**__import__("os").environ, "PYTHONPATH": str(site)},
     ).stdout
     assert "simulator  pymunk" in out and "physbench" in out

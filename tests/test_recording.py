@@ -35,23 +35,76 @@ MALFORMED = [
     ("duplicate column", "t,body,x,y,x\n0,ball,1,2,3\n", 1, None, "x", "duplicate column"),
     ("short row", "t,body,x,y\n0,ball,1,2\n0.1,ball,1\n", 3, 2, "y", "expected 4 values"),
     ("long row", "t,body,x,y\n0,ball,1,2,5\n", 2, 1, "#5", "expected 4 values"),
-    ("non-numeric x", "t,body,x,y\n0,ball,1,2\n0.1,ball,one,2\n", 3, 2, "x", "'one' is not a number"),
+    (
+        "non-numeric x",
+        "t,body,x,y\n0,ball,1,2\n0.1,ball,one,2\n",
+        3,
+        2,
+        "x",
+        "'one' is not a number",
+    ),
     ("empty y", "t,body,x,y\n0,ball,1,\n", 2, 1, "y", "'' is not a number"),
     ("NaN", "t,body,x,y\n0,ball,1,2\n0.1,ball,1,nan\n", 3, 2, "y", "finite"),
     ("infinite angle", "t,body,x,y,angle\n0,ball,1,2,inf\n", 2, 1, "angle", "finite"),
-    ("non-numeric time", "t,body,x,y\n0,ball,1,2\n1s,ball,1,2\n", 3, 2, "t", "'1s' is not a number"),
+    (
+        "non-numeric time",
+        "t,body,x,y\n0,ball,1,2\n1s,ball,1,2\n",
+        3,
+        2,
+        "t",
+        "'1s' is not a number",
+    ),
     ("negative time", "t,body,x,y\n-0.1,ball,1,2\n", 2, 1, "t", ">= 0"),
     ("unknown body", "t,body,x,y\n0,ball,1,2\n0,bal,1,2\n", 3, 2, "body", "unknown body 'bal'"),
     ("empty body", "t,body,x,y\n0,,1,2\n", 2, 1, "body", "empty body name"),
-    ("repeated time", "t,body,x,y\n0,ball,1,2\n0.5,ball,1,2\n0.5,ball,1.1,2\n", 4, 3, "t", "repeats"),
-    ("repeated time, rows apart", "t,body,x,y,run\n0.2,ball,1,2,a\n0.1,box,1,2,a\n0.2,ball,3,2,a\n", 4, 3, "t", "also at line 2"),
-    ("angle given then missing", "t,body,x,y,angle\n0,ball,1,2,0.5\n0.1,ball,1,2,\n", 3, 2, "angle", "given"),
-    ("empty run label", "t,body,x,y,run\n0,ball,1,2,a\n0,ball,1,2,\n", 3, 2, "run", "empty run label"),
-    ("comment lines count", "# made by hand\nt,body,x,y\n0,ball,1,2\n0,ball,x,2\n", 4, 2, "x", "not a number"),
+    (
+        "repeated time",
+        "t,body,x,y\n0,ball,1,2\n0.5,ball,1,2\n0.5,ball,1.1,2\n",
+        4,
+        3,
+        "t",
+        "repeats",
+    ),
+    (
+        "repeated time, rows apart",
+        "t,body,x,y,run\n0.2,ball,1,2,a\n0.1,box,1,2,a\n0.2,ball,3,2,a\n",
+        4,
+        3,
+        "t",
+        "also at line 2",
+    ),
+    (
+        "angle given then missing",
+        "t,body,x,y,angle\n0,ball,1,2,0.5\n0.1,ball,1,2,\n",
+        3,
+        2,
+        "angle",
+        "given",
+    ),
+    (
+        "empty run label",
+        "t,body,x,y,run\n0,ball,1,2,a\n0,ball,1,2,\n",
+        3,
+        2,
+        "run",
+        "empty run label",
+    ),
+    (
+        "comment lines count",
+        "# made by hand\nt,body,x,y\n0,ball,1,2\n0,ball,x,2\n",
+        4,
+        2,
+        "x",
+        "not a number",
+    ),
 ]
 
 
-@pytest.mark.parametrize(("text", "line", "row", "column", "fragment"), [c[1:] for c in MALFORMED], ids=[c[0] for c in MALFORMED])
+@pytest.mark.parametrize(
+    ("text", "line", "row", "column", "fragment"),
+    [c[1:] for c in MALFORMED],
+    ids=[c[0] for c in MALFORMED],
+)
 def test_malformed_csv_names_line_row_and_column(text, line, row, column, fragment):
     with pytest.raises(RecordingError) as info:
         parse_recordings(text, bodies=BODIES, source="rec.csv")
@@ -74,7 +127,11 @@ def test_rows_in_any_order_are_sorted_per_body():
     text = "body,t,y,x\nball,0.3,3,30\nbox,0.0,0,0\nball,0.1,1,10\n\nball,0.2,2,20\n"
     (rec,) = parse_recordings(text)
     tr = rec.track("ball")
-    assert tr.t.tolist() == [0.1, 0.2, 0.3] and tr.x.tolist() == [10, 20, 30] and tr.y.tolist() == [1, 2, 3]
+    assert (
+        tr.t.tolist() == [0.1, 0.2, 0.3]
+        and tr.x.tolist() == [10, 20, 30]
+        and tr.y.tolist() == [1, 2, 3]
+    )
     assert tr.angle is None and rec.run == "" and rec.track("box").t.tolist() == [0.0]
 
 
@@ -84,8 +141,15 @@ def random_recordings(rng: np.random.Generator) -> list[Recording]:
         tracks = {}
         for body, with_angle in (("ball", True), ("box", False)):
             n = int(rng.integers(1, 30))
-            t = np.sort(rng.choice(np.linspace(0, 5, 2000), size=n, replace=False) + rng.uniform(0, 1e-3, n))
-            tracks[body] = Track(t, rng.normal(size=n), rng.normal(size=n) * 1e-7, rng.normal(size=n) if with_angle else None)
+            t = np.sort(
+                rng.choice(np.linspace(0, 5, 2000), size=n, replace=False) + rng.uniform(0, 1e-3, n)
+            )
+            tracks[body] = Track(
+                t,
+                rng.normal(size=n),
+                rng.normal(size=n) * 1e-7,
+                rng.normal(size=n) if with_angle else None,
+            )
         recs.append(Recording(tracks, run=run))
     return recs
 
@@ -123,7 +187,9 @@ def test_round_trip_of_several_irregular_runs_is_exact(tmp_path):
 
 
 def test_single_run_without_run_column(tmp_path):
-    rec = Recording({"ball": Track(np.array([0.0, 0.25]), np.array([1.0, 2.0]), np.array([0.5, 0.25]))})
+    rec = Recording(
+        {"ball": Track(np.array([0.0, 0.25]), np.array([1.0, 2.0]), np.array([0.5, 0.25]))}
+    )
     write_recordings(tmp_path / "one.csv", rec)
     assert (tmp_path / "one.csv").read_text().splitlines()[0] == "t,body,x,y"
     assert read_recording(tmp_path / "one.csv").track("ball").x.tolist() == [1.0, 2.0]
@@ -133,8 +199,13 @@ def test_single_run_without_run_column(tmp_path):
 
 
 def falling_ball(frames: int = 31, fps: float = 30.0) -> tuple[Scene, Trajectory]:
-    scene = Scene("drop", (Body("ball", Circle(0.1), (1.0, 9.0), velocity=(0.5, 0.0), angular_velocity=2.0),),
-                  bounds=(0, 0, 10, 10), fps=fps, frames=frames)
+    scene = Scene(
+        "drop",
+        (Body("ball", Circle(0.1), (1.0, 9.0), velocity=(0.5, 0.0), angular_velocity=2.0),),
+        bounds=(0, 0, 10, 10),
+        fps=fps,
+        frames=frames,
+    )
     return scene, PymunkSimulator().simulate(scene)
 
 
@@ -161,7 +232,9 @@ def test_residuals_respect_fields_and_wrap_angles():
     t = np.array([0.1, 0.2])
     sim = Recording.from_trajectory(traj, times=t)
     tr = sim.track("ball")
-    shifted = Recording({"ball": Track(t, tr.x + 0.1, tr.y, tr.angle + 2 * math.pi + 0.05)}, fields=("x", "angle"))
+    shifted = Recording(
+        {"ball": Track(t, tr.x + 0.1, tr.y, tr.angle + 2 * math.pi + 0.05)}, fields=("x", "angle")
+    )
     res = shifted.residuals(traj)  # default: the measured fields only
     np.testing.assert_allclose(res, [-0.1, -0.1, -0.05, -0.05], atol=1e-9)
     np.testing.assert_allclose(shifted.residuals(traj, fields=["y"]), 0.0, atol=1e-12)
@@ -174,7 +247,9 @@ def test_residuals_respect_fields_and_wrap_angles():
 def test_residuals_refuse_recordings_outside_the_simulation():
     _, traj = falling_ball(frames=16)  # 0 .. 0.5 s
     late = Recording({"ball": Track(np.array([0.2, 0.9]), np.zeros(2), np.zeros(2))}, run="r")
-    with pytest.raises(RecordingError, match=r"0.2..0.9 s but the simulation covers 0..0.5 s.*at least 28"):
+    with pytest.raises(
+        RecordingError, match=r"0.2..0.9 s but the simulation covers 0..0.5 s.*at least 28"
+    ):
         late.residuals(traj)
     assert late.frames_for(30.0) == 28
     ghost = Recording({"cube": Track(np.array([0.1]), np.zeros(1), np.zeros(1))})

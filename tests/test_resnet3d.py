@@ -18,7 +18,9 @@ from physbench.estimators.resnet3d.model import FULL_WIDTHS, NetConfig, build_ne
 from physbench.estimators.resnet3d.train import TrainConfig, train  # noqa: E402
 
 TINY = NetConfig(n_outputs=1, widths=(4, 8, 8, 8), resolution=16, frames=6)
-TINY_DATA = DataSpec("three_circles", ("mass",), render_resolution=32, resolution=16, frames=6, group=3)
+TINY_DATA = DataSpec(
+    "three_circles", ("mass",), render_resolution=32, resolution=16, frames=6, group=3
+)
 
 
 @pytest.mark.parametrize(("n_out", "batch", "frames", "res"), [(1, 2, 6, 16), (2, 3, 15, 32)])
@@ -81,12 +83,22 @@ def test_train_writes_checkpoints_resumes_and_saves_safetensors(tmp_path: Path) 
     cfg = TrainConfig(samples=96, batch=8, eval_every=48, val_groups=1, workers=0, threads=1)
     path, meta = train(TINY_DATA, TINY, cfg, tmp_path, progress=False)
     assert path.suffix == ".safetensors" and path.with_suffix(".json").is_file()
-    for key in ("data", "net", "ranges", "normalization", "training", "val_mse", "physbench_version"):
+    for key in (
+        "data",
+        "net",
+        "ranges",
+        "normalization",
+        "training",
+        "val_mse",
+        "physbench_version",
+    ):
         assert key in meta
     assert meta["ranges"] == {"mass": [2.0, 8.0]} or set(meta["ranges"]) == {"mass"}
     assert [h["samples"] for h in meta["history"]] == [48, 96]
     # Resume: a larger budget continues from the checkpoint instead of starting over.
-    path2, meta2 = train(TINY_DATA, TINY, TrainConfig(**{**cfg.__dict__, "samples": 144}), tmp_path, progress=False)
+    path2, meta2 = train(
+        TINY_DATA, TINY, TrainConfig(**{**cfg.__dict__, "samples": 144}), tmp_path, progress=False
+    )
     assert [h["samples"] for h in meta2["history"]] == [48, 96, 144]
     # Weights round-trip through safetensors: same outputs after loading.
     state, side = weights.load(path2)
@@ -101,9 +113,14 @@ def test_train_writes_checkpoints_resumes_and_saves_safetensors(tmp_path: Path) 
     assert path2.read_bytes()[8:9] == b"{"  # safetensors header, not a pickle
 
 
-def test_missing_weights_error_says_how_to_train(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+def test_missing_weights_error_says_how_to_train(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
     monkeypatch.setattr(weights, "SHIPPED", tmp_path)
-    with pytest.raises(PhysbenchError, match=r"no resnet3d weights for scene 'three_circles'.*physbench train --scene three_circles --params mass"):
+    with pytest.raises(
+        PhysbenchError,
+        match=r"no resnet3d weights for scene 'three_circles'.*physbench train --scene three_circles --params mass",
+    ):
         weights.find("three_circles", ("mass",))
 
 
@@ -142,8 +159,13 @@ def test_shipped_weights_beat_the_random_estimator(info: weights.WeightsInfo) ->
         space = ParamSpace.from_scene(scene, spec.params)
         truth, initial = draw_problem(space, seed)
         obs = simulate_observation(scene, truth, sim, renderer, marked=space.bodies)
-        for est, out in ((ResNet3DEstimator(weights=str(info.path)), learned), (RandomSearch(), baseline)):
-            h = refine(obs, scene, space, sim, renderer, est, iterations=3, seed=seed, initial=initial)
+        for est, out in (
+            (ResNet3DEstimator(weights=str(info.path)), learned),
+            (RandomSearch(), baseline),
+        ):
+            h = refine(
+                obs, scene, space, sim, renderer, est, iterations=3, seed=seed, initial=initial
+            )
             out.append(h.min_nmse)
     assert np.mean(learned) < np.mean(baseline), (learned, baseline)
 
@@ -156,7 +178,11 @@ def test_int8_storage_round_trips_within_a_step_and_is_a_quarter_of_float32(tmp_
     back = weights.dequantize(q)
     assert set(back) == set(state)
     for k, v in state.items():
-        step = v.abs().flatten(1).amax(1).view((-1,) + (1,) * (v.dim() - 1)) / 127 if v.dim() >= 2 else 1e-3 * v.abs().max()
+        step = (
+            v.abs().flatten(1).amax(1).view((-1,) + (1,) * (v.dim() - 1)) / 127
+            if v.dim() >= 2
+            else 1e-3 * v.abs().max()
+        )
         assert torch.all((back[k] - v).abs() <= step / 2 + 1e-6), k
     path = weights.save(tmp_path / "w", q, {"storage": weights.INT8, "net": TINY.to_dict()})
     loaded, _ = weights.load(path)
@@ -170,11 +196,16 @@ def test_int8_storage_round_trips_within_a_step_and_is_a_quarter_of_float32(tmp_
 
 def test_blur_augmentation_blurs_the_observed_half_only() -> None:
     sharp = PairMaker(TINY_DATA).group(4321)
-    blurred = PairMaker(DataSpec(**{**TINY_DATA.__dict__, "blur_max": 3.0, "blur_prob": 1.0})).group(4321)
+    blurred = PairMaker(
+        DataSpec(**{**TINY_DATA.__dict__, "blur_max": 3.0, "blur_prob": 1.0})
+    ).group(4321)
     frames = TINY_DATA.frames
     assert np.array_equal(sharp[1], blurred[1])  # same simulations, same targets
-    assert np.array_equal(sharp[0][:, :, frames:], blurred[0][:, :, frames:])  # simulated half untouched
+    assert np.array_equal(
+        sharp[0][:, :, frames:], blurred[0][:, :, frames:]
+    )  # simulated half untouched
     assert not np.allclose(sharp[0][:, :, :frames], blurred[0][:, :, :frames])
+
     # Blur smooths: less total variation across the image.
     def tv(x: np.ndarray) -> float:
         return float(np.abs(np.diff(x, axis=-1)).sum() + np.abs(np.diff(x, axis=-2)).sum())
@@ -208,8 +239,17 @@ def test_symmetric_option_makes_the_truth_an_exact_fixed_point(symmetric: bool) 
     sim, renderer = create("simulator", "pymunk"), create("renderer", "raster", resolution=64)
     obs = simulate_observation(scene, truth, sim, renderer, marked=space.bodies)
     # Started at the truth, the simulated frames equal the observed ones.
-    h = refine(obs, scene, space, sim, renderer, ResNet3DEstimator(symmetric=symmetric), iterations=2, seed=3,
-               initial=truth)
+    h = refine(
+        obs,
+        scene,
+        space,
+        sim,
+        renderer,
+        ResNet3DEstimator(symmetric=symmetric),
+        iterations=2,
+        seed=3,
+        initial=truth,
+    )
     moved = max(abs(h.records[1].params[k] - truth[k]) for k in truth)
     if symmetric:
         assert moved < 1e-9  # f(o, s) - f(s, o) vanishes when o == s
@@ -221,10 +261,21 @@ def test_init_fine_tunes_from_weights_and_refuses_another_architecture(tmp_path:
     cfg = TrainConfig(samples=16, batch=8, eval_every=16, val_groups=1, workers=0, threads=1)
     first, _ = train(TINY_DATA, TINY, cfg, tmp_path / "a", progress=False)
     # lr = 0: nothing moves, so the fine-tuned weights are the ones it started from.
-    same, _ = train(TINY_DATA, TINY, TrainConfig(**{**cfg.__dict__, "lr": 0.0, "init": str(first)}), tmp_path / "b",
-                    progress=False)
+    same, _ = train(
+        TINY_DATA,
+        TINY,
+        TrainConfig(**{**cfg.__dict__, "lr": 0.0, "init": str(first)}),
+        tmp_path / "b",
+        progress=False,
+    )
     a, b = weights.load(first)[0], weights.load(same)[0]
     assert all(torch.allclose(a[k], b[k], atol=1e-6) for k in a)
     other = NetConfig(**{**TINY.to_dict(), "widths": (4, 8, 8, 16)})
     with pytest.raises(PhysbenchError, match="architecture"):
-        train(TINY_DATA, other, TrainConfig(**{**cfg.__dict__, "init": str(first)}), tmp_path / "c", progress=False)
+        train(
+            TINY_DATA,
+            other,
+            TrainConfig(**{**cfg.__dict__, "init": str(first)}),
+            tmp_path / "c",
+            progress=False,
+        )

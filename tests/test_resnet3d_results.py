@@ -25,7 +25,9 @@ RESULTS = ROOT / "results" / "resnet3d"
 def _table_module() -> ModuleType:
     if "resnet3d_table" in sys.modules:
         return sys.modules["resnet3d_table"]
-    spec = importlib.util.spec_from_file_location("resnet3d_table", ROOT / "benchmarks" / "resnet3d_table.py")
+    spec = importlib.util.spec_from_file_location(
+        "resnet3d_table", ROOT / "benchmarks" / "resnet3d_table.py"
+    )
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     sys.modules["resnet3d_table"] = module
@@ -38,11 +40,18 @@ def results() -> pd.DataFrame:
     return pd.read_parquet(RESULTS / "results.parquet")
 
 
-def _resnet3d_after_11(results: pd.DataFrame, scene: str, params: frozenset[str], blur: float) -> pd.DataFrame:
+def _resnet3d_after_11(
+    results: pd.DataFrame, scene: str, params: frozenset[str], blur: float
+) -> pd.DataFrame:
     """The learned estimator's rows after 11 iterations for one Table 1 row (all bodies unknown)."""
-    return results[(results.estimator_name == "resnet3d") & (results.scene == scene) & (results.bodies == "all")
-                   & (results.blur == blur) & (results.iteration == 10)
-                   & (results.unknowns.map(lambda u: frozenset(u.split("+"))) == params)]
+    return results[
+        (results.estimator_name == "resnet3d")
+        & (results.scene == scene)
+        & (results.bodies == "all")
+        & (results.blur == blur)
+        & (results.iteration == 10)
+        & (results.unknowns.map(lambda u: frozenset(u.split("+"))) == params)
+    ]
 
 
 def test_committed_table_is_generated_from_the_committed_results() -> None:
@@ -52,7 +61,9 @@ def test_committed_table_is_generated_from_the_committed_results() -> None:
     )
 
 
-def test_every_table1_row_ran_on_at_least_ten_held_out_seeds_without_failures(results: pd.DataFrame) -> None:
+def test_every_table1_row_ran_on_at_least_ten_held_out_seeds_without_failures(
+    results: pd.DataFrame,
+) -> None:
     assert (results.status == "ok").all()
     for scene, params in PAPER:
         for blur in (0.0, 3.0):
@@ -62,13 +73,19 @@ def test_every_table1_row_ran_on_at_least_ten_held_out_seeds_without_failures(re
             assert rows.seed.max() < 2**24
 
 
-@pytest.mark.parametrize("row", sorted(PAPER, key=str), ids=lambda r: f"{r[0]}-{'+'.join(sorted(r[1]))}")
-def test_resnet3d_is_at_or_below_the_papers_nn_after_11_iterations(results: pd.DataFrame, row: tuple) -> None:
+@pytest.mark.parametrize(
+    "row", sorted(PAPER, key=str), ids=lambda r: f"{r[0]}-{'+'.join(sorted(r[1]))}"
+)
+def test_resnet3d_is_at_or_below_the_papers_nn_after_11_iterations(
+    results: pd.DataFrame, row: tuple
+) -> None:
     sel = _resnet3d_after_11(results, *row, 0.0)
     assert len(sel) and sel.best_nmse.mean() <= PAPER[row]["NN"][0]
 
 
-def test_resnet3d_beats_every_gradient_free_estimator_on_every_table1_row(results: pd.DataFrame) -> None:
+def test_resnet3d_beats_every_gradient_free_estimator_on_every_table1_row(
+    results: pd.DataFrame,
+) -> None:
     at11 = results[(results.iteration == 10) & (results.blur == 0) & (results.bodies == "all")]
     means = at11.groupby(["scene", "unknowns", "estimator_name"]).best_nmse.mean().unstack()
     assert {"tpe", "cmaes", "optuna"} <= set(means.columns)

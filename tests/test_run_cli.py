@@ -21,7 +21,18 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
 
 
 def test_table_and_final_line(capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, _ = run(capsys, "--estimator", "tpe", "--scene", "three_circles", "--params", "mass", *FAST, "--seed", "1")
+    code, out, _ = run(
+        capsys,
+        "--estimator",
+        "tpe",
+        "--scene",
+        "three_circles",
+        "--params",
+        "mass",
+        *FAST,
+        "--seed",
+        "1",
+    )
     assert code == 0
     lines = out.splitlines()
     assert lines[0].split()[:4] == ["iter", "a.mass", "b.mass", "image"]
@@ -37,11 +48,24 @@ def test_quiet_prints_only_the_final_line(capsys: pytest.CaptureFixture[str]) ->
 
 
 def test_json_history_is_reproducible(capsys: pytest.CaptureFixture[str]) -> None:
-    argv = ("--estimator", "optuna", "--params", "mass", "elasticity", *FAST, "--json", "-q", "--seed", "2")
+    argv = (
+        "--estimator",
+        "optuna",
+        "--params",
+        "mass",
+        "elasticity",
+        *FAST,
+        "--json",
+        "-q",
+        "--seed",
+        "2",
+    )
     _, out1, _ = run(capsys, *argv)
     _, out2, _ = run(capsys, *argv)
     a, b = json.loads(out1), json.loads(out2)
-    assert a["keys"] == ["a.mass", "a.elasticity", "b.mass", "b.elasticity"] and len(a["records"]) == 4
+    assert (
+        a["keys"] == ["a.mass", "a.elasticity", "b.mass", "b.elasticity"] and len(a["records"]) == 4
+    )
     assert a["min_nmse"] == a["records"][-1]["best_nmse"] and a["truth"] is not None
     for d in (a, b):
         d.pop("timings"), d["meta"].pop("t_start")
@@ -51,7 +75,9 @@ def test_json_history_is_reproducible(capsys: pytest.CaptureFixture[str]) -> Non
     assert a == b
 
 
-def test_observation_file_round_trip_and_wrong_shape(capsys: pytest.CaptureFixture[str], tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_observation_file_round_trip_and_wrong_shape(
+    capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:  # type: ignore[no-untyped-def]
     path = tmp_path / "obs.npz"
     code, _, _ = run(capsys, "--estimator", "random", *FAST, "-q", "--save-observation", str(path))
     assert code == 0 and path.exists()
@@ -60,32 +86,66 @@ def test_observation_file_round_trip_and_wrong_shape(capsys: pytest.CaptureFixtu
 
     frames = np.load(path)["frames"]
     np.savez(tmp_path / "short.npz", frames=frames[:10])
-    code, _, err = run(capsys, "--estimator", "random", *FAST, "--observation", str(tmp_path / "short.npz"))
+    code, _, err = run(
+        capsys, "--estimator", "random", *FAST, "--observation", str(tmp_path / "short.npz")
+    )
     assert code == 2
-    assert f"frames have shape (10, 2, 32, 32), expected (T, C, H, W) = {frames.shape}" in err and "T 10 != " in err
-    code, _, err = run(capsys, "--estimator", "random", "--iterations", "4", "--observation", str(path))
-    assert code == 2 and "H 32 != 64, W 32 != 64" in err  # observed at 32 px, modelled at the default 64
+    assert (
+        f"frames have shape (10, 2, 32, 32), expected (T, C, H, W) = {frames.shape}" in err
+        and "T 10 != " in err
+    )
+    code, _, err = run(
+        capsys, "--estimator", "random", "--iterations", "4", "--observation", str(path)
+    )
+    assert (
+        code == 2 and "H 32 != 64, W 32 != 64" in err
+    )  # observed at 32 px, modelled at the default 64
 
 
 def test_reality_gap_blur_and_plot(capsys: pytest.CaptureFixture[str], tmp_path) -> None:  # type: ignore[no-untyped-def]
     png = tmp_path / "conv.png"
     code, out, _ = run(
-        capsys, "--estimator", "cmaes", *FAST, "-q", "--engine", "pymunk", "--observe-engine", "box2d",
-        "--blur", "1.5", "--plot", str(png),
+        capsys,
+        "--estimator",
+        "cmaes",
+        *FAST,
+        "-q",
+        "--engine",
+        "pymunk",
+        "--observe-engine",
+        "box2d",
+        "--blur",
+        "1.5",
+        "--plot",
+        str(png),
     )
     assert code == 0 and out.startswith("normalized min MSE")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_estimator_options(capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, _ = run(capsys, "--estimator", "optuna", "-o", "sampler=random", "-o", "startup=2", *FAST, "--json", "-q")
+    code, out, _ = run(
+        capsys,
+        "--estimator",
+        "optuna",
+        "-o",
+        "sampler=random",
+        "-o",
+        "startup=2",
+        *FAST,
+        "--json",
+        "-q",
+    )
     assert code == 0 and json.loads(out)["options"] == {"sampler": "random", "startup": 2}
 
 
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--estimator", "nope"], "unknown estimator 'nope'; known estimators: cmaes, optuna, random, resnet3d"),
+        (
+            ["--estimator", "nope"],
+            "unknown estimator 'nope'; known estimators: cmaes, optuna, random, resnet3d",
+        ),
         (["--scene", "no_such_scene"], "unknown scene 'no_such_scene'"),
         (["--params", "friction"], "unknown parameter 'friction' of scene 'three_circles'"),
         (["--iterations", "0"], "--iterations 0: expected a whole number >= 1"),

@@ -85,28 +85,52 @@ def test_builtin_scene_round_trip_is_exact(name: str, seed: int, tmp_path: Path)
 
 # (replace this, with that, expected key, expected line, message fragment)
 BAD = [
-    ('radius = 0.3 }', 'radius = -0.3 }', "bodies[0].shape.radius", 11, "must be > 0"),
-    ('kind = "circle"', 'kind = "ellipse"', "bodies[0].shape.kind", 11, "unknown shape; known: circle, box, polygon"),
+    ("radius = 0.3 }", "radius = -0.3 }", "bodies[0].shape.radius", 11, "must be > 0"),
+    (
+        'kind = "circle"',
+        'kind = "ellipse"',
+        "bodies[0].shape.kind",
+        11,
+        "unknown shape; known: circle, box, polygon",
+    ),
     ("mass = 5.0", "mass = -2.0", "bodies[0].mass", 13, "mass must be > 0"),
     ("elasticity = 0.4", "elasticity = 1.5", "bodies[1].elasticity", 20, "must lie in [0.0, 1.0]"),
     ("friction = 0.6", "friction = -0.1", "bodies[1].friction", 21, "must lie in"),
-    ("position = [1.0, 2.0]", "position = [9.0, 2.0]", "bodies[0].position", 12, "inside the world bounds"),
+    (
+        "position = [1.0, 2.0]",
+        "position = [9.0, 2.0]",
+        "bodies[0].position",
+        12,
+        "inside the world bounds",
+    ),
     ("position = [1.0, 2.0]", "position = [1.0]", "bodies[0].position", 12, "pair of numbers"),
     ('name = "a"', 'name = "test"', "bodies[1].name", 16, "duplicate body name"),
     ("frames = 20", "frames = 0", "frames", 5, "whole number >= 1"),
     ("fps = 30.0", "fps = -30.0", "fps", 4, "must be > 0"),
     ("bounds = [0.0, 0.0, 4.0, 4.0]", "bounds = [4.0, 0.0, 0.0, 4.0]", "bounds", 2, "min < max"),
     ('test_body = "test"', 'test_body = "nobody"', "test_body", 7, "no such body"),
-    ("mass = 3.0", "mass = 3.0\ncolour = \"red\"", "bodies[1].colour", 20, "unknown key"),
-    ('param = "mass"', 'param = "colour"', "unknowns[0].param", 45, "unknown parameter; known: mass"),
+    ("mass = 3.0", 'mass = 3.0\ncolour = "red"', "bodies[1].colour", 20, "unknown key"),
+    (
+        'param = "mass"',
+        'param = "colour"',
+        "unknowns[0].param",
+        45,
+        "unknown parameter; known: mass",
+    ),
     ("range = [1.0, 10.0]", "range = [10.0, 1.0]", "unknowns[0].range", 46, "low < high"),
     ("range = [1.0, 10.0]", "range = [-1.0, 10.0]", "unknowns[0].range[0]", 46, "mass must be > 0"),
     ('body = "a"\nparam', 'body = "ghost"\nparam', "unknowns[0].body", 44, "no such body"),
     ("end = 0.2", "end = 0.0", "forces[0].end", 37, "end > start"),
     ('body = "test"\nvector', 'body = "ghost"\nvector', "forces[0].body", 34, "no such body"),
     ('a = "tri"', 'a = "ghost"', "joints[0].a", 40, "no such body"),
-    ("[-0.2, -0.2], [0.2, -0.2], [0.0, 0.3]", "[0.0, 0.3], [0.2, -0.2], [-0.2, -0.2]", "bodies[2].shape.points", 25, "convex"),
-    ('b = [4.0, 0.0]', 'b = [0.0, 0.0]', "statics[0].b", 31, "end points must differ"),
+    (
+        "[-0.2, -0.2], [0.2, -0.2], [0.0, 0.3]",
+        "[0.0, 0.3], [0.2, -0.2], [-0.2, -0.2]",
+        "bodies[2].shape.points",
+        25,
+        "convex",
+    ),
+    ("b = [4.0, 0.0]", "b = [0.0, 0.0]", "statics[0].b", 31, "end points must differ"),
     ('kind = "segment"', 'kind = "circle"', "statics[0].kind", 29, "unknown static kind"),
     ("gravity = [0.0, -9.81]", 'gravity = "down"', "gravity", 3, "pair of numbers"),
     ("substeps = 8", "substeps = 2.5", "substeps", 6, "whole number"),
@@ -114,8 +138,12 @@ BAD = [
 ]
 
 
-@pytest.mark.parametrize(("old", "new", "key", "line", "fragment"), BAD, ids=[b[2] + ":" + b[4][:18] for b in BAD])
-def test_bad_scene_file_names_key_value_and_line(old: str, new: str, key: str, line: int, fragment: str) -> None:
+@pytest.mark.parametrize(
+    ("old", "new", "key", "line", "fragment"), BAD, ids=[b[2] + ":" + b[4][:18] for b in BAD]
+)
+def test_bad_scene_file_names_key_value_and_line(
+    old: str, new: str, key: str, line: int, fragment: str
+) -> None:
     assert old in GOOD
     text = GOOD.replace(old, new, 1)
     with pytest.raises(SceneError) as info:

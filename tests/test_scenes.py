@@ -100,7 +100,9 @@ def observability(cid: str, engine: str) -> dict[str, Any]:
         base = sim.simulate(scene, p)
         for body in space.bodies:
             xy = base.body(body)[:, :2]
-            disp.setdefault(body, []).append((seed, float(np.linalg.norm(xy - xy[0], axis=1).max())))
+            disp.setdefault(body, []).append(
+                (seed, float(np.linalg.norm(xy - xy[0], axis=1).max()))
+            )
         for u in space.unknowns:
             ref = renderer.render(scene, base, focus=u.body)
             changes = []
@@ -118,7 +120,14 @@ def test_registered() -> None:
     from physbench.plugins import get_registry
 
     names = set(get_registry().names("scene"))
-    for name in ("three_circles", "second_order", "stacked_boxes", "bouncing_balls", "pendulum", "ball_drop"):
+    for name in (
+        "three_circles",
+        "second_order",
+        "stacked_boxes",
+        "bouncing_balls",
+        "pendulum",
+        "ball_drop",
+    ):
         assert name in names
         gen = get_registry().get("scene", name)
         assert gen.name == name and gen.description
@@ -172,7 +181,11 @@ def test_pendulum_matches_the_rig(rig: str) -> None:
         phi = st[:, 2]  # deflection from hanging down
         up = np.flatnonzero((phi[:-1] < 0) & (phi[1:] >= 0))  # upward zero crossings
         t = (up + phi[up] / (phi[up] - phi[up + 1])) / scene.fps
-        assert len(t) >= 2 and abs(np.diff(t).mean() / period - 1) < 2e-3, (engine, np.diff(t), period)
+        assert len(t) >= 2 and abs(np.diff(t).mean() / period - 1) < 2e-3, (
+            engine,
+            np.diff(t),
+            period,
+        )
 
 
 def test_ball_drop_matches_data_units() -> None:
@@ -206,15 +219,27 @@ def test_bouncing_balls_counts() -> None:
 @pytest.mark.parametrize("cid", PAPER_IDS)
 def test_unknown_bodies_move_clearly(cid: str, engine: str) -> None:
     disp = observability(cid, engine)["disp"]
-    bad = [(body, seed, round(d, 3)) for body, ds in disp.items() for seed, d in ds if d < MIN_DISPLACEMENT]
-    assert not bad, f"{cid}/{engine}: (body, seed, displacement m) below {MIN_DISPLACEMENT} m: {bad}"
+    bad = [
+        (body, seed, round(d, 3))
+        for body, ds in disp.items()
+        for seed, d in ds
+        if d < MIN_DISPLACEMENT
+    ]
+    assert not bad, (
+        f"{cid}/{engine}: (body, seed, displacement m) below {MIN_DISPLACEMENT} m: {bad}"
+    )
 
 
 @pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("cid", PAPER_IDS)
 def test_ten_percent_changes_the_video(cid: str, engine: str) -> None:
     pix = observability(cid, engine)["pix"]
-    bad = [(key, seed, round(c, 1)) for key, cs in pix.items() for seed, c in cs if c < MIN_PIXEL_CHANGE]
+    bad = [
+        (key, seed, round(c, 1))
+        for key, cs in pix.items()
+        for seed, c in cs
+        if c < MIN_PIXEL_CHANGE
+    ]
     assert not bad, f"{cid}/{engine}: (unknown, seed, pixel change) below {MIN_PIXEL_CHANGE}: {bad}"
 
 

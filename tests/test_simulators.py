@@ -103,7 +103,14 @@ def test_slow_bodies_never_sleep(sim: SteppingSimulator) -> None:
 def test_angle_is_ccw_and_velocities_match_finite_differences(sim: SteppingSimulator) -> None:
     """Positive ω turns counter-clockwise (y up); reported velocities are those of the shape
     centre, also when the centre of mass is elsewhere."""
-    body = Body("b", Box(0.4, 0.2), (2.0, 2.0), velocity=(0.5, -0.2), angular_velocity=2.0, com_offset=(0.1, 0.05))
+    body = Body(
+        "b",
+        Box(0.4, 0.2),
+        (2.0, 2.0),
+        velocity=(0.5, -0.2),
+        angular_velocity=2.0,
+        com_offset=(0.1, 0.05),
+    )
     scene = Scene("spin", (body,), gravity=(0.0, 0.0), fps=60, frames=61)
     tr = sim.simulate(scene)
     t, s = tr.times, tr.body("b")
@@ -134,7 +141,9 @@ def test_angle_is_ccw_and_velocities_match_finite_differences(sim: SteppingSimul
     [(1.0, 3.0, 1.0, 1.0), (2.0, 0.5, 1.0, 1.0), (1.0, 3.0, 0.8, 0.5)],
     ids=["elastic_light_heavy", "elastic_heavy_light", "restitution_product"],
 )
-def test_head_on_collision(sim: SteppingSimulator, m1: float, m2: float, e1: float, e2: float) -> None:
+def test_head_on_collision(
+    sim: SteppingSimulator, m1: float, m2: float, e1: float, e2: float
+) -> None:
     u1, u2 = 2.0, -1.0
     scene = Scene(
         "collide",
@@ -219,7 +228,11 @@ def test_sliding_friction_is_product(sim: SteppingSimulator, floor_kind: str) ->
     )
     scene = Scene(
         "slide",
-        (Body("box", Box(0.4, 0.2), (1.0, 0.1), velocity=(4.0, 0.0), friction=0.5, elasticity=0.0),),
+        (
+            Body(
+                "box", Box(0.4, 0.2), (1.0, 0.1), velocity=(4.0, 0.0), friction=0.5, elasticity=0.0
+            ),
+        ),
         statics=(floor,),
         bounds=(0.0, -1.0, 10.0, 3.0),
         frames=31,
@@ -311,7 +324,9 @@ def test_com_offset_and_moment_are_honoured(sim: SteppingSimulator, moment: floa
     """A box pivoted at its shape centre with its CoM 0.3 m off swings as a physical pendulum,
     T = 2π√(I_pivot / (m g d)); the trajectory reports the (fixed) shape centre."""
     d, th0 = 0.3, 0.05
-    box = Body("b", Box(0.8, 0.8), (2.0, 2.0), angle=th0, mass=2.0, com_offset=(0.0, -d), moment=moment)
+    box = Body(
+        "b", Box(0.8, 0.8), (2.0, 2.0), angle=th0, mass=2.0, com_offset=(0.0, -d), moment=moment
+    )
     scene = Scene("physical_pendulum", (box,), joints=(Joint("b", (2.0, 2.0)),), fps=60, frames=301)
     tr = sim.simulate(scene)
     s = tr.body("b")
@@ -368,7 +383,9 @@ def test_force_window_and_impulse(sim: SteppingSimulator, t0: float, t1: float) 
     before = tr.times <= min(t0, 0.5)
     assert np.abs(s[before, 3:5]).max() == 0.0  # nothing acts before its start
     at = round(0.5 * scene.fps)
-    assert s[at + 1, 4] - s[at, 4] == pytest.approx((J[1] + F[1] * _overlap(t0, t1, 0.5, 0.5 + scene.dt)) / m, abs=1e-6)
+    assert s[at + 1, 4] - s[at, 4] == pytest.approx(
+        (J[1] + F[1] * _overlap(t0, t1, 0.5, 0.5 + scene.dt)) / m, abs=1e-6
+    )
 
 
 def _overlap(a0: float, a1: float, b0: float, b1: float) -> float:
@@ -465,7 +482,10 @@ def test_nan_impulse_raises(sim: SteppingSimulator) -> None:
 
 
 def test_box2d_polygon_vertex_limit_raises() -> None:
-    pts = tuple((0.2 * math.cos(2 * math.pi * i / 20), 0.2 * math.sin(2 * math.pi * i / 20)) for i in range(20))
+    pts = tuple(
+        (0.2 * math.cos(2 * math.pi * i / 20), 0.2 * math.sin(2 * math.pi * i / 20))
+        for i in range(20)
+    )
     scene = Scene("many", (Body("poly", Polygon(pts), (2.0, 2.0)),))
     assert PymunkSimulator().simulate(scene).frames == 30
     with pytest.raises(SimulationError, match="b2_maxPolygonVertices") as info:
@@ -480,7 +500,12 @@ def _busy_scene() -> Scene:
     bodies = (
         Body("a", Circle(0.3), (1.0, 2.5), velocity=(3.0, 0.0), elasticity=0.7, friction=0.4),
         Body("b", Box(0.5, 0.4), (2.0, 0.3), angle=0.1, mass=2.0, elasticity=0.3),
-        Body("c", Polygon(((-0.2, -0.2), (0.3, -0.2), (0.0, 0.3))), (3.0, 1.0), com_offset=(0.05, 0.0)),
+        Body(
+            "c",
+            Polygon(((-0.2, -0.2), (0.3, -0.2), (0.0, 0.3))),
+            (3.0, 1.0),
+            com_offset=(0.05, 0.0),
+        ),
     )
     return Scene(
         "busy",

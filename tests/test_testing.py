@@ -109,7 +109,9 @@ def test_a_correct_estimator_passes() -> None:
 
 
 def test_out_of_range_proposals_fail() -> None:
-    with pytest.raises(ConformanceError, match=r"proposed a.mass = 15.0 .*expected a finite number in \[1, 10\]"):
+    with pytest.raises(
+        ConformanceError, match=r"proposed a.mass = 15.0 .*expected a finite number in \[1, 10\]"
+    ):
         check_respects_ranges(OutOfRange)
     with pytest.raises(ConformanceError, match=r"missing \['a.mass'\]"):
         check_respects_ranges(DropsAKey)
@@ -144,9 +146,13 @@ def test_protocol_shape() -> None:
 
 
 def test_unclear_errors_fail() -> None:
-    with pytest.raises(ConformanceError, match="unknown option 'no_such_option_xyz' was accepted silently"):
+    with pytest.raises(
+        ConformanceError, match="unknown option 'no_such_option_xyz' was accepted silently"
+    ):
         check_bad_input(SwallowsOptions)
-    with pytest.raises(ConformanceError, match="propose\\(\\) before start\\(\\) raised AttributeError"):
+    with pytest.raises(
+        ConformanceError, match="propose\\(\\) before start\\(\\) raised AttributeError"
+    ):
         check_bad_input(CrashesBeforeStart)
     with pytest.raises(ConformanceError, match=r"bad options \{'width': -1\} were accepted"):
         check_bad_input(AcceptsBadWidth, [{"width": -1}])
@@ -155,7 +161,9 @@ def test_unclear_errors_fail() -> None:
 def test_check_estimator_lists_every_failure() -> None:
     with pytest.raises(ConformanceError) as info:
         check_estimator(Unseeded, subprocess=False)
-    assert "fails 1 conformance check(s)" in str(info.value) and "- deterministic:" in str(info.value)
+    assert "fails 1 conformance check(s)" in str(info.value) and "- deterministic:" in str(
+        info.value
+    )
     with pytest.raises(ConformanceError, match=r"fails 2 conformance check\(s\)"):
         check_estimator(UnseededOutOfRange, subprocess=False)
 

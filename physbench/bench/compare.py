@@ -75,7 +75,9 @@ def holm(p: Sequence[float]) -> np.ndarray:
     return adj
 
 
-def compare(new: pd.DataFrame, base: pd.DataFrame, *, alpha: float = ALPHA, min_ratio: float = MIN_RATIO) -> Comparison:
+def compare(
+    new: pd.DataFrame, base: pd.DataFrame, *, alpha: float = ALPHA, min_ratio: float = MIN_RATIO
+) -> Comparison:
     """Match the final rows of two long tables and test every configuration (see module doc)."""
     import pandas as pd
 
@@ -87,7 +89,10 @@ def compare(new: pd.DataFrame, base: pd.DataFrame, *, alpha: float = ALPHA, min_
     a = final_rows(new)[[*cols, "status", "best_nmse"]]
     b = final_rows(base)[[*cols, "status", "best_nmse"]]
     m = a.merge(b, on=cols, how="outer", suffixes=("_new", "_base"), indicator=True)
-    only_new, only_base = int((m["_merge"] == "left_only").sum()), int((m["_merge"] == "right_only").sum())
+    only_new, only_base = (
+        int((m["_merge"] == "left_only").sum()),
+        int((m["_merge"] == "right_only").sum()),
+    )
     m = m[m["_merge"] == "both"]
     if m.empty:
         raise PhysbenchError(
@@ -100,19 +105,30 @@ def compare(new: pd.DataFrame, base: pd.DataFrame, *, alpha: float = ALPHA, min_
         d = np.log(np.maximum(ok["best_nmse_new"].to_numpy(float), FLOOR)) - np.log(
             np.maximum(ok["best_nmse_base"].to_numpy(float), FLOOR)
         )
-        rows.append({
-            **dict(zip(CONFIG, key, strict=True)), "matched": len(g), "compared": int(d.size),
-            "failed_new": int((g["status_new"] != "ok").sum()), "failed_base": int((g["status_base"] != "ok").sum()),
-            "mean_new": float(ok["best_nmse_new"].mean()) if d.size else math.nan,
-            "mean_base": float(ok["best_nmse_base"].mean()) if d.size else math.nan,
-            "gm_ratio": float(np.exp(d.mean())) if d.size else math.nan,
-            "worse_seeds": int((d > 0).sum()), "better_seeds": int((d < 0).sum()),
-            "p_worse": _p_greater(d) if d.size else 1.0, "p_better": _p_greater(-d) if d.size else 1.0,
-            "identical": bool(d.size) and not np.any(d),
-        })
+        rows.append(
+            {
+                **dict(zip(CONFIG, key, strict=True)),
+                "matched": len(g),
+                "compared": int(d.size),
+                "failed_new": int((g["status_new"] != "ok").sum()),
+                "failed_base": int((g["status_base"] != "ok").sum()),
+                "mean_new": float(ok["best_nmse_new"].mean()) if d.size else math.nan,
+                "mean_base": float(ok["best_nmse_base"].mean()) if d.size else math.nan,
+                "gm_ratio": float(np.exp(d.mean())) if d.size else math.nan,
+                "worse_seeds": int((d > 0).sum()),
+                "better_seeds": int((d < 0).sum()),
+                "p_worse": _p_greater(d) if d.size else 1.0,
+                "p_better": _p_greater(-d) if d.size else 1.0,
+                "identical": bool(d.size) and not np.any(d),
+            }
+        )
     t = pd.DataFrame(rows)
     t["p_worse_holm"], t["p_better_holm"] = holm(t["p_worse"]), holm(t["p_better"])
-    worse = (t["failed_new"] > t["failed_base"]) | ((t["p_worse_holm"] < alpha) & (t["gm_ratio"] >= min_ratio))
+    worse = (t["failed_new"] > t["failed_base"]) | (
+        (t["p_worse_holm"] < alpha) & (t["gm_ratio"] >= min_ratio)
+    )
     better = ~worse & (t["p_better_holm"] < alpha) & (t["gm_ratio"] <= 1 / min_ratio)
-    t["verdict"] = np.where(worse, "worse", np.where(better, "better", np.where(t.pop("identical"), "identical", "ok")))
+    t["verdict"] = np.where(
+        worse, "worse", np.where(better, "better", np.where(t.pop("identical"), "identical", "ok"))
+    )
     return Comparison(t, only_new, only_base)

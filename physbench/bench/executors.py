@@ -72,7 +72,9 @@ class ProcessExecutor:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        self._pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"))
+        self._pool = ProcessPoolExecutor(
+            self.workers, mp_context=multiprocessing.get_context("spawn")
+        )
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -125,11 +127,20 @@ class DaskExecutor:
         try:
             if self.address:
                 self._client = Client(self.address, timeout="20s")
-                self.workers = max(1, sum(w.get("nthreads", 1) for w in self._client.scheduler_info()["workers"].values()))
+                self.workers = max(
+                    1,
+                    sum(
+                        w.get("nthreads", 1)
+                        for w in self._client.scheduler_info()["workers"].values()
+                    ),
+                )
             else:
                 self._cluster = LocalCluster(
-                    n_workers=self.workers, threads_per_worker=1, processes=True,
-                    dashboard_address=None, silence_logs=logging.ERROR,
+                    n_workers=self.workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=logging.ERROR,
                 )
                 self._client = Client(self._cluster)
         except OSError as exc:
@@ -172,11 +183,15 @@ def make_executor(name: str, *, workers: int | None = None, address: str | None 
     if workers is not None and (isinstance(workers, bool) or workers < 1):
         raise PhysbenchError(f"--workers {workers}: expected a whole number >= 1")
     if address and name != "dask":
-        raise PhysbenchError(f"--address {address!r} names a Dask scheduler; it needs --executor dask (got {name!r})")
+        raise PhysbenchError(
+            f"--address {address!r} names a Dask scheduler; it needs --executor dask (got {name!r})"
+        )
     if name == "serial":
         return SerialExecutor()
     if name == "processes":
         return ProcessExecutor(workers)
     if name == "dask":
         return DaskExecutor(address, workers)
-    raise PhysbenchError(f"--executor {name!r}: unknown executor; known executors: {', '.join(NAMES)}")
+    raise PhysbenchError(
+        f"--executor {name!r}: unknown executor; known executors: {', '.join(NAMES)}"
+    )

@@ -33,7 +33,17 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 #: Settings that split figures (everything in a configuration but unknowns and estimator).
-SETTINGS = ("scene", "bodies", "engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
+SETTINGS = (
+    "scene",
+    "bodies",
+    "engine",
+    "observe_engine",
+    "blur",
+    "noise",
+    "resolution",
+    "render_mode",
+    "iterations",
+)
 DPI = 90
 
 
@@ -62,7 +72,12 @@ def _varying(df: pd.DataFrame) -> list[str]:
 
 
 def _name(prefix: str, cfg: dict[str, Any], varying: Sequence[str], extra: str = "") -> str:
-    parts = [prefix, str(cfg["scene"]), *(f"{c}{cfg[c]}" for c in varying), *([extra] if extra else [])]
+    parts = [
+        prefix,
+        str(cfg["scene"]),
+        *(f"{c}{cfg[c]}" for c in varying),
+        *([extra] if extra else []),
+    ]
     return re.sub(r"[^A-Za-z0-9_.+-]+", "-", "_".join(parts)) + ".png"
 
 
@@ -100,15 +115,26 @@ def convergence(df: pd.DataFrame, out: Path) -> list[Path]:
         for ax, unknowns in zip(axes[0], sets, strict=True):
             sub = rows[rows["unknowns"] == unknowns]
             for est, er in _groups(sub, ["estimator"]):
-                y = er.pivot_table(index="seed", columns="iteration", values="best_nmse").to_numpy(dtype=float)
+                y = er.pivot_table(index="seed", columns="iteration", values="best_nmse").to_numpy(
+                    dtype=float
+                )
                 x = np.arange(1, y.shape[1] + 1)
                 lo, hi = np.nanpercentile(y, [25, 75], axis=0)
-                (line,) = ax.plot(x, np.nanmean(y, axis=0), marker="o", ms=2.5, lw=1.3, label=f"{est['estimator']}")
+                (line,) = ax.plot(
+                    x,
+                    np.nanmean(y, axis=0),
+                    marker="o",
+                    ms=2.5,
+                    lw=1.3,
+                    label=f"{est['estimator']}",
+                )
                 ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.15, lw=0)
             for which, style in (("NN", "--"), ("Hyperopt", ":")):
                 ref = paper_value(str(cfg["scene"]), unknowns, which)
                 if ref:
-                    ax.axhline(ref[0], color="0.35", ls=style, lw=1, label=f"paper {which} (11 it.)")
+                    ax.axhline(
+                        ref[0], color="0.35", ls=style, lw=1, label=f"paper {which} (11 it.)"
+                    )
             ax.set_yscale("log")
             ax.set_title(unknowns_label(unknowns), fontsize="medium")
             ax.set_xlabel("iterations (simulations)")
@@ -117,7 +143,10 @@ def convergence(df: pd.DataFrame, out: Path) -> list[Path]:
         axes[0, 0].set_ylabel("best-so-far normalized MSE")
         axes[0, -1].legend(fontsize="x-small", loc="upper right")
         n = rows["seed"].nunique()
-        fig.suptitle(f"{_title(cfg, varying)}: mean over {n} seeds, band = interquartile range", fontsize="medium")
+        fig.suptitle(
+            f"{_title(cfg, varying)}: mean over {n} seeds, band = interquartile range",
+            fontsize="medium",
+        )
         fig.tight_layout()
         paths.append(_save(fig, out / _name("convergence", cfg, varying)))
     return paths
@@ -161,8 +190,12 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
                 c = colors[i % len(colors)]
                 xs, ys = p[kx].to_numpy(), p[ky].to_numpy()
                 for j in range(len(xs) - 1):
-                    ax.annotate("", xy=(xs[j + 1], ys[j + 1]), xytext=(xs[j], ys[j]),
-                                arrowprops={"arrowstyle": "->", "color": c, "lw": 0.8, "alpha": 0.8})
+                    ax.annotate(
+                        "",
+                        xy=(xs[j + 1], ys[j + 1]),
+                        xytext=(xs[j], ys[j]),
+                        arrowprops={"arrowstyle": "->", "color": c, "lw": 0.8, "alpha": 0.8},
+                    )
                 ax.plot(xs[0], ys[0], "o", mfc="none", mec=c, ms=5)
                 b = int(run["best_iteration"].iloc[-1])
                 ax.plot(xs[b], ys[b], "*", color=c, ms=8, mec="k", mew=0.4)
@@ -175,7 +208,8 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
         axes[0, 0].set_ylabel(ky)
         fig.suptitle(
             f"{_title(cfg, varying)}, {unknowns_label(str(cfg['unknowns']))}: seeds {', '.join(map(str, chosen))} "
-            "(hollow: start, star: best by image MSE, filled: truth)", fontsize="small",
+            "(hollow: start, star: best by image MSE, filled: truth)",
+            fontsize="small",
         )
         fig.tight_layout()
         paths.append(_save(fig, out / _name("trajectories", cfg, varying, str(cfg["unknowns"]))))
@@ -183,8 +217,14 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
 
 
 def landscape_data(
-    scene: str, param: str, *, engine: str = "pymunk", resolution: int = 64, render_mode: str = "mark",
-    seeds: Sequence[int] = (0, 1, 2), points: int = 21,
+    scene: str,
+    param: str,
+    *,
+    engine: str = "pymunk",
+    resolution: int = 64,
+    render_mode: str = "mark",
+    seeds: Sequence[int] = (0, 1, 2),
+    points: int = 21,
 ) -> dict[str, np.ndarray]:
     """Image MSE between the scene at nominal parameters and the scene with one unknown
     ``body.param`` moved across its range, per key: ``{"x": Δp grid (points,), key: (seeds, points)}``,
@@ -208,7 +248,9 @@ def landscape_data(
             row = out.setdefault(u.key, np.full((len(seeds), points), np.nan))
             for j, d in enumerate(grid):
                 try:
-                    frames = ren.render(sc, sim.simulate(sc, {**nominal, u.key: nominal[u.key] + d}))
+                    frames = ren.render(
+                        sc, sim.simulate(sc, {**nominal, u.key: nominal[u.key] + d})
+                    )
                     row[si, j] = image_mse(frames, obs)
                 except Exception:  # an exploding simulation leaves a gap in the curve
                     pass
@@ -223,17 +265,33 @@ def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) 
     engine, res, mode = str(first["engine"]), int(first["resolution"]), str(first["render_mode"])
     paths = []
     for scene in dict.fromkeys(df.sort_values("cell_index")["scene"]):
-        params = list(dict.fromkeys(p for u in df.loc[df["scene"] == scene, "unknowns"] for p in u.split("+")))
+        params = list(
+            dict.fromkeys(p for u in df.loc[df["scene"] == scene, "unknowns"] for p in u.split("+"))
+        )
         fig, axes = plt.subplots(1, len(params), figsize=(4 * len(params), 3.2), squeeze=False)
         try:
             for ax, param in zip(axes[0], params, strict=True):
-                data = landscape_data(str(scene), param, engine=engine, resolution=res, render_mode=mode,
-                                      seeds=range(seeds), points=points)
+                data = landscape_data(
+                    str(scene),
+                    param,
+                    engine=engine,
+                    resolution=res,
+                    render_mode=mode,
+                    seeds=range(seeds),
+                    points=points,
+                )
                 x = data.pop("x")
                 for key, y in data.items():
                     (line,) = ax.plot(x, np.nanmean(y, axis=0), lw=1.3, label=key)
                     if y.shape[0] > 1:
-                        ax.fill_between(x, np.nanmin(y, axis=0), np.nanmax(y, axis=0), color=line.get_color(), alpha=0.15, lw=0)
+                        ax.fill_between(
+                            x,
+                            np.nanmin(y, axis=0),
+                            np.nanmax(y, axis=0),
+                            color=line.get_color(),
+                            alpha=0.15,
+                            lw=0,
+                        )
                 ax.axvline(0, color="0.5", ls="--", lw=0.8)
                 ax.set_xlabel(f"Δ{param} from nominal")
                 ax.set_title(param, fontsize="medium")
@@ -243,10 +301,14 @@ def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) 
             plt.close(fig)
             continue
         axes[0, 0].set_ylabel("image MSE vs nominal")
-        fig.suptitle(f"{scene_label(str(scene))}: image-MSE landscape ({engine}, {res} px, mean of {seeds} scene instances)",
-                     fontsize="medium")
+        fig.suptitle(
+            f"{scene_label(str(scene))}: image-MSE landscape ({engine}, {res} px, mean of {seeds} scene instances)",
+            fontsize="medium",
+        )
         fig.tight_layout()
-        paths.append(_save(fig, out / f"landscape_{re.sub(r'[^A-Za-z0-9_.-]+', '-', str(scene))}.png"))
+        paths.append(
+            _save(fig, out / f"landscape_{re.sub(r'[^A-Za-z0-9_.-]+', '-', str(scene))}.png")
+        )
     return paths
 
 
@@ -263,7 +325,14 @@ def win_rate(df: pd.DataFrame, out: Path) -> list[Path]:
         for j in range(len(wr)):
             v = wr.iat[i, j]
             if np.isfinite(v):
-                ax.text(j, i, f"{100 * v:.0f}%\n(n={int(n.iat[i, j])})", ha="center", va="center", fontsize="x-small")
+                ax.text(
+                    j,
+                    i,
+                    f"{100 * v:.0f}%\n(n={int(n.iat[i, j])})",
+                    ha="center",
+                    va="center",
+                    fontsize="x-small",
+                )
     ax.set_xticks(range(len(wr)), wr.columns, rotation=30, ha="right")
     ax.set_yticks(range(len(wr)), wr.index)
     ax.set_xlabel("opponent")
@@ -273,10 +342,15 @@ def win_rate(df: pd.DataFrame, out: Path) -> list[Path]:
     return [_save(fig, out / "win_rate.png")]
 
 
-def plot_all(df: pd.DataFrame, out: Path, *, seeds: int = 3, landscape_seeds: int = 3) -> dict[str, list[Path]]:
+def plot_all(
+    df: pd.DataFrame, out: Path, *, seeds: int = 3, landscape_seeds: int = 3
+) -> dict[str, list[Path]]:
     """Every figure into ``out`` (created); ``landscape_seeds=0`` skips the simulating one."""
     out.mkdir(parents=True, exist_ok=True)
-    figs = {"convergence": convergence(df, out), "trajectories": trajectories(df, out, seeds=seeds),
-            "win rate": win_rate(df, out)}
+    figs = {
+        "convergence": convergence(df, out),
+        "trajectories": trajectories(df, out, seeds=seeds),
+        "win rate": win_rate(df, out),
+    }
     figs["landscape"] = landscape(df, out, seeds=landscape_seeds) if landscape_seeds else []
     return figs

@@ -30,7 +30,9 @@ def _table(df: pd.DataFrame) -> str:
 
 def _img(path: Path) -> str:
     data = base64.b64encode(path.read_bytes()).decode()
-    return f'<figure><img alt="{html.escape(path.name)}" src="data:image/png;base64,{data}"></figure>'
+    return (
+        f'<figure><img alt="{html.escape(path.name)}" src="data:image/png;base64,{data}"></figure>'
+    )
 
 
 def build(
@@ -53,38 +55,58 @@ def build(
     )
 
     st = stats(df)
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>",
-             f"<style>{CSS}</style></head><body><h1>{html.escape(title)}</h1>"]
+    parts = [
+        f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>",
+        f"<style>{CSS}</style></head><body><h1>{html.escape(title)}</h1>",
+    ]
     fin = final_rows(df)
     cells, failed = len(fin), int((fin["status"] != "ok").sum())
     iters = ", ".join(str(i) for i in dict.fromkeys(st["iterations"]))
-    parts.append(f"<p>{cells} cells ({failed} failed), {fin['seed'].nunique()} seeds, {iters} iterations. "
-                 "Score: normalized min MSE of the best-by-image-MSE iterate (the paper's Table 1 metric).</p>")
+    parts.append(
+        f"<p>{cells} cells ({failed} failed), {fin['seed'].nunique()} seeds, {iters} iterations. "
+        "Score: normalized min MSE of the best-by-image-MSE iterate (the paper's Table 1 metric).</p>"
+    )
     if run_log:
         runs = run_log.get("runs", [])
         rows = "".join(
             f"<tr><td>{html.escape(str(r.get('started')))}</td><td>{html.escape(str(r.get('executor')))}</td>"
-            f"<td>{r.get('ran')}</td><td>{r.get('skipped')}</td><td>{r.get('wall_s')}</td></tr>" for r in runs
+            f"<td>{r.get('ran')}</td><td>{r.get('skipped')}</td><td>{r.get('wall_s')}</td></tr>"
+            for r in runs
         )
-        parts.append("<h2>Runs</h2><table><tr><th>started</th><th>executor</th><th>cells run</th><th>skipped</th>"
-                     f"<th>wall s</th></tr>{rows}</table>")
+        parts.append(
+            "<h2>Runs</h2><table><tr><th>started</th><th>executor</th><th>cells run</th><th>skipped</th>"
+            f"<th>wall s</th></tr>{rows}</table>"
+        )
         if run_log.get("versions"):
-            parts.append(f"<p class='note'>versions: <code>{html.escape(json.dumps(run_log['versions']))}</code></p>")
-    parts += ["<h2>Table 1 layout</h2><p class='note'>mean ± sample std over seeds; paper rows: Link, Schwarz, "
-              "Behnke (IJCNN 2022), Table 1, 11 iterations, 10 seeds.</p>", _table(paper_layout(st))]
+            parts.append(
+                f"<p class='note'>versions: <code>{html.escape(json.dumps(run_log['versions']))}</code></p>"
+            )
+    parts += [
+        "<h2>Table 1 layout</h2><p class='note'>mean ± sample std over seeds; paper rows: Link, Schwarz, "
+        "Behnke (IJCNN 2022), Table 1, 11 iterations, 10 seeds.</p>",
+        _table(paper_layout(st)),
+    ]
     parts += ["<h2>Next to the paper</h2>", _table(side_by_side(st))]
-    parts += ["<h2>Per configuration</h2><p class='note'>median and 95 % percentile-bootstrap interval of the "
-              "mean over seeds.</p>", _table(detail(st))]
+    parts += [
+        "<h2>Per configuration</h2><p class='note'>median and 95 % percentile-bootstrap interval of the "
+        "mean over seeds.</p>",
+        _table(detail(st)),
+    ]
     bad = st[st["failed"] > 0]
     if len(bad):
-        parts += ["<h2>Failed cells</h2>", _table(bad[["scene", "unknowns", "estimator", "failed", "error"]])]
+        parts += [
+            "<h2>Failed cells</h2>",
+            _table(bad[["scene", "unknowns", "estimator", "failed", "error"]]),
+        ]
     wr, _ = win_rate_table(fin)
     if len(wr) > 1:
         shown = wr.map(lambda v: "-" if v != v else f"{100 * v:.0f}%")
         shown.insert(0, "estimator", wr.index)
-        parts += ["<h2>Win rate</h2><p class='note'>share of matched cells (same configuration and seed) where "
-                  "the row estimator ends with a lower normalized min MSE than the column (ties: half).</p>",
-                  _table(shown)]
+        parts += [
+            "<h2>Win rate</h2><p class='note'>share of matched cells (same configuration and seed) where "
+            "the row estimator ends with a lower normalized min MSE than the column (ties: half).</p>",
+            _table(shown),
+        ]
     for name, paths in figures.items():
         if paths:
             parts.append(f"<h2>{html.escape(name.capitalize())}</h2>")

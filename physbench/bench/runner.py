@@ -28,7 +28,18 @@ if TYPE_CHECKING:
     import pandas as pd
 
 #: Distributions whose versions are recorded with every cell (those installed).
-VERSIONED = ("physbench", "numpy", "scipy", "pymunk", "box2d", "hyperopt", "optuna", "nevergrad", "cmaes", "torch")
+VERSIONED = (
+    "physbench",
+    "numpy",
+    "scipy",
+    "pymunk",
+    "box2d",
+    "hyperopt",
+    "optuna",
+    "nevergrad",
+    "cmaes",
+    "torch",
+)
 
 
 @functools.cache
@@ -54,7 +65,11 @@ def run_cell(case: Case) -> dict[str, Any]:
     try:
         out["history"] = run_case(case).to_dict()
     except Exception as exc:  # any failure of one cell is data, not the end of the sweep
-        out.update(status="failed", error=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc(limit=8))
+        out.update(
+            status="failed",
+            error=f"{type(exc).__name__}: {exc}",
+            traceback=traceback.format_exc(limit=8),
+        )
     out["t_cell"] = time.perf_counter() - t0
     out["versions"] = versions()
     return out
@@ -83,7 +98,9 @@ def assemble(cells: list[Cell], store: CellStore) -> pd.DataFrame:
     for c in cells:
         data = store.load(c.key)
         if data is not None:
-            rows += cell_rows({"key": c.key, "index": c.index, "scene": c.scene, "label": c.label}, data)
+            rows += cell_rows(
+                {"key": c.key, "index": c.index, "scene": c.scene, "label": c.label}, data
+            )
     return to_frame(rows)
 
 
@@ -147,8 +164,15 @@ def run_sweep(
     t0 = time.perf_counter()
     started = datetime.now(UTC).isoformat(timespec="seconds")
     n_failed = 0
-    bar = tqdm(total=len(cells), initial=len(cells) - len(todo), desc=spec.name, unit="cell",
-               file=sys.stderr, disable=None if progress else True, dynamic_ncols=True)
+    bar = tqdm(
+        total=len(cells),
+        initial=len(cells) - len(todo),
+        desc=spec.name,
+        unit="cell",
+        file=sys.stderr,
+        disable=None if progress else True,
+        dynamic_ncols=True,
+    )
     try:
         if todo:
             with ex:
@@ -171,11 +195,22 @@ def run_sweep(
         log = json.loads(log_path.read_text())
     except (OSError, ValueError):
         log = {"runs": []}
-    log.update(spec=spec.name, spec_path=spec.path, cells=len(cells), failed=failed, versions=versions())
-    log["runs"].append({
-        "started": started, "executor": ex.describe(), "workers": ex.workers, "ran": len(todo),
-        "skipped": len(cells) - len(todo), "failed_now": n_failed, "wall_s": round(wall, 2),
-        "command": command,
-    })
+    log.update(
+        spec=spec.name, spec_path=spec.path, cells=len(cells), failed=failed, versions=versions()
+    )
+    log["runs"].append(
+        {
+            "started": started,
+            "executor": ex.describe(),
+            "workers": ex.workers,
+            "ran": len(todo),
+            "skipped": len(cells) - len(todo),
+            "failed_now": n_failed,
+            "wall_s": round(wall, 2),
+            "command": command,
+        }
+    )
     atomic_write(log_path, (json.dumps(log, indent=1) + "\n").encode())
-    return SweepResult(out, len(cells), len(todo), len(cells) - len(todo), failed, wall, ex.describe(), table, st)
+    return SweepResult(
+        out, len(cells), len(todo), len(cells) - len(todo), failed, wall, ex.describe(), table, st
+    )

@@ -47,8 +47,14 @@ TOP_KEYS = ("name", "description", "scenes", "unknowns", "estimators", "seeds", 
 SCENE_KEYS = ("name", "unknowns", "bodies")
 ESTIMATOR_KEYS = ("name", "label", "options")
 DEFAULTS: dict[str, Any] = {
-    "engine": "pymunk", "observe_engine": None, "blur": 0.0, "noise": 0.0, "resolution": 64,
-    "render_mode": "mark", "iterations": 11, "unknowns": ["mass"],
+    "engine": "pymunk",
+    "observe_engine": None,
+    "blur": 0.0,
+    "noise": 0.0,
+    "resolution": 64,
+    "render_mode": "mark",
+    "iterations": 11,
+    "unknowns": ["mass"],
 }
 
 
@@ -108,8 +114,13 @@ class Spec:
                     for est in self.estimators:
                         for seed in self.seeds:
                             case = Case(
-                                scene=sc.path, params=unknowns, estimator=est.name, options=dict(est.options),
-                                seed=seed, bodies=sc.bodies, **ax,
+                                scene=sc.path,
+                                params=unknowns,
+                                estimator=est.name,
+                                options=dict(est.options),
+                                seed=seed,
+                                bodies=sc.bodies,
+                                **ax,
                             )
                             out.append(Cell(len(out), case, sc.name, est.label))
         return out
@@ -132,8 +143,8 @@ def _unknown_set(value: Any, where: str) -> tuple[str, ...]:
         parts = []
     if not parts or len(set(parts)) != len(parts):
         raise SpecError(
-            f"{where} = {value!r}: expected an unknown-parameter set such as \"mass\", \"mass+elasticity\" "
-            "or [\"mass\", \"elasticity\"] (no repeats)"
+            f'{where} = {value!r}: expected an unknown-parameter set such as "mass", "mass+elasticity" '
+            'or ["mass", "elasticity"] (no repeats)'
         )
     return tuple(parts)
 
@@ -146,7 +157,12 @@ def _seeds(value: Any, where: str) -> tuple[int, ...]:
         seeds = list(range(value))
     elif isinstance(value, list) and all(ok(v) for v in value):
         seeds = list(value)
-    elif isinstance(value, dict) and set(value) <= {"start", "count"} and ok(value.get("start", 0)) and ok(value.get("count")):
+    elif (
+        isinstance(value, dict)
+        and set(value) <= {"start", "count"}
+        and ok(value.get("start", 0))
+        and ok(value.get("count"))
+    ):
         seeds = list(range(value.get("start", 0), value.get("start", 0) + value["count"]))
     else:
         raise SpecError(
@@ -168,10 +184,17 @@ def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
             if not isinstance(v, str) or not v:
                 raise bad(v, "a name (string)")
         elif name in ("blur", "noise"):
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v) or v < 0:
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, int | float)
+                or not math.isfinite(v)
+                or v < 0
+            ):
                 raise bad(v, "a finite number >= 0")
             v = float(v)
-        elif name in ("resolution", "iterations") and (isinstance(v, bool) or not isinstance(v, int) or v < 1):
+        elif name in ("resolution", "iterations") and (
+            isinstance(v, bool) or not isinstance(v, int) or v < 1
+        ):
             raise bad(v, "a whole number >= 1")
         out.append(v)
     if len(set(out)) != len(out):
@@ -186,10 +209,14 @@ def _estimators(value: Any, where: str) -> tuple[EstimatorSpec, ...]:
         if isinstance(item, str):
             item = {"name": item}
         if not isinstance(item, dict) or not isinstance(item.get("name"), str):
-            raise SpecError(f"{at} = {item!r}: expected an estimator name or {{name = \"tpe\", label = \"...\", options = {{...}}}}")
+            raise SpecError(
+                f'{at} = {item!r}: expected an estimator name or {{name = "tpe", label = "...", options = {{...}}}}'
+            )
         extra = sorted(set(item) - set(ESTIMATOR_KEYS))
         if extra:
-            raise SpecError(f"{at}: unknown key {extra[0]!r}; known keys: {', '.join(ESTIMATOR_KEYS)}")
+            raise SpecError(
+                f"{at}: unknown key {extra[0]!r}; known keys: {', '.join(ESTIMATOR_KEYS)}"
+            )
         options = item.get("options", {})
         if not isinstance(options, dict):
             raise SpecError(f"{at}.options = {options!r}: expected a table of estimator options")
@@ -204,7 +231,9 @@ def _estimators(value: Any, where: str) -> tuple[EstimatorSpec, ...]:
     same = [(e.name, json.dumps(dict(e.options), sort_keys=True)) for e in out]
     dup2 = next((x for x in same if same.count(x) > 1), None)
     if dup2 is not None:
-        raise SpecError(f"{where}: estimator {dup2[0]!r} with options {dup2[1]} appears twice (it would run the same cells)")
+        raise SpecError(
+            f"{where}: estimator {dup2[0]!r} with options {dup2[1]} appears twice (it would run the same cells)"
+        )
     return tuple(out)
 
 
@@ -215,7 +244,9 @@ def _scenes(value: Any, default_unknowns: Any, base: Path, where: str) -> tuple[
         if isinstance(item, str):
             item = {"name": item}
         if not isinstance(item, dict) or not isinstance(item.get("name"), str):
-            raise SpecError(f"{at} = {item!r}: expected a scene name or a [[scenes]] table with name and unknowns")
+            raise SpecError(
+                f"{at} = {item!r}: expected a scene name or a [[scenes]] table with name and unknowns"
+            )
         extra = sorted(set(item) - set(SCENE_KEYS))
         if extra:
             raise SpecError(f"{at}: unknown key {extra[0]!r}; known keys: {', '.join(SCENE_KEYS)}")
@@ -230,37 +261,62 @@ def _scenes(value: Any, default_unknowns: Any, base: Path, where: str) -> tuple[
         # Each item is one set: "mass", "mass+elasticity" or ["mass", "elasticity"].
         sets = tuple(_unknown_set(u, f"{at}.unknowns") for u in _as_list(raw))
         if not sets:
-            raise SpecError(f"{at}.unknowns = []: empty product: the scene lists no unknown-parameter set")
+            raise SpecError(
+                f"{at}.unknowns = []: empty product: the scene lists no unknown-parameter set"
+            )
         if len(set(sets)) != len(sets):
             raise SpecError(f"{at}.unknowns = {raw!r}: an unknown set repeats")
         bodies = item.get("bodies")
-        if bodies is not None and (not isinstance(bodies, list) or not all(isinstance(b, str) for b in bodies) or not bodies):
+        if bodies is not None and (
+            not isinstance(bodies, list)
+            or not all(isinstance(b, str) for b in bodies)
+            or not bodies
+        ):
             raise SpecError(f"{at}.bodies = {bodies!r}: expected a non-empty list of body names")
         out.append(SceneSpec(name, path, sets, None if bodies is None else tuple(bodies)))
     return tuple(out)
 
 
-def parse_spec(data: Mapping[str, Any], *, path: str = "", source: str = "", base: Path | None = None) -> Spec:
+def parse_spec(
+    data: Mapping[str, Any], *, path: str = "", source: str = "", base: Path | None = None
+) -> Spec:
     """A :class:`Spec` from parsed TOML; names are checked against the plugin registry and each
     scene's unknowns, so a bad spec fails before anything runs."""
     base = Path(path).parent if base is None and path else (base or Path.cwd())
     for key in data:
         if key not in TOP_KEYS:
-            raise SpecError(f"{_where(path, key)}: unknown axis or key {key!r}; known: {', '.join(TOP_KEYS)}")
+            raise SpecError(
+                f"{_where(path, key)}: unknown axis or key {key!r}; known: {', '.join(TOP_KEYS)}"
+            )
     for key in ("scenes", "estimators", "seeds"):
         if key not in data:
-            raise SpecError(f"{_where(path, key)}: missing; a spec needs scenes, estimators and seeds")
+            raise SpecError(
+                f"{_where(path, key)}: missing; a spec needs scenes, estimators and seeds"
+            )
     name = data.get("name", Path(path).stem if path else "sweep")
     if not isinstance(name, str) or not name:
         raise SpecError(f"{_where(path, 'name')} = {name!r}: expected a non-empty string")
     description = str(data.get("description", ""))
-    scenes = _scenes(data["scenes"], data.get("unknowns", DEFAULTS["unknowns"]), base, _where(path, "scenes"))
+    scenes = _scenes(
+        data["scenes"], data.get("unknowns", DEFAULTS["unknowns"]), base, _where(path, "scenes")
+    )
     estimators = _estimators(data["estimators"], _where(path, "estimators"))
     seeds = _seeds(data["seeds"], _where(path, "seeds"))
     axes = {a: _check_axis(a, _as_list(data.get(a, DEFAULTS[a])), _where(path, a)) for a in AXES}
-    empty = [k for k, v in (("scenes", scenes), ("estimators", estimators), ("seeds", seeds), *axes.items()) if not v]
+    empty = [
+        k
+        for k, v in (
+            ("scenes", scenes),
+            ("estimators", estimators),
+            ("seeds", seeds),
+            *axes.items(),
+        )
+        if not v
+    ]
     if empty:
-        raise SpecError(f"{_where(path, empty[0])}: empty product: the axis {empty[0]!r} has no values")
+        raise SpecError(
+            f"{_where(path, empty[0])}: empty product: the axis {empty[0]!r} has no values"
+        )
     spec = Spec(name, description, scenes, estimators, seeds, axes, source, path)
     _check_names(spec)
     check_unique(spec.cells())
@@ -305,12 +361,17 @@ def _check_names(spec: Spec) -> None:
             make_estimator(est.name, est.options)
         for e in {*spec.axes["engine"], *(v for v in spec.axes["observe_engine"] if v is not None)}:
             reg.get("simulator", e)
-        for res, mode, blur, noise in itertools.product(*(spec.axes[a] for a in ("resolution", "render_mode", "blur", "noise"))):
+        for res, mode, blur, noise in itertools.product(
+            *(spec.axes[a] for a in ("resolution", "render_mode", "blur", "noise"))
+        ):
             create("renderer", "raster", resolution=res, mode=mode, blur=blur, noise=noise)
         for sc in spec.scenes:
             scene = resolve_scene(sc.path, spec.seeds[0])
             for unknowns in sc.unknowns:
-                case_space(Case(scene=sc.path, params=unknowns, bodies=sc.bodies, seed=spec.seeds[0]), scene)
+                case_space(
+                    Case(scene=sc.path, params=unknowns, bodies=sc.bodies, seed=spec.seeds[0]),
+                    scene,
+                )
     except UnknownNameError as exc:
         raise SpecError(f"{where}: {exc}") from None
     except SpecError:

@@ -17,7 +17,15 @@ from typing import Any
 from physbench.errors import PhysbenchError
 
 RESULTS = "results.parquet"
-DERIVED = (RESULTS, "stats.csv", "summary.csv", "summary.md", "summary.tex", "report.html", "win_rate.csv")
+DERIVED = (
+    RESULTS,
+    "stats.csv",
+    "summary.csv",
+    "summary.md",
+    "summary.tex",
+    "report.html",
+    "win_rate.csv",
+)
 
 
 def atomic_write(path: Path, data: bytes) -> None:

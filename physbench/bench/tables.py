@@ -27,40 +27,93 @@ if TYPE_CHECKING:
 
 #: Column -> pandas dtype of the long table.
 SCHEMA: dict[str, str] = {
-    "cell": "string", "cell_index": "int64", "scene": "string", "unknowns": "string", "bodies": "string",
-    "keys": "string", "estimator": "string", "estimator_name": "string", "options": "string",
-    "engine": "string", "observe_engine": "string", "blur": "float64", "noise": "float64",
-    "resolution": "int64", "render_mode": "string", "iterations": "int64", "seed": "int64",
-    "status": "string", "error": "string", "iteration": "Int64", "params": "string", "truth": "string",
-    "image_mse": "float64", "nmse": "float64", "best_iteration": "Int64", "best_image_mse": "float64",
-    "best_nmse": "float64", "sim_error": "string", "t_simulate": "float64", "t_render": "float64",
-    "t_estimator": "float64", "t_start": "float64", "t_cell": "float64", "versions": "string",
+    "cell": "string",
+    "cell_index": "int64",
+    "scene": "string",
+    "unknowns": "string",
+    "bodies": "string",
+    "keys": "string",
+    "estimator": "string",
+    "estimator_name": "string",
+    "options": "string",
+    "engine": "string",
+    "observe_engine": "string",
+    "blur": "float64",
+    "noise": "float64",
+    "resolution": "int64",
+    "render_mode": "string",
+    "iterations": "int64",
+    "seed": "int64",
+    "status": "string",
+    "error": "string",
+    "iteration": "Int64",
+    "params": "string",
+    "truth": "string",
+    "image_mse": "float64",
+    "nmse": "float64",
+    "best_iteration": "Int64",
+    "best_image_mse": "float64",
+    "best_nmse": "float64",
+    "sim_error": "string",
+    "t_simulate": "float64",
+    "t_render": "float64",
+    "t_estimator": "float64",
+    "t_start": "float64",
+    "t_cell": "float64",
+    "versions": "string",
 }
 #: Columns that vary between identical runs.
 TIMINGS = tuple(c for c in SCHEMA if c.startswith("t_"))
 #: What identifies a configuration (a cell without its seed), in display order.
-CONFIG = ("scene", "unknowns", "bodies", "engine", "observe_engine", "blur", "noise", "resolution",
-          "render_mode", "iterations", "estimator")
+CONFIG = (
+    "scene",
+    "unknowns",
+    "bodies",
+    "engine",
+    "observe_engine",
+    "blur",
+    "noise",
+    "resolution",
+    "render_mode",
+    "iterations",
+    "estimator",
+)
 #: What identifies a cell across two sweeps (``compare`` matches on these).
 MATCH = (*CONFIG, "options", "seed")
 ALL_BODIES = "all"
 #: Configuration columns shown only when they vary within a sweep.
-SETTINGS = ("bodies", "engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
+SETTINGS = (
+    "bodies",
+    "engine",
+    "observe_engine",
+    "blur",
+    "noise",
+    "resolution",
+    "render_mode",
+    "iterations",
+)
 
 #: Link, Schwarz, Behnke (2022), Table 1: normalized min MSE after 11 iterations, mean ± std over
 #: 10 runs. "NN" is the paper's learned estimator, "Hyperopt" its TPE baseline.
 PAPER: dict[tuple[str, frozenset[str]], dict[str, tuple[float, float]]] = {
     ("three_circles", frozenset({"mass"})): {"NN": (2.6e-3, 0.9e-3), "Hyperopt": (1.1e-2, 0.3e-2)},
     ("three_circles", frozenset({"elasticity"})): {"NN": (8.7e-5, 1.9e-5)},
-    ("three_circles", frozenset({"mass", "elasticity"})): {"NN": (1.4e-2, 0.5e-2), "Hyperopt": (5.2e-2, 0.7e-2)},
+    ("three_circles", frozenset({"mass", "elasticity"})): {
+        "NN": (1.4e-2, 0.5e-2),
+        "Hyperopt": (5.2e-2, 0.7e-2),
+    },
     ("second_order", frozenset({"mass"})): {"NN": (3e-4, 0.7e-4)},
     ("second_order", frozenset({"elasticity"})): {"NN": (4e-3, 2e-3)},
     ("stacked_boxes", frozenset({"mass"})): {"NN": (2e-3, 0.5e-3)},
     ("stacked_boxes", frozenset({"friction"})): {"NN": (3.9e-3, 1.2e-3)},
     ("bouncing_balls", frozenset({"mass"})): {"NN": (6.3e-3, 0.8e-3)},
 }
-PAPER_SCENES = {"three_circles": "3 circles", "second_order": "second order", "stacked_boxes": "box scene",
-                "bouncing_balls": "bouncing balls"}
+PAPER_SCENES = {
+    "three_circles": "3 circles",
+    "second_order": "second order",
+    "stacked_boxes": "box scene",
+    "bouncing_balls": "bouncing balls",
+}
 BOOTSTRAP = 4000
 
 
@@ -74,28 +127,50 @@ def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str
     settings); ``data`` is what :func:`physbench.bench.runner.run_cell` returned."""
     case = data["case"]
     base = {
-        "cell": cell["key"], "cell_index": cell["index"], "scene": cell["scene"],
+        "cell": cell["key"],
+        "cell_index": cell["index"],
+        "scene": cell["scene"],
         "unknowns": "+".join(case["params"]),
         "bodies": ALL_BODIES if case.get("bodies") is None else ",".join(case["bodies"]),
-        "estimator": cell["label"], "estimator_name": case["estimator"], "options": dumps(case["options"]),
-        "engine": case["engine"], "observe_engine": case["observe_engine"] or case["engine"],
-        "blur": case["blur"], "noise": case["noise"], "resolution": case["resolution"],
-        "render_mode": case["render_mode"], "iterations": case["iterations"], "seed": case["seed"],
-        "status": data["status"], "error": data.get("error"), "t_cell": data.get("t_cell"),
+        "estimator": cell["label"],
+        "estimator_name": case["estimator"],
+        "options": dumps(case["options"]),
+        "engine": case["engine"],
+        "observe_engine": case["observe_engine"] or case["engine"],
+        "blur": case["blur"],
+        "noise": case["noise"],
+        "resolution": case["resolution"],
+        "render_mode": case["render_mode"],
+        "iterations": case["iterations"],
+        "seed": case["seed"],
+        "status": data["status"],
+        "error": data.get("error"),
+        "t_cell": data.get("t_cell"),
         "versions": dumps(data.get("versions", {})),
     }
     hist = data.get("history")
     if data["status"] != "ok" or not hist:
         return [{**base, "keys": None}]
     keys = list(hist["keys"])
-    base.update(keys=json.dumps(keys), truth=None if hist["truth"] is None else json.dumps(hist["truth"]),
-                t_start=hist["meta"].get("t_start"))
+    base.update(
+        keys=json.dumps(keys),
+        truth=None if hist["truth"] is None else json.dumps(hist["truth"]),
+        t_start=hist["meta"].get("t_start"),
+    )
     return [
         {
-            **base, "iteration": r["iteration"], "params": json.dumps({k: r["params"][k] for k in keys}),
-            "image_mse": r["loss"], "nmse": r["nmse"], "best_iteration": r["best_iteration"],
-            "best_image_mse": r["best_loss"], "best_nmse": r["best_nmse"], "sim_error": r.get("failed"),
-            "t_simulate": r.get("t_simulate"), "t_render": r.get("t_render"), "t_estimator": r.get("t_estimator"),
+            **base,
+            "iteration": r["iteration"],
+            "params": json.dumps({k: r["params"][k] for k in keys}),
+            "image_mse": r["loss"],
+            "nmse": r["nmse"],
+            "best_iteration": r["best_iteration"],
+            "best_image_mse": r["best_loss"],
+            "best_nmse": r["best_nmse"],
+            "sim_error": r.get("failed"),
+            "t_simulate": r.get("t_simulate"),
+            "t_render": r.get("t_render"),
+            "t_estimator": r.get("t_estimator"),
         }
         for r in hist["records"]
     ]
@@ -147,7 +222,9 @@ def paper_value(scene: str, unknowns: str, which: str) -> tuple[float, float] | 
     return PAPER.get((scene, frozenset(unknowns.split("+"))), {}).get(which)
 
 
-def bootstrap_ci(values: Sequence[float], *, level: float = 0.95, n: int = BOOTSTRAP, seed: int = 0) -> tuple[float, float]:
+def bootstrap_ci(
+    values: Sequence[float], *, level: float = 0.95, n: int = BOOTSTRAP, seed: int = 0
+) -> tuple[float, float]:
     """Percentile bootstrap interval of the mean (resampling seeds; a fixed generator, so the
     same values always give the same interval)."""
     v = np.asarray(values, dtype=float)
@@ -162,13 +239,21 @@ def bootstrap_ci(values: Sequence[float], *, level: float = 0.95, n: int = BOOTS
     return float(lo), float(hi)
 
 
-def ratio_ci(num: Sequence[float], den: Sequence[float], *, level: float = 0.9, n: int = BOOTSTRAP,
-             seed: int = 0) -> tuple[float, float, float]:
+def ratio_ci(
+    num: Sequence[float],
+    den: Sequence[float],
+    *,
+    level: float = 0.9,
+    n: int = BOOTSTRAP,
+    seed: int = 0,
+) -> tuple[float, float, float]:
     """``mean(num) / mean(den)`` of paired values (the same seeds) and its percentile-bootstrap
     interval, resampling the pairs together so shared per-seed difficulty cancels."""
     a, b = np.asarray(num, dtype=float), np.asarray(den, dtype=float)
     idx = np.random.default_rng(seed).integers(0, a.size, size=(n, a.size))
-    lo, hi = np.quantile(a[idx].mean(axis=1) / b[idx].mean(axis=1), [(1 - level) / 2, (1 + level) / 2])
+    lo, hi = np.quantile(
+        a[idx].mean(axis=1) / b[idx].mean(axis=1), [(1 - level) / 2, (1 + level) / 2]
+    )
     return float(a.mean() / b.mean()), float(lo), float(hi)
 
 
@@ -198,15 +283,22 @@ def stats(df: pd.DataFrame) -> pd.DataFrame:
         errors = sorted(set(g.loc[g["status"] != "ok", "error"].dropna()))
         lo, hi = bootstrap_ci(v)
         nn, hy = (paper_value(cfg["scene"], cfg["unknowns"], w) for w in ("NN", "Hyperopt"))
-        rows.append({
-            **cfg, "n": int(v.size), "failed": int((g["status"] != "ok").sum()),
-            "mean": float(v.mean()) if v.size else math.nan,
-            "std": float(v.std(ddof=1)) if v.size > 1 else (0.0 if v.size else math.nan),
-            "median": float(np.median(v)) if v.size else math.nan, "ci_low": lo, "ci_high": hi,
-            "initial_mean": float(init.loc[isel, "nmse"].mean()) if isel.any() else math.nan,
-            "paper_nn": format_mean_std(*nn) if nn else "", "paper_hyperopt": format_mean_std(*hy) if hy else "",
-            "error": errors[0] if errors else "",
-        })
+        rows.append(
+            {
+                **cfg,
+                "n": int(v.size),
+                "failed": int((g["status"] != "ok").sum()),
+                "mean": float(v.mean()) if v.size else math.nan,
+                "std": float(v.std(ddof=1)) if v.size > 1 else (0.0 if v.size else math.nan),
+                "median": float(np.median(v)) if v.size else math.nan,
+                "ci_low": lo,
+                "ci_high": hi,
+                "initial_mean": float(init.loc[isel, "nmse"].mean()) if isel.any() else math.nan,
+                "paper_nn": format_mean_std(*nn) if nn else "",
+                "paper_hyperopt": format_mean_std(*hy) if hy else "",
+                "error": errors[0] if errors else "",
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -236,14 +328,36 @@ def paper_layout(st: pd.DataFrame) -> pd.DataFrame:
         sst = st[st["scene"] == scene]
         for which in ("NN", "Hyperopt"):
             vals = {h: paper_value(scene, u, which) for u, h in zip(sets, heads, strict=True)}
-            if any(v is not None for u, v in zip(sets, vals.values(), strict=True) if u in set(sst["unknowns"])):
-                rows.append({"scene": scene_label(scene), **dict.fromkeys(extra, ""), "estimator": f"paper {which}",
-                             **{h: format_mean_std(*v) if v else "-" for h, v in vals.items()}})
-        for key in dict.fromkeys(tuple(r) for r in sst[[*extra, "estimator"]].itertuples(index=False)):
-            sel = np.logical_and.reduce([sst[c] == v for c, v in zip([*extra, "estimator"], key, strict=True)])
+            if any(
+                v is not None
+                for u, v in zip(sets, vals.values(), strict=True)
+                if u in set(sst["unknowns"])
+            ):
+                rows.append(
+                    {
+                        "scene": scene_label(scene),
+                        **dict.fromkeys(extra, ""),
+                        "estimator": f"paper {which}",
+                        **{h: format_mean_std(*v) if v else "-" for h, v in vals.items()},
+                    }
+                )
+        for key in dict.fromkeys(
+            tuple(r) for r in sst[[*extra, "estimator"]].itertuples(index=False)
+        ):
+            sel = np.logical_and.reduce(
+                [sst[c] == v for c, v in zip([*extra, "estimator"], key, strict=True)]
+            )
             by_set = {r["unknowns"]: r for r in sst[sel].to_dict("records")}
-            rows.append({"scene": scene_label(scene), **dict(zip([*extra, "estimator"], key, strict=True)),
-                         **{h: _cell_text(by_set[u]) if u in by_set else "-" for u, h in zip(sets, heads, strict=True)}})
+            rows.append(
+                {
+                    "scene": scene_label(scene),
+                    **dict(zip([*extra, "estimator"], key, strict=True)),
+                    **{
+                        h: _cell_text(by_set[u]) if u in by_set else "-"
+                        for u, h in zip(sets, heads, strict=True)
+                    },
+                }
+            )
     return pd.DataFrame(rows, columns=["scene", *extra, "estimator", *heads])
 
 
@@ -255,13 +369,21 @@ def side_by_side(st: pd.DataFrame) -> pd.DataFrame:
     extra = _varying(st, SETTINGS)
     ests = list(dict.fromkeys(st["estimator"]))
     rows = []
-    for key in dict.fromkeys(tuple(r) for r in st[["scene", "unknowns", *extra]].itertuples(index=False)):
-        sel = np.logical_and.reduce([st[c] == v for c, v in zip(["scene", "unknowns", *extra], key, strict=True)])
+    for key in dict.fromkeys(
+        tuple(r) for r in st[["scene", "unknowns", *extra]].itertuples(index=False)
+    ):
+        sel = np.logical_and.reduce(
+            [st[c] == v for c, v in zip(["scene", "unknowns", *extra], key, strict=True)]
+        )
         g = st[sel]
         first = g.iloc[0]
-        row = {"scene": scene_label(str(key[0])), "unknowns": unknowns_label(str(key[1])),
-               **dict(zip(extra, key[2:], strict=True)),
-               "paper NN": first["paper_nn"] or "-", "paper Hyperopt": first["paper_hyperopt"] or "-"}
+        row = {
+            "scene": scene_label(str(key[0])),
+            "unknowns": unknowns_label(str(key[1])),
+            **dict(zip(extra, key[2:], strict=True)),
+            "paper NN": first["paper_nn"] or "-",
+            "paper Hyperopt": first["paper_hyperopt"] or "-",
+        }
         by_est = {r["estimator"]: r for r in g.to_dict("records")}
         row.update({e: _cell_text(by_est[e]) if e in by_est else "-" for e in ests})
         rows.append(row)
@@ -276,15 +398,24 @@ def detail(st: pd.DataFrame) -> pd.DataFrame:
     extra = _varying(st, SETTINGS)
     rows = []
     for r in st.to_dict("records"):
-        rows.append({
-            "scene": r["scene"], "unknowns": r["unknowns"], **{c: r[c] for c in extra}, "estimator": r["estimator"],
-            "n": r["n"], "failed": r["failed"],
-            "mean ± std": format_mean_std(r["mean"], r["std"]) if r["n"] else "-",
-            "median": f"{r['median']:.2e}" if r["n"] else "-",
-            "95% CI of mean": f"[{r['ci_low']:.2e}, {r['ci_high']:.2e}]" if r["n"] else "-",
-            "initial guess": f"{r['initial_mean']:.2e}" if math.isfinite(r["initial_mean"]) else "-",
-            "paper NN": r["paper_nn"] or "-", "paper Hyperopt": r["paper_hyperopt"] or "-",
-        })
+        rows.append(
+            {
+                "scene": r["scene"],
+                "unknowns": r["unknowns"],
+                **{c: r[c] for c in extra},
+                "estimator": r["estimator"],
+                "n": r["n"],
+                "failed": r["failed"],
+                "mean ± std": format_mean_std(r["mean"], r["std"]) if r["n"] else "-",
+                "median": f"{r['median']:.2e}" if r["n"] else "-",
+                "95% CI of mean": f"[{r['ci_low']:.2e}, {r['ci_high']:.2e}]" if r["n"] else "-",
+                "initial guess": f"{r['initial_mean']:.2e}"
+                if math.isfinite(r["initial_mean"])
+                else "-",
+                "paper NN": r["paper_nn"] or "-",
+                "paper Hyperopt": r["paper_hyperopt"] or "-",
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -297,7 +428,9 @@ def win_rate_table(fin: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     ok = fin[fin["status"] == "ok"]
     ests = list(dict.fromkeys(ok.sort_values("cell_index")["estimator"]))
     idx = [c for c in MATCH if c not in ("estimator", "options")]
-    wide = ok.pivot_table(index=idx, columns="estimator", values="best_nmse", aggfunc="first", observed=True)
+    wide = ok.pivot_table(
+        index=idx, columns="estimator", values="best_nmse", aggfunc="first", observed=True
+    )
     rate = pd.DataFrame(np.nan, index=ests, columns=ests)
     n = pd.DataFrame(0, index=ests, columns=ests)
     for a in ests:
@@ -331,7 +464,13 @@ def _latex_cell(text: str) -> str:
 
 
 def _latex_escape(text: str) -> str:
-    for a, b in (("\\", r"\textbackslash{}"), ("&", r"\&"), ("%", r"\%"), ("_", r"\_"), ("#", r"\#")):
+    for a, b in (
+        ("\\", r"\textbackslash{}"),
+        ("&", r"\&"),
+        ("%", r"\%"),
+        ("_", r"\_"),
+        ("#", r"\#"),
+    ):
         text = text.replace(a, b)
     return text
 
@@ -339,9 +478,15 @@ def _latex_escape(text: str) -> str:
 def latex(df: pd.DataFrame, *, caption: str) -> str:
     """A booktabs ``table*`` like the paper's Table 1 (needs ``\\usepackage{booktabs}``)."""
     ncol = len(df.columns)
-    lines = [r"\begin{table*}", r"\centering", f"\\caption{{{_latex_escape(caption)}}}",
-             r"\begin{tabular}{" + "l" * (ncol - _n_value_cols(df)) + "r" * _n_value_cols(df) + "}",
-             r"\toprule", " & ".join(_latex_escape(str(c)) for c in df.columns) + r" \\", r"\midrule"]
+    lines = [
+        r"\begin{table*}",
+        r"\centering",
+        f"\\caption{{{_latex_escape(caption)}}}",
+        r"\begin{tabular}{" + "l" * (ncol - _n_value_cols(df)) + "r" * _n_value_cols(df) + "}",
+        r"\toprule",
+        " & ".join(_latex_escape(str(c)) for c in df.columns) + r" \\",
+        r"\midrule",
+    ]
     for row in df.itertuples(index=False):
         lines.append(" & ".join(_latex_cell(str(v)) for v in row) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}", r"\end{table*}"]
@@ -358,20 +503,31 @@ def write_summary(df: pd.DataFrame, out: Path, *, title: str) -> pd.DataFrame:
     st = stats(df)
     layout = paper_layout(st)
     iters = ", ".join(str(i) for i in dict.fromkeys(st["iterations"]))
-    caption = (f"{title}: normalized min MSE after {iters} iterations, mean ± std over seeds "
-               "(paper: Link et al. 2022, Table 1, 10 seeds)")
+    caption = (
+        f"{title}: normalized min MSE after {iters} iterations, mean ± std over seeds "
+        "(paper: Link et al. 2022, Table 1, 10 seeds)"
+    )
     _atomic(out / "stats.csv", st.to_csv(index=False))
     _atomic(out / "summary.csv", layout.to_csv(index=False))
     _atomic(out / "summary.tex", latex(layout, caption=caption))
-    md = [f"# {title}\n", f"{caption}.\n", markdown(layout),
-          "\n## Next to the paper\n", "The same means ± std, a row per scene and unknown set.\n", markdown(side_by_side(st)),
-          "\n## Per configuration\n",
-          "Normalized min MSE after N iterations over seeds: mean ± sample std, median, 95 % percentile-bootstrap "
-          f"interval of the mean ({BOOTSTRAP} resamples), cells that ran (n) and failed.\n",
-          markdown(detail(st))]
+    md = [
+        f"# {title}\n",
+        f"{caption}.\n",
+        markdown(layout),
+        "\n## Next to the paper\n",
+        "The same means ± std, a row per scene and unknown set.\n",
+        markdown(side_by_side(st)),
+        "\n## Per configuration\n",
+        "Normalized min MSE after N iterations over seeds: mean ± sample std, median, 95 % percentile-bootstrap "
+        f"interval of the mean ({BOOTSTRAP} resamples), cells that ran (n) and failed.\n",
+        markdown(detail(st)),
+    ]
     failed = st[st["failed"] > 0]
     if len(failed):
-        md += ["\n## Failed cells\n", markdown(failed[["scene", "unknowns", "estimator", "failed", "error"]])]
+        md += [
+            "\n## Failed cells\n",
+            markdown(failed[["scene", "unknowns", "estimator", "failed", "error"]]),
+        ]
     _atomic(out / "summary.md", "\n".join(md))
     return st
 

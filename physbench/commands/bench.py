@@ -23,19 +23,40 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.epilog = EPILOG
     p.formatter_class = argparse.RawDescriptionHelpFormatter
     p.add_argument("spec", metavar="SPEC", help="sweep spec (TOML), e.g. benchmarks/smoke.toml")
-    p.add_argument("--out", required=True, metavar="DIR", help="output folder (created; an existing one is resumed)")
     p.add_argument(
-        "--executor", default="processes", choices=("serial", "processes", "dask"),
+        "--out",
+        required=True,
+        metavar="DIR",
+        help="output folder (created; an existing one is resumed)",
+    )
+    p.add_argument(
+        "--executor",
+        default="processes",
+        choices=("serial", "processes", "dask"),
         help="where cells run: this process, local worker processes (default), or a Dask cluster",
     )
-    p.add_argument("--workers", type=int, default=None, metavar="N", help="worker processes (default: all cores)")
     p.add_argument(
-        "--address", default=None, metavar="tcp://HOST:PORT",
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="worker processes (default: all cores)",
+    )
+    p.add_argument(
+        "--address",
+        default=None,
+        metavar="tcp://HOST:PORT",
         help="Dask scheduler address (with --executor dask; default: start a LocalCluster of --workers processes)",
     )
-    p.add_argument("--fresh", action="store_true", help="discard the cells already in DIR and run everything")
-    p.add_argument("--retry-failed", action="store_true", help="run the cells recorded as failed again")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or table: only the final line")
+    p.add_argument(
+        "--fresh", action="store_true", help="discard the cells already in DIR and run everything"
+    )
+    p.add_argument(
+        "--retry-failed", action="store_true", help="run the cells recorded as failed again"
+    )
+    p.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress bar or table: only the final line"
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -45,13 +66,23 @@ def main(args: argparse.Namespace) -> int:
     spec = load_spec(args.spec)
     try:
         res = run_sweep(
-            spec, args.out, executor=args.executor, workers=args.workers, address=args.address,
-            fresh=args.fresh, retry_failed=args.retry_failed, progress=not args.quiet,
-            command="physbench bench " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == ["bench"] else "",
+            spec,
+            args.out,
+            executor=args.executor,
+            workers=args.workers,
+            address=args.address,
+            fresh=args.fresh,
+            retry_failed=args.retry_failed,
+            progress=not args.quiet,
+            command="physbench bench " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+            if sys.argv[1:2] == ["bench"]
+            else "",
         )
     except KeyboardInterrupt:
-        print(f"physbench bench: interrupted; finished cells are saved in {args.out}: re-run the same command to resume",
-              file=sys.stderr)
+        print(
+            f"physbench bench: interrupted; finished cells are saved in {args.out}: re-run the same command to resume",
+            file=sys.stderr,
+        )
         return 130
     if not args.quiet:
         from physbench.bench.tables import markdown, paper_layout

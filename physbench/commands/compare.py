@@ -27,14 +27,28 @@ p is 2^-n, which must beat alpha / (number of configurations): e.g. 10 seeds for
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.epilog = EPILOG
     p.formatter_class = argparse.RawDescriptionHelpFormatter
-    p.add_argument("new", metavar="NEW", help="the sweep to check (output folder or results.parquet)")
-    p.add_argument("baseline", metavar="BASELINE", help="the reference sweep, e.g. results/baseline")
-    p.add_argument("--alpha", type=float, default=ALPHA, help=f"significance level of the one-sided test (default: {ALPHA})")
     p.add_argument(
-        "--min-ratio", type=float, default=MIN_RATIO, metavar="R",
+        "new", metavar="NEW", help="the sweep to check (output folder or results.parquet)"
+    )
+    p.add_argument(
+        "baseline", metavar="BASELINE", help="the reference sweep, e.g. results/baseline"
+    )
+    p.add_argument(
+        "--alpha",
+        type=float,
+        default=ALPHA,
+        help=f"significance level of the one-sided test (default: {ALPHA})",
+    )
+    p.add_argument(
+        "--min-ratio",
+        type=float,
+        default=MIN_RATIO,
+        metavar="R",
         help=f"smallest geometric-mean error ratio new/baseline that counts as worse (default: {MIN_RATIO})",
     )
-    p.add_argument("--all", action="store_true", help="list every configuration, not only changed ones")
+    p.add_argument(
+        "--all", action="store_true", help="list every configuration, not only changed ones"
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -42,14 +56,44 @@ def main(args: argparse.Namespace) -> int:
     from physbench.bench.runner import read_table
     from physbench.bench.tables import markdown
 
-    res = compare(read_table(args.new), read_table(args.baseline), alpha=args.alpha, min_ratio=args.min_ratio)
+    res = compare(
+        read_table(args.new), read_table(args.baseline), alpha=args.alpha, min_ratio=args.min_ratio
+    )
     t = res.table
     shown = t if args.all else t[t["verdict"].isin(["worse", "better"])]
     if len(shown):
-        view = shown[["scene", "unknowns", "estimator", "compared", "failed_new", "failed_base", "mean_base",
-                      "mean_new", "gm_ratio", "worse_seeds", "better_seeds", "p_worse", "p_worse_holm", "verdict"]].copy()
-        extra = [c for c in ("bodies", "engine", "observe_engine", "blur", "noise", "resolution", "render_mode",
-                             "iterations") if t[c].nunique() > 1]
+        view = shown[
+            [
+                "scene",
+                "unknowns",
+                "estimator",
+                "compared",
+                "failed_new",
+                "failed_base",
+                "mean_base",
+                "mean_new",
+                "gm_ratio",
+                "worse_seeds",
+                "better_seeds",
+                "p_worse",
+                "p_worse_holm",
+                "verdict",
+            ]
+        ].copy()
+        extra = [
+            c
+            for c in (
+                "bodies",
+                "engine",
+                "observe_engine",
+                "blur",
+                "noise",
+                "resolution",
+                "render_mode",
+                "iterations",
+            )
+            if t[c].nunique() > 1
+        ]
         for c in reversed(extra):
             view.insert(3, c, shown[c])
         for c in ("mean_base", "mean_new"):
@@ -59,11 +103,24 @@ def main(args: argparse.Namespace) -> int:
             view[c] = view[c].map(lambda v: f"{v:.3g}")
         print(markdown(view))
     counts = t["verdict"].value_counts().to_dict()
-    summary = ", ".join(f"{counts[k]} {k}" for k in ("worse", "better", "ok", "identical") if k in counts)
-    unmatched = f"; unmatched cells: {res.only_new} new, {res.only_base} baseline" if res.only_new or res.only_base else ""
-    print(f"compared {int(t['matched'].sum())} cells in {len(t)} configurations: {summary}{unmatched} "
-          f"(worse: one-sided Wilcoxon, Holm-corrected p < {args.alpha}, and geometric-mean ratio >= {args.min_ratio})")
+    summary = ", ".join(
+        f"{counts[k]} {k}" for k in ("worse", "better", "ok", "identical") if k in counts
+    )
+    unmatched = (
+        f"; unmatched cells: {res.only_new} new, {res.only_base} baseline"
+        if res.only_new or res.only_base
+        else ""
+    )
+    print(
+        f"compared {int(t['matched'].sum())} cells in {len(t)} configurations: {summary}{unmatched} "
+        f"(worse: one-sided Wilcoxon, Holm-corrected p < {args.alpha}, and geometric-mean ratio >= {args.min_ratio})"
+    )
     if len(res.worse):
-        print("REGRESSION: " + "; ".join(f"{r.estimator} on {r.scene} [{r.unknowns}]" for r in res.worse.itertuples()))
+        print(
+            "REGRESSION: "
+            + "; ".join(
+                f"{r.estimator} on {r.scene} [{r.unknowns}]" for r in res.worse.itertuples()
+            )
+        )
         return 1
     return 0

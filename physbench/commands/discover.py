@@ -7,27 +7,72 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("recording", metavar="RECORDING",
-                   help="tracked trajectories (.csv: t,body,x,y[,angle][,run]) or observed frames (.npz, key 'frames')")
-    p.add_argument("--scene", required=True, metavar="SCENE.toml", help="the setup, with the base model's unknowns")
-    p.add_argument("--effects", nargs="+", metavar="NAME", help="candidate effects (default: every registered effect that applies)")
+    p.add_argument(
+        "recording",
+        metavar="RECORDING",
+        help="tracked trajectories (.csv: t,body,x,y[,angle][,run]) or observed frames (.npz, key 'frames')",
+    )
+    p.add_argument(
+        "--scene",
+        required=True,
+        metavar="SCENE.toml",
+        help="the setup, with the base model's unknowns",
+    )
+    p.add_argument(
+        "--effects",
+        nargs="+",
+        metavar="NAME",
+        help="candidate effects (default: every registered effect that applies)",
+    )
     p.add_argument("--json", metavar="OUT", help="write the verdict as JSON here ('-' for stdout)")
     p.add_argument("--report", metavar="DIR", help="write plots and index.html into this folder")
     p.add_argument("--engine", default="pymunk", help="simulator (default pymunk)")
-    p.add_argument("--estimator", default="lsq",
-                   help="base fit: lsq (local least squares, default) or a registered estimator (tpe, cmaes, optuna, random) polished by lsq")
-    p.add_argument("--iterations", type=int, default=60, help="estimator iterations for the base fit (default 60)")
-    p.add_argument("--holdout", type=float, default=0.3, help="share of the data held out (default 0.3)")
-    p.add_argument("--split", default="auto", choices=("auto", "time", "runs"),
-                   help="hold out each run's later part (time) or whole runs (runs); auto: runs with >= 3 runs")
-    p.add_argument("--nuisance", nargs="+", default=["auto"], metavar="NAME",
-                   help="initial-state parameters fitted per run: auto, none, or names like ball.vx0 force0.fx")
+    p.add_argument(
+        "--estimator",
+        default="lsq",
+        help="base fit: lsq (local least squares, default) or a registered estimator (tpe, cmaes, optuna, random) polished by lsq",
+    )
+    p.add_argument(
+        "--iterations",
+        type=int,
+        default=60,
+        help="estimator iterations for the base fit (default 60)",
+    )
+    p.add_argument(
+        "--holdout", type=float, default=0.3, help="share of the data held out (default 0.3)"
+    )
+    p.add_argument(
+        "--split",
+        default="auto",
+        choices=("auto", "time", "runs"),
+        help="hold out each run's later part (time) or whole runs (runs); auto: runs with >= 3 runs",
+    )
+    p.add_argument(
+        "--nuisance",
+        nargs="+",
+        default=["auto"],
+        metavar="NAME",
+        help="initial-state parameters fitted per run: auto, none, or names like ball.vx0 force0.fx",
+    )
     p.add_argument("--run", help="use only this run of a multi-run CSV")
-    p.add_argument("--min-gain", type=float, default=None, help="held-out gain a cause must reach (default 0.1)")
-    p.add_argument("--min-delta-bic", type=float, default=None, help="BIC drop a cause must reach (default 10)")
+    p.add_argument(
+        "--min-gain",
+        type=float,
+        default=None,
+        help="held-out gain a cause must reach (default 0.1)",
+    )
+    p.add_argument(
+        "--min-delta-bic", type=float, default=None, help="BIC drop a cause must reach (default 10)"
+    )
     p.add_argument("--max-causes", type=int, default=None, help="most effects added (default 3)")
-    p.add_argument("--render-mode", choices=("mark", "mask", "instance"), help="raster mode of .npz frames (default from C)")
-    p.add_argument("--seed", type=int, default=0, help="seed of a black-box base-fit estimator (default 0)")
+    p.add_argument(
+        "--render-mode",
+        choices=("mark", "mask", "instance"),
+        help="raster mode of .npz frames (default from C)",
+    )
+    p.add_argument(
+        "--seed", type=int, default=0, help="seed of a black-box base-fit estimator (default 0)"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="print only the causes and the gain")
 
 
@@ -43,14 +88,32 @@ def main(args: argparse.Namespace) -> int:
 
     runs = load_runs(args.recording, args.scene, run=args.run)
     nuisance = args.nuisance[0] if args.nuisance in (["auto"], ["none"]) else list(args.nuisance)
-    kw = {k: v for k, v in (("min_gain", args.min_gain), ("min_delta_bic", args.min_delta_bic), ("max_causes", args.max_causes)) if v is not None}
-    settings = Settings(effects=args.effects, holdout=args.holdout, split=args.split, nuisance=nuisance,
-                        estimator=args.estimator, estimator_iterations=args.iterations, seed=args.seed, **kw)
+    kw = {
+        k: v
+        for k, v in (
+            ("min_gain", args.min_gain),
+            ("min_delta_bic", args.min_delta_bic),
+            ("max_causes", args.max_causes),
+        )
+        if v is not None
+    }
+    settings = Settings(
+        effects=args.effects,
+        holdout=args.holdout,
+        split=args.split,
+        nuisance=nuisance,
+        estimator=args.estimator,
+        estimator_iterations=args.iterations,
+        seed=args.seed,
+        **kw,
+    )
     renderer = renderer_for(runs, args.render_mode) if runs[0].frames is not None else None
     disc = discover(runs, create("simulator", args.engine), settings=settings, renderer=renderer)
     if args.quiet:
         causes = ", ".join(disc.causes) or "none"
-        print(f"causes: {causes}; gain {disc.gain:.1%} (held-out error {disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})")
+        print(
+            f"causes: {causes}; gain {disc.gain:.1%} (held-out error {disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})"
+        )
     else:
         print(text(disc))
     if args.json:

@@ -12,10 +12,21 @@ import argparse
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("dir", metavar="DIR", help="output folder of `physbench bench` (holds results.parquet)")
-    p.add_argument("--seeds", type=int, default=3, metavar="N", help="seeds drawn in the trajectory plots (default: 3)")
     p.add_argument(
-        "--landscape-seeds", type=int, default=3, metavar="N",
+        "dir", metavar="DIR", help="output folder of `physbench bench` (holds results.parquet)"
+    )
+    p.add_argument(
+        "--seeds",
+        type=int,
+        default=3,
+        metavar="N",
+        help="seeds drawn in the trajectory plots (default: 3)",
+    )
+    p.add_argument(
+        "--landscape-seeds",
+        type=int,
+        default=3,
+        metavar="N",
         help="scene instances averaged in the image-MSE landscape, which simulates (default: 3; 0 skips it)",
     )
 
@@ -29,7 +40,9 @@ def main(args: argparse.Namespace) -> int:
     if args.seeds < 1:
         raise PhysbenchError(f"--seeds {args.seeds}: expected a whole number >= 1")
     if args.landscape_seeds < 0:
-        raise PhysbenchError(f"--landscape-seeds {args.landscape_seeds}: expected a whole number >= 0")
+        raise PhysbenchError(
+            f"--landscape-seeds {args.landscape_seeds}: expected a whole number >= 0"
+        )
 
     from physbench.bench import plots, report
     from physbench.bench.runner import read_table
@@ -39,8 +52,12 @@ def main(args: argparse.Namespace) -> int:
     out = Path(args.dir)
     df = read_table(out)
     if df.empty:
-        raise PhysbenchError(f"{str(out)!r}: the results table is empty; run `physbench bench SPEC --out {out}` first")
-    figures = plots.plot_all(df, out / "plots", seeds=args.seeds, landscape_seeds=args.landscape_seeds)
+        raise PhysbenchError(
+            f"{str(out)!r}: the results table is empty; run `physbench bench SPEC --out {out}` first"
+        )
+    figures = plots.plot_all(
+        df, out / "plots", seeds=args.seeds, landscape_seeds=args.landscape_seeds
+    )
     rate, _ = win_rate_table(final_rows(df))
     atomic_write(out / "win_rate.csv", rate.to_csv(index_label="estimator").encode())
     try:

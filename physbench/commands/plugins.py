@@ -17,10 +17,18 @@ def main(args: argparse.Namespace) -> int:
     reg = get_registry()
     rows = [(c.kind, c.name, c.plugin, c.package, c.version) for c in reg.all()]
     if args.json:
-        print(json.dumps({
-            "components": [dict(zip(("kind", "name", "plugin", "package", "version"), r, strict=True)) for r in rows],
-            "failed": [f.__dict__ for f in reg.failed],
-        }, indent=2))
+        print(
+            json.dumps(
+                {
+                    "components": [
+                        dict(zip(("kind", "name", "plugin", "package", "version"), r, strict=True))
+                        for r in rows
+                    ],
+                    "failed": [f.__dict__ for f in reg.failed],
+                },
+                indent=2,
+            )
+        )
         return 0
     head = ("KIND", "NAME", "PLUGIN", "PACKAGE", "VERSION")
     widths = [max(len(str(x)) for x in col) for col in zip(head, *rows, strict=True)]

@@ -15,33 +15,119 @@ from typing import Any
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--estimator", default="tpe", metavar="NAME", help="correction estimator (default: tpe; see `physbench plugins`)")
     p.add_argument(
-        "-o", "--option", action="append", default=[], metavar="KEY=VALUE",
+        "--estimator",
+        default="tpe",
+        metavar="NAME",
+        help="correction estimator (default: tpe; see `physbench plugins`)",
+    )
+    p.add_argument(
+        "-o",
+        "--option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
         help="estimator option, repeatable, e.g. -o startup=5 or -o sampler=cmaes (values parse as JSON, else text)",
     )
-    p.add_argument("--scene", default="three_circles", metavar="NAME|FILE", help="registered scene or scene TOML (default: three_circles)")
     p.add_argument(
-        "--params", nargs="+", default=["mass"], metavar="PARAM",
+        "--scene",
+        default="three_circles",
+        metavar="NAME|FILE",
+        help="registered scene or scene TOML (default: three_circles)",
+    )
+    p.add_argument(
+        "--params",
+        nargs="+",
+        default=["mass"],
+        metavar="PARAM",
         help="unknown parameters to identify, e.g. mass or mass elasticity (commas work too; default: mass)",
     )
-    p.add_argument("--bodies", nargs="+", default=None, metavar="BODY", help="only these bodies' unknowns (default: all)")
-    p.add_argument("--iterations", type=int, default=11, metavar="N", help="simulations = propose calls (default: 11, as in the paper)")
-    p.add_argument("--seed", type=int, default=0, help="scene instance, truth, initial guess and estimator seed (default: 0)")
-    p.add_argument("--engine", default="pymunk", metavar="NAME", help="simulator of the model (default: pymunk)")
     p.add_argument(
-        "--observe-engine", default=None, metavar="NAME",
+        "--bodies",
+        nargs="+",
+        default=None,
+        metavar="BODY",
+        help="only these bodies' unknowns (default: all)",
+    )
+    p.add_argument(
+        "--iterations",
+        type=int,
+        default=11,
+        metavar="N",
+        help="simulations = propose calls (default: 11, as in the paper)",
+    )
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="scene instance, truth, initial guess and estimator seed (default: 0)",
+    )
+    p.add_argument(
+        "--engine",
+        default="pymunk",
+        metavar="NAME",
+        help="simulator of the model (default: pymunk)",
+    )
+    p.add_argument(
+        "--observe-engine",
+        default=None,
+        metavar="NAME",
         help="simulator that makes the observation (default: --engine); another engine gives a sim-to-sim reality gap",
     )
-    p.add_argument("--resolution", type=int, default=64, metavar="PX", help="frame width in pixels (default: 64)")
-    p.add_argument("--render-mode", default="mark", choices=("mark", "instance", "mask"), help="raster channels (default: mark)")
-    p.add_argument("--blur", type=float, default=0.0, metavar="SIGMA", help="Gaussian blur (pixels) of the observation only; the model stays sharp")
-    p.add_argument("--noise", type=float, default=0.0, metavar="SIGMA", help="Gaussian pixel noise of the observation only")
-    p.add_argument("--observation", default=None, metavar="FILE", help="observed frames (.npz with key 'frames', (T, C, H, W) in [0, 1])")
-    p.add_argument("--save-observation", default=None, metavar="FILE", help="write the observation used to FILE (.npz)")
-    p.add_argument("--json", action="store_true", help="print the history as JSON instead of the table")
-    p.add_argument("--plot", default=None, metavar="FILE", help="convergence plot (best-so-far errors per iteration), e.g. out.png")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress display or table: only the final line (or the JSON)")
+    p.add_argument(
+        "--resolution",
+        type=int,
+        default=64,
+        metavar="PX",
+        help="frame width in pixels (default: 64)",
+    )
+    p.add_argument(
+        "--render-mode",
+        default="mark",
+        choices=("mark", "instance", "mask"),
+        help="raster channels (default: mark)",
+    )
+    p.add_argument(
+        "--blur",
+        type=float,
+        default=0.0,
+        metavar="SIGMA",
+        help="Gaussian blur (pixels) of the observation only; the model stays sharp",
+    )
+    p.add_argument(
+        "--noise",
+        type=float,
+        default=0.0,
+        metavar="SIGMA",
+        help="Gaussian pixel noise of the observation only",
+    )
+    p.add_argument(
+        "--observation",
+        default=None,
+        metavar="FILE",
+        help="observed frames (.npz with key 'frames', (T, C, H, W) in [0, 1])",
+    )
+    p.add_argument(
+        "--save-observation",
+        default=None,
+        metavar="FILE",
+        help="write the observation used to FILE (.npz)",
+    )
+    p.add_argument(
+        "--json", action="store_true", help="print the history as JSON instead of the table"
+    )
+    p.add_argument(
+        "--plot",
+        default=None,
+        metavar="FILE",
+        help="convergence plot (best-so-far errors per iteration), e.g. out.png",
+    )
+    p.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        help="no progress display or table: only the final line (or the JSON)",
+    )
 
 
 def parse_options(items: list[str]) -> dict[str, Any]:
@@ -69,21 +155,33 @@ def print_table(history: Any, out: Any = sys.stdout) -> None:
     """The per-iteration table: parameters, image MSE, normalized MSE, best-so-far, timings (ms)."""
     keys = list(history.keys)
     has_truth = history.truth is not None
-    head = ["iter", *keys, "image MSE"] + (["norm MSE"] if has_truth else []) + ["best", "best image"]
+    head = (
+        ["iter", *keys, "image MSE"] + (["norm MSE"] if has_truth else []) + ["best", "best image"]
+    )
     head += (["best norm"] if has_truth else []) + ["sim ms", "render ms", "est ms"]
     rows = []
     for r in history.records:
         row = [str(r.iteration), *(f"{r.params[k]:.4g}" for k in keys), _fmt(r.loss)]
         row += [_fmt(r.nmse)] if has_truth else []
-        row += [str(r.best_iteration), _fmt(r.best_loss)] + ([_fmt(r.best_nmse)] if has_truth else [])
-        row += [f"{1e3 * r.t_simulate:.2f}", f"{1e3 * r.t_render:.2f}", f"{1e3 * r.t_estimator:.2f}"]
+        row += [str(r.best_iteration), _fmt(r.best_loss)] + (
+            [_fmt(r.best_nmse)] if has_truth else []
+        )
+        row += [
+            f"{1e3 * r.t_simulate:.2f}",
+            f"{1e3 * r.t_render:.2f}",
+            f"{1e3 * r.t_estimator:.2f}",
+        ]
         if r.failed:
             row[-1] += f"  (simulation failed: {r.failed})"
         rows.append(row)
     widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(head)]
     print("  ".join(h.rjust(w) for h, w in zip(head, widths, strict=True)), file=out)
     for row in rows:
-        print("  ".join(c.rjust(w) for c, w in zip(row, widths, strict=False)) + "".join(row[len(widths):]), file=out)
+        print(
+            "  ".join(c.rjust(w) for c, w in zip(row, widths, strict=False))
+            + "".join(row[len(widths) :]),
+            file=out,
+        )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -97,20 +195,40 @@ def main(args: argparse.Namespace) -> int:
     from physbench.experiment import Case, case_space, make_estimator, run_case
 
     params = tuple(q for item in args.params for q in item.split(",") if q)
-    bodies = None if args.bodies is None else tuple(b for item in args.bodies for b in item.split(",") if b)
+    bodies = (
+        None
+        if args.bodies is None
+        else tuple(b for item in args.bodies for b in item.split(",") if b)
+    )
     case = Case(
-        scene=args.scene, params=params, estimator=args.estimator, options=parse_options(args.option),
-        seed=args.seed, iterations=args.iterations, engine=args.engine, observe_engine=args.observe_engine,
-        blur=args.blur, noise=args.noise, resolution=args.resolution, render_mode=args.render_mode,
-        bodies=bodies, observation=args.observation,
+        scene=args.scene,
+        params=params,
+        estimator=args.estimator,
+        options=parse_options(args.option),
+        seed=args.seed,
+        iterations=args.iterations,
+        engine=args.engine,
+        observe_engine=args.observe_engine,
+        blur=args.blur,
+        noise=args.noise,
+        resolution=args.resolution,
+        render_mode=args.render_mode,
+        bodies=bodies,
+        observation=args.observation,
     )
     space = case_space(case)  # unknown scene or parameter: fail before the progress bar appears
     make_estimator(case.estimator, case.options)
 
     from tqdm import tqdm
 
-    bar = tqdm(total=args.iterations, desc=f"{args.estimator} on {args.scene}", unit="it", file=sys.stderr,
-               disable=True if args.quiet else None, leave=False)
+    bar = tqdm(
+        total=args.iterations,
+        desc=f"{args.estimator} on {args.scene}",
+        unit="it",
+        file=sys.stderr,
+        disable=True if args.quiet else None,
+        leave=False,
+    )
 
     def progress(rec: Any) -> None:
         post = {"best image": f"{rec.best_loss:.2e}"}
@@ -127,7 +245,11 @@ def main(args: argparse.Namespace) -> int:
     if args.plot:
         from physbench.plotting.convergence import plot_convergence
 
-        plot_convergence({f"{history.estimator}": [history]}, args.plot, title=f"{history.meta['scene']}: {', '.join(space.keys)}")
+        plot_convergence(
+            {f"{history.estimator}": [history]},
+            args.plot,
+            title=f"{history.meta['scene']}: {', '.join(space.keys)}",
+        )
 
     if args.json:
         print(history.to_json(indent=1))
@@ -143,12 +265,17 @@ def main(args: argparse.Namespace) -> int:
         best = history.best
         if history.truth is not None:
             print("truth:   " + "  ".join(f"{k}={v:.4g}" for k, v in history.truth.items()))
-        print(f"best (iteration {best.iteration}, by image MSE): " + "  ".join(f"{k}={v:.4g}" for k, v in best.params.items()))
+        print(
+            f"best (iteration {best.iteration}, by image MSE): "
+            + "  ".join(f"{k}={v:.4g}" for k, v in best.params.items())
+        )
     if history.min_nmse is not None:
         print(
             f"normalized min MSE after {n} iterations: {history.min_nmse:.3e} "
             f"(initial guess {history.initial_nmse:.3e}; min image MSE {history.min_loss:.3e})"
         )
     else:
-        print(f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation from {args.observation})")
+        print(
+            f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation from {args.observation})"
+        )
     return 0

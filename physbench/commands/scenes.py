@@ -24,7 +24,9 @@ def main(args: argparse.Namespace) -> int:
         print(f"{name}  ({reg.info('scene', name).package})")
         print(f"    {getattr(gen, 'description', '')}")
         bodies = ", ".join(scene.body_names)
-        print(f"    bodies: {bodies}" + (f"; test body: {scene.test_body}" if scene.test_body else ""))
+        print(
+            f"    bodies: {bodies}" + (f"; test body: {scene.test_body}" if scene.test_body else "")
+        )
         by_param: dict[str, list[str]] = {}
         for u in scene.unknowns:
             by_param.setdefault(u.param, []).append(f"{u.body} [{u.low:g}, {u.high:g}]")

@@ -7,12 +7,21 @@ import argparse
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scene", required=True, help="registered scene name or a scene .toml file")
-    p.add_argument("--engine", default="pymunk", help="simulator (see `physbench plugins`; default pymunk)")
+    p.add_argument(
+        "--engine", default="pymunk", help="simulator (see `physbench plugins`; default pymunk)"
+    )
     p.add_argument("--seed", type=int, default=0, help="scene instance seed (default 0)")
-    p.add_argument("--set", action="append", default=[], metavar="BODY.PARAM=VALUE",
-                   help="override a body parameter, e.g. --set a.mass=3 (repeatable)")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="BODY.PARAM=VALUE",
+        help="override a body parameter, e.g. --set a.mass=3 (repeatable)",
+    )
     p.add_argument("--resolution", type=int, default=64, help="frame width in pixels (default 64)")
-    p.add_argument("--mode", default="mark", help="renderer mode: mark, instance or mask (default mark)")
+    p.add_argument(
+        "--mode", default="mark", help="renderer mode: mark, instance or mask (default mark)"
+    )
     p.add_argument("--out", metavar="FILE.npz", help="write trajectory and frames here")
     p.add_argument("--preview", metavar="FILE.gif|png", help="write a picture of the run")
 
@@ -28,7 +37,9 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
                 raise ValueError
             out[key.strip()] = float(value)
         except ValueError:
-            raise PhysbenchError(f"--set {item!r}: expected BODY.PARAM=NUMBER, e.g. a.mass=3.5") from None
+            raise PhysbenchError(
+                f"--set {item!r}: expected BODY.PARAM=NUMBER, e.g. a.mass=3.5"
+            ) from None
     return out
 
 
@@ -46,9 +57,13 @@ def main(args: argparse.Namespace) -> int:
     scene = resolve_scene(args.scene, args.seed)
     scene = scene.with_params(parse_overrides(args.set)).validate()
     traj = create("simulator", args.engine).simulate(scene)
-    frames = create("renderer", "raster", resolution=args.resolution, mode=args.mode).render(scene, traj)
-    print(f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies {', '.join(traj.bodies)}, "
-          f"frames {frames.shape}")
+    frames = create("renderer", "raster", resolution=args.resolution, mode=args.mode).render(
+        scene, traj
+    )
+    print(
+        f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies {', '.join(traj.bodies)}, "
+        f"frames {frames.shape}"
+    )
     for i, name in enumerate(traj.bodies):
         (x0, y0), (x1, y1) = traj.states[0, i, :2], traj.states[-1, i, :2]
         print(f"  {name:>8}: ({x0:6.3f}, {y0:6.3f}) -> ({x1:6.3f}, {y1:6.3f}) m")
@@ -56,7 +71,9 @@ def main(args: argparse.Namespace) -> int:
         from physbench.scene_toml import dumps_scene
 
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        np.savez_compressed(args.out, frames=frames, scene_toml=np.array(dumps_scene(scene)), **traj.to_npz_dict())
+        np.savez_compressed(
+            args.out, frames=frames, scene_toml=np.array(dumps_scene(scene)), **traj.to_npz_dict()
+        )
         print(f"wrote {args.out}")
     if args.preview:
         from physbench.render.preview import save_preview

@@ -80,7 +80,9 @@ def _extremes(a: np.ndarray, c: float) -> np.ndarray:
     d = a - c
     sign = np.sign(d)
     cross = np.nonzero(sign[:-1] * sign[1:] < 0)[0] + 1
-    return np.array([lo + int(np.argmax(np.abs(d[lo:hi]))) for lo, hi in itertools.pairwise(cross)], dtype=int)
+    return np.array(
+        [lo + int(np.argmax(np.abs(d[lo:hi]))) for lo, hi in itertools.pairwise(cross)], dtype=int
+    )
 
 
 def oscillation_centre(t: np.ndarray, a: np.ndarray) -> float:
@@ -103,7 +105,9 @@ def oscillation_periods(t: np.ndarray, a: np.ndarray, centre: float | None = Non
     return np.diff(_up_crossings(t, a - c))
 
 
-def swing_peaks(t: np.ndarray, a: np.ndarray, centre: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+def swing_peaks(
+    t: np.ndarray, a: np.ndarray, centre: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Times and amplitudes (about ``centre``, default :func:`oscillation_centre`) of the extremes
     of each complete half swing."""
     c = oscillation_centre(t, a) if centre is None else centre
@@ -129,4 +133,14 @@ def load(name: str, **options: object) -> list[Case]:
     return loaders[name](**options)
 
 
-__all__ = ["DATA_ENV", "Case", "DatasetError", "data_dir", "dataset_names", "load", "oscillation_centre", "oscillation_periods", "swing_peaks"]
+__all__ = [
+    "DATA_ENV",
+    "Case",
+    "DatasetError",
+    "data_dir",
+    "dataset_names",
+    "load",
+    "oscillation_centre",
+    "oscillation_periods",
+    "swing_peaks",
+]

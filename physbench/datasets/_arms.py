@@ -30,7 +30,9 @@ def _direction(angle: np.ndarray) -> np.ndarray:
     return np.stack([np.sin(angle), -np.cos(angle)], axis=-1)
 
 
-def chain_poses(pivot: tuple[float, float], arms: Sequence[Arm], angles: np.ndarray) -> list[np.ndarray]:
+def chain_poses(
+    pivot: tuple[float, float], arms: Sequence[Arm], angles: np.ndarray
+) -> list[np.ndarray]:
     """Shape-centre positions ``(T, 2)`` of each arm for absolute angles ``(T, n_arms)``."""
     p = np.broadcast_to(np.asarray(pivot, dtype=float), (angles.shape[0], 2))
     out = []
@@ -54,9 +56,16 @@ def chain(
         centre, v = p + r, vp + w * np.array([-r[1], r[0]])
         bodies.append(
             Body(
-                arm.name, Box(ARM_WIDTH, arm.length), (float(centre[0]), float(centre[1])), angle=float(a),
-                velocity=(float(v[0]), float(v[1])), angular_velocity=float(w), mass=arm.mass,
-                moment=arm.inertia, com_offset=(0.0, 0.5 * arm.length - arm.com), friction=0.0,
+                arm.name,
+                Box(ARM_WIDTH, arm.length),
+                (float(centre[0]), float(centre[1])),
+                angle=float(a),
+                velocity=(float(v[0]), float(v[1])),
+                angular_velocity=float(w),
+                mass=arm.mass,
+                moment=arm.inertia,
+                com_offset=(0.0, 0.5 * arm.length - arm.com),
+                friction=0.0,
             )
         )
         joints.append(Joint(arm.name, (float(p[0]), float(p[1])), parent))
@@ -66,7 +75,12 @@ def chain(
     return tuple(bodies), tuple(joints)
 
 
-def chain_tracks(pivot: tuple[float, float], arms: Sequence[Arm], t: np.ndarray, angles: np.ndarray) -> dict[str, Track]:
+def chain_tracks(
+    pivot: tuple[float, float], arms: Sequence[Arm], t: np.ndarray, angles: np.ndarray
+) -> dict[str, Track]:
     """Tracks of each arm: the measured angle and the shape centre it implies."""
     poses = chain_poses(pivot, arms, angles)
-    return {arm.name: Track(t, xy[:, 0], xy[:, 1], angles[:, k]) for k, (arm, xy) in enumerate(zip(arms, poses, strict=True))}
+    return {
+        arm.name: Track(t, xy[:, 0], xy[:, 1], angles[:, k])
+        for k, (arm, xy) in enumerate(zip(arms, poses, strict=True))
+    }

@@ -54,7 +54,9 @@ def ball_properties(folder: Path) -> dict[str, tuple[float, float] | None]:
         if not parts:
             continue
         if len(parts) != 3:
-            raise DatasetError(f"{folder / 'balls.txt'}:{n}: expected 'name weight_oz circumference_cm', got {line!r}")
+            raise DatasetError(
+                f"{folder / 'balls.txt'}:{n}: expected 'name weight_oz circumference_cm', got {line!r}"
+            )
         name, oz, cm = parts
         out[name] = None if "?" in oz + cm else (float(oz) * OZ, float(cm) / (200 * math.pi))
     return out
@@ -96,11 +98,17 @@ def load(
         data = np.loadtxt(folder / f"{stem}.csv", delimiter=",", skiprows=1, ndmin=2)
         prop = props.get(BALLS[stem])
         assumed = prop is None
-        mass, radius = prop if prop is not None else (VOLLEYBALL_ASSUMED[0], VOLLEYBALL_ASSUMED[1] / (2 * math.pi))
+        mass, radius = (
+            prop
+            if prop is not None
+            else (VOLLEYBALL_ASSUMED[0], VOLLEYBALL_ASSUMED[1] / (2 * math.pi))
+        )
         for drop in drops:
             rows = data[data[:, 0] == drop]
             if rows.shape[0] < FIT_SAMPLES:
-                raise DatasetError(f"{folder / stem}.csv: drop {drop} has {rows.shape[0]} rows; drops: {sorted(set(data[:, 0].astype(int)))}")
+                raise DatasetError(
+                    f"{folder / stem}.csv: drop {drop} has {rows.shape[0]} rows; drops: {sorted(set(data[:, 0].astype(int)))}"
+                )
             keep = clip_drop(rows[:, 1])
             t = rows[:keep, 1] - rows[0, 1]
             h = rows[:keep, 2]

@@ -38,7 +38,9 @@ MAX_START_STEP = 0.1  # s
 def _table(path: Path) -> np.ndarray:
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     if data.shape[1] != 6:
-        raise DatasetError(f"{path}: expected 6 columns shot_index,shot_id,ball_id,t_s,x_m,y_m, got {data.shape[1]}")
+        raise DatasetError(
+            f"{path}: expected 6 columns shot_index,shot_id,ball_id,t_s,x_m,y_m, got {data.shape[1]}"
+        )
     return data
 
 
@@ -55,7 +57,12 @@ def cushions(elasticity: float = 0.9, friction: float = 0.0) -> tuple[Segment, .
     lo, hx, hy = -r - r, w + r + r, h + r + r  # long enough to close the corners
     return tuple(
         Segment(a, b, radius=r, elasticity=elasticity, friction=friction)
-        for a, b in (((lo, -r), (hx, -r)), ((lo, h + r), (hx, h + r)), ((-r, lo), (-r, hy)), ((w + r, lo), (w + r, hy)))
+        for a, b in (
+            ((lo, -r), (hx, -r)),
+            ((lo, h + r), (hx, h + r)),
+            ((-r, lo), (-r, hy)),
+            ((w + r, lo), (w + r, hy)),
+        )
     )
 
 
@@ -110,8 +117,14 @@ def load(
         cue = "white" if counts["white"] >= counts["yellow"] else "yellow"
         strike = cue_strike(tracks[cue])
         bodies = tuple(
-            Body(name, Circle(BALL_RADIUS), (float(tr.x[0]), float(tr.y[0])), mass=BALL_MASS,
-                 elasticity=ball_elasticity, friction=0.0)
+            Body(
+                name,
+                Circle(BALL_RADIUS),
+                (float(tr.x[0]), float(tr.y[0])),
+                mass=BALL_MASS,
+                elasticity=ball_elasticity,
+                friction=0.0,
+            )
             for name, tr in tracks.items()
         )
         forces = ()
@@ -119,7 +132,13 @@ def load(
             t_s, (vx, vy) = strike
             forces = (Force(cue, (BALL_MASS * vx, BALL_MASS * vy), start=t_s, kind="impulse"),)
         shot_id = int(rows[0, 1])
-        rec = Recording(tracks, run=str(shot), fields=("x", "y"), source=FOLDER, meta={"shot_id": shot_id, "cue": cue})
+        rec = Recording(
+            tracks,
+            run=str(shot),
+            fields=("x", "y"),
+            source=FOLDER,
+            meta={"shot_id": shot_id, "cue": cue},
+        )
         margin = 0.1
         scene = Scene(
             name=f"billiards_shot_{shot}",
@@ -137,11 +156,21 @@ def load(
         notes = {
             "shot_id": shot_id,
             "cue": cue,
-            "strike": None if strike is None else {"t_s": strike[0], "speed_mps": float(np.hypot(*strike[1]))},
+            "strike": None
+            if strike is None
+            else {"t_s": strike[0], "speed_mps": float(np.hypot(*strike[1]))},
             "ball_mass_assumed": True,
             "samples": counts,
         }
-        cases.append(Case(f"shot_{shot}", scene, rec, ("rolling_resistance", "velocity_dependent_restitution"), notes))
+        cases.append(
+            Case(
+                f"shot_{shot}",
+                scene,
+                rec,
+                ("rolling_resistance", "velocity_dependent_restitution"),
+                notes,
+            )
+        )
     return cases
 
 

@@ -92,7 +92,16 @@ def load(
             description=f"rod pendulum free swing {number} from {math.degrees(phi[0, 0]):.0f}° (jensen-benard)",
             meta={"dataset": NAME},
         ).validate()
-        notes = {"nominal_rate_hz": NOMINAL_RATE, "small_angle_period_s": 2 * math.pi * math.sqrt(2 * ROD_LENGTH / (3 * G))}
-        effects = ("joint_viscous_damping", "joint_coulomb_friction", "joint_quadratic_damping", "sensor_offset", "clock_scale")
+        notes = {
+            "nominal_rate_hz": NOMINAL_RATE,
+            "small_angle_period_s": 2 * math.pi * math.sqrt(2 * ROD_LENGTH / (3 * G)),
+        }
+        effects = (
+            "joint_viscous_damping",
+            "joint_coulomb_friction",
+            "joint_quadratic_damping",
+            "sensor_offset",
+            "clock_scale",
+        )
         cases.append(Case(rec.run, scene, rec, effects, notes))
     return cases

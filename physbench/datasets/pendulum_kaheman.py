@@ -26,7 +26,10 @@ G = 9.81
 
 #: The authors' fits (EstimatedParameters_*.mat): mass, CoM distance, pivot distance, inertia.
 SINGLE = (Arm("arm1", 0.14758, 0.14775, 2 * 0.14775, 1.0912e-4),)
-DOUBLE = (Arm("arm1", 0.09384, 0.10857, 0.17272, 4.375e-4), Arm("arm2", 0.13760, 0.11678, 2 * 0.11678, 1.2688e-3))
+DOUBLE = (
+    Arm("arm1", 0.09384, 0.10857, 0.17272, 4.375e-4),
+    Arm("arm2", 0.13760, 0.11678, 2 * 0.11678, 1.2688e-3),
+)
 #: The authors' linear viscous joint damping, N·m·s/rad, for reference.
 AUTHORS_DAMPING = {1: (2.2394e-4,), 2: (2.371e-4, 1.0e-5)}
 FILES = {1: "single_pendulum_freeswing", 2: "double_pendulum_freeswing"}
@@ -73,7 +76,9 @@ def load(
     cases = []
     for w in range(n):
         t0 = start + w * length
-        sel = np.nonzero((t_all >= t0 - 1e-9) & (t_all <= t0 + length + 1e-9))[0][:: max(1, int(every))]
+        sel = np.nonzero((t_all >= t0 - 1e-9) & (t_all <= t0 + length + 1e-9))[0][
+            :: max(1, int(every))
+        ]
         if sel.size < 2:
             raise DatasetError(f"window {t0:g}..{t0 + length:g} s holds {sel.size} samples")
         rows = data[sel]
@@ -100,8 +105,17 @@ def load(
             description=f"{'single' if arms == 1 else 'double'} pendulum free swing from t = {rows[0, 2]:g} s (Kaheman et al. 2022)",
             meta={"dataset": NAME},
         ).validate()
-        notes = {"authors_joint_damping": AUTHORS_DAMPING[arms], "rest_angle_offset_rad": math.pi - 3.167}
+        notes = {
+            "authors_joint_damping": AUTHORS_DAMPING[arms],
+            "rest_angle_offset_rad": math.pi - 3.167,
+        }
         cases.append(
-            Case(rec.run, scene, rec, ("joint_viscous_damping", "joint_coulomb_friction", "sensor_offset"), notes)
+            Case(
+                rec.run,
+                scene,
+                rec,
+                ("joint_viscous_damping", "joint_coulomb_friction", "sensor_offset"),
+                notes,
+            )
         )
     return cases

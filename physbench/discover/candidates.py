@@ -64,7 +64,10 @@ def free_bodies(scene: Scene) -> list[str]:
 
 
 def candidates_for(
-    scene: Scene, names: Sequence[str] | None = None, *, factories: dict[str, Callable[..., Effect]] | None = None
+    scene: Scene,
+    names: Sequence[str] | None = None,
+    *,
+    factories: dict[str, Callable[..., Effect]] | None = None,
 ) -> tuple[list[CandidateSpec], list[tuple[str, str]]]:
     """Candidates for ``scene`` from the registered effects (or ``names``), and the ones left out
     with the reason. Raises :class:`UnknownNameError` for a name that is not registered."""
@@ -85,17 +88,34 @@ def candidates_for(
     for name in chosen:
         options: dict[str, Any] = {}
         if name == "rolling_resistance" and not top_down and not scene.statics:
-            skipped.append((name, "no surface to roll on (gravity acts in the scene's plane and there is no static geometry)"))
+            skipped.append(
+                (
+                    name,
+                    "no surface to roll on (gravity acts in the scene's plane and there is no static geometry)",
+                )
+            )
             continue
-        if name in same and one_mass and same[name] in chosen and name != ("table_tilt" if top_down else "constant_force"):
+        if (
+            name in same
+            and one_mass
+            and same[name] in chosen
+            and name != ("table_tilt" if top_down else "constant_force")
+        ):
             skipped.append((name, f"on bodies of one mass it is {same[name]} again"))
             continue
         if name == "clock_scale" and not scene.forces:
-            skipped.append((name, "no force of known size: a clock error would be a change of gravity and initial speeds"))
+            skipped.append(
+                (
+                    name,
+                    "no force of known size: a clock error would be a change of gravity and initial speeds",
+                )
+            )
             continue
         if name in TRANSLATIONAL_LOSSES and len(free) < len(scene.bodies):
             if not free:
-                skipped.append((name, "no free bodies (on a jointed body this loss is joint damping)"))
+                skipped.append(
+                    (name, "no free bodies (on a jointed body this loss is joint damping)")
+                )
                 continue
             options["bodies"] = free
         if name in CONTACT_LAWS and not scene.statics and len(scene.bodies) < 2:
@@ -120,6 +140,10 @@ def start_values(effect: Effect, scene: Scene) -> dict[str, float]:
         products = [b.elasticity * s.elasticity for b in scene.bodies for s in scene.statics]
         if not getattr(effect, "statics_only", False):
             bs = scene.bodies
-            products += [bs[i].elasticity * bs[j].elasticity for i in range(len(bs)) for j in range(i + 1, len(bs))]
+            products += [
+                bs[i].elasticity * bs[j].elasticity
+                for i in range(len(bs))
+                for j in range(i + 1, len(bs))
+            ]
         return {"e0": float(statistics.median(products)) if products else 0.9, "k": 0.0}
     return {}

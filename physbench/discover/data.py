@@ -59,7 +59,9 @@ class Run:
         else:
             f = np.asarray(self.frames)
             if f.ndim != 4 or f.shape[0] < 2:
-                raise DiscoverError(f"run {self.name!r}: frames must be (T, C, H, W) with T >= 2, got shape {f.shape}")
+                raise DiscoverError(
+                    f"run {self.name!r}: frames must be (T, C, H, W) with T >= 2, got shape {f.shape}"
+                )
             frames = int(f.shape[0])
         if self.scene.frames != frames:
             object.__setattr__(self, "scene", replace(self.scene, frames=frames))
@@ -80,7 +82,9 @@ def runs_from_cases(cases: Iterable[Case]) -> list[Run]:
     return [Run(c.name, c.scene, recording=c.recording, source=c.recording.source) for c in cases]
 
 
-def load_runs(recording: str | Path, scene: Scene | str | Path, *, run: str | None = None) -> list[Run]:
+def load_runs(
+    recording: str | Path, scene: Scene | str | Path, *, run: str | None = None
+) -> list[Run]:
     """Runs from a recording file (``.csv``: tracked trajectories, one run per ``run`` label;
     ``.npz``: observed frames under key ``frames``) and a scene (object or ``.toml`` file) that
     every run shares. ``run`` keeps one run of a multi-run CSV."""
@@ -90,7 +94,9 @@ def load_runs(recording: str | Path, scene: Scene | str | Path, *, run: str | No
     sc.validate()
     path = Path(recording)
     if not path.is_file():
-        raise DiscoverError(f"recording file {str(path)!r} does not exist; expected a .csv recording or .npz frames")
+        raise DiscoverError(
+            f"recording file {str(path)!r} does not exist; expected a .csv recording or .npz frames"
+        )
     suffix = path.suffix.lower()
     if suffix == ".csv":
         from physbench.recording import read_recordings
@@ -106,7 +112,9 @@ def load_runs(recording: str | Path, scene: Scene | str | Path, *, run: str | No
         from physbench.observation import load_observation
 
         obs = load_observation(path)
-        return [Run(path.stem, sc, frames=np.asarray(obs.frames, dtype=np.float32), source=str(path))]
+        return [
+            Run(path.stem, sc, frames=np.asarray(obs.frames, dtype=np.float32), source=str(path))
+        ]
     raise DiscoverError(
         f"recording {str(path)!r}: unknown format {suffix or '(no suffix)'!r}; expected .csv (tracked "
         "trajectories t,body,x,y[,angle][,run]) or .npz (frames)"
@@ -138,7 +146,9 @@ def sub_recording(rec: Recording, lo: float, hi: float) -> Recording | None:
     for body, tr in rec.tracks.items():
         keep = (tr.t > lo) & (tr.t <= hi)
         if keep.any():
-            tracks[body] = Track(tr.t[keep], tr.x[keep], tr.y[keep], None if tr.angle is None else tr.angle[keep])
+            tracks[body] = Track(
+                tr.t[keep], tr.x[keep], tr.y[keep], None if tr.angle is None else tr.angle[keep]
+            )
     if not tracks:
         return None
     return Recording(tracks, run=rec.run, fields=rec.fields, source=rec.source, meta=rec.meta)
@@ -147,7 +157,10 @@ def sub_recording(rec: Recording, lo: float, hi: float) -> Recording | None:
 def _cut(run: Run, index: int, t_cut: float, what: str) -> tuple[Part, Part]:
     t_cut += 1e-9 * max(1.0, abs(t_cut))  # a sample at the cut belongs to the fitted part
     if run.recording is not None:
-        first, held = sub_recording(run.recording, -math.inf, t_cut), sub_recording(run.recording, t_cut, math.inf)
+        first, held = (
+            sub_recording(run.recording, -math.inf, t_cut),
+            sub_recording(run.recording, t_cut, math.inf),
+        )
         n_fit = 0 if first is None else first.n_samples
         n_held = 0 if held is None else held.n_samples
         a = Part(index, recording=first, t_end=t_cut if first is None else first.t_end)
@@ -204,14 +217,22 @@ class Split:
         return f"runs {names} held out (their first {1 - self.fraction:.0%} fits only their initial state)"
 
 
-def make_split(runs: Sequence[Run], holdout: float = 0.3, kind: str = "auto", lead: float = 0.25) -> Split:
+def make_split(
+    runs: Sequence[Run], holdout: float = 0.3, kind: str = "auto", lead: float = 0.25
+) -> Split:
     """Split ``runs``: ``"time"`` holds out the last ``holdout`` of every run; ``"runs"`` holds out
     the last ``round(holdout · runs)`` runs (at least one), whose first ``lead`` fits only their own
     initial state; ``"auto"`` is ``"runs"`` with 3 or more runs, else ``"time"``."""
     if kind not in SPLITS:
         raise DiscoverError(f"split = {kind!r}: expected one of {', '.join(SPLITS)}")
-    if isinstance(holdout, bool) or not isinstance(holdout, int | float) or not 0.05 <= holdout <= 0.8:
-        raise DiscoverError(f"holdout = {holdout!r}: expected a fraction in [0.05, 0.8] of the data to hold out")
+    if (
+        isinstance(holdout, bool)
+        or not isinstance(holdout, int | float)
+        or not 0.05 <= holdout <= 0.8
+    ):
+        raise DiscoverError(
+            f"holdout = {holdout!r}: expected a fraction in [0.05, 0.8] of the data to hold out"
+        )
     if not runs:
         raise DiscoverError("no runs to discover from")
     names = [r.name for r in runs]
@@ -220,7 +241,9 @@ def make_split(runs: Sequence[Run], holdout: float = 0.3, kind: str = "auto", le
     if kind == "auto":
         kind = "runs" if len(runs) >= 3 else "time"
     if kind == "runs" and len(runs) < 2:
-        raise DiscoverError(f"split = 'runs' needs at least 2 runs; got {len(runs)} ({', '.join(names)}); use split='time'")
+        raise DiscoverError(
+            f"split = 'runs' needs at least 2 runs; got {len(runs)} ({', '.join(names)}); use split='time'"
+        )
     if kind == "time":
         fit, held = [], []
         for i, r in enumerate(runs):
@@ -239,4 +262,12 @@ def make_split(runs: Sequence[Run], holdout: float = 0.3, kind: str = "auto", le
         a, b = _cut(r, i, t0 + lead * (r.t_end - t0), f"first {lead:.0%} fits the initial state")
         leads.append(a)
         held.append(b)
-    return Split("runs", 1.0 - float(lead), tuple(_whole(runs[i], i) for i in train), tuple(leads), tuple(held), train, test)
+    return Split(
+        "runs",
+        1.0 - float(lead),
+        tuple(_whole(runs[i], i) for i in train),
+        tuple(leads),
+        tuple(held),
+        train,
+        test,
+    )

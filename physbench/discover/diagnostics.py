@@ -42,8 +42,14 @@ class Finding:
     suggests: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, object]:
-        return {"kind": self.kind, "run": self.run, "body": self.body, "text": self.text,
-                "values": {k: float(v) for k, v in self.values.items()}, "suggests": list(self.suggests)}
+        return {
+            "kind": self.kind,
+            "run": self.run,
+            "body": self.body,
+            "text": self.text,
+            "values": {k: float(v) for k, v in self.values.items()},
+            "suggests": list(self.suggests),
+        }
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,7 +73,11 @@ def views(scored: Scored) -> list[RunView]:
         traj, measured = model.simulate(i, model.values)
         scene, _ = model.run_scene(i, model.values)
         sim = run.recording.sample(measured) if run.recording is not None else None
-        out.append(RunView(run.name, scene, traj, measured, run.recording, sim, frame_events(scene, measured)))
+        out.append(
+            RunView(
+                run.name, scene, traj, measured, run.recording, sim, frame_events(scene, measured)
+            )
+        )
     return out
 
 
@@ -76,7 +86,10 @@ def diagnose(disc: Discovery) -> None:
     final model."""
     for label, scored in (("base", disc.base), ("final", disc.final)):
         if label == "final" and not disc.causes:
-            disc.findings["final"], disc.breakdowns["final"] = disc.findings["base"], disc.breakdowns["base"]
+            disc.findings["final"], disc.breakdowns["final"] = (
+                disc.findings["base"],
+                disc.breakdowns["base"],
+            )
             break
         vs = views(scored)
         parts = []
@@ -151,7 +164,9 @@ def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     return float(coef[1]), float(math.sqrt(max(cov[1, 1], 0.0))), float(coef[0])
 
 
-def _free_flight(run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, pos: Sequence[str]) -> list[Finding]:
+def _free_flight(
+    run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, pos: Sequence[str]
+) -> list[Finding]:
     free = ev == EVENTS.index("free")
     tm, vo = _speed(obs.t, obs, pos)
     _, vs = _speed(obs.t, sim, pos)
@@ -177,10 +192,23 @@ def _free_flight(run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, po
     vbar = float(np.mean(vs[ok])) if ok.any() else math.nan
     values = {"excess_deceleration": a_ex, "stderr": se, "mean_speed": vbar}
     if a_ex < 0:
-        return [Finding("free_flight", run, body, f"{body}: in free flight the observed speed falls {-a_ex:.3g} m/s² slower "
-                        "than simulated (the model loses too much speed)", values, ())]
-    text = (f"{body}: in free flight the observed speed falls {a_ex:.3g} ± {se:.2g} m/s² faster than simulated "
-            f"({a_ex / vbar:.1%} of the mean speed per second)" if vbar > 0 else f"{body}: observed speed falls faster")
+        return [
+            Finding(
+                "free_flight",
+                run,
+                body,
+                f"{body}: in free flight the observed speed falls {-a_ex:.3g} m/s² slower "
+                "than simulated (the model loses too much speed)",
+                values,
+                (),
+            )
+        ]
+    text = (
+        f"{body}: in free flight the observed speed falls {a_ex:.3g} ± {se:.2g} m/s² faster than simulated "
+        f"({a_ex / vbar:.1%} of the mean speed per second)"
+        if vbar > 0
+        else f"{body}: observed speed falls faster"
+    )
     suggests: tuple[str, ...] = ("linear_drag", "quadratic_drag", "rolling_resistance")
     pts = [(v, a) for v, a, s in halves if a > 2 * s and v > 0]
     if len(pts) >= 3 and np.ptp([p[0] for p in pts]) > 0.2 * np.mean([p[0] for p in pts]):
@@ -188,16 +216,24 @@ def _free_flight(run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, po
         n_exp = float(np.polyfit(lv, la, 1)[0])
         values["speed_exponent"] = n_exp
         if n_exp < 0.5:
-            suggests, law = ("rolling_resistance",), "about constant (a rolling-resistance-like loss)"
+            suggests, law = (
+                ("rolling_resistance",),
+                "about constant (a rolling-resistance-like loss)",
+            )
         elif n_exp < 1.5:
             suggests, law = ("linear_drag",), "about proportional to the speed (linear drag)"
         else:
-            suggests, law = ("quadratic_drag",), "about proportional to the squared speed (quadratic drag)"
+            suggests, law = (
+                ("quadratic_drag",),
+                "about proportional to the squared speed (quadratic drag)",
+            )
         text += f"; the excess grows like speed^{n_exp:.1f}: {law}"
     return [Finding("free_flight", run, body, text, values, suggests)]
 
 
-def _impacts(run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, pos: Sequence[str]) -> list[Finding]:
+def _impacts(
+    run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, pos: Sequence[str]
+) -> list[Finding]:
     hit = ev == EVENTS.index("impact")
     if not hit.any():
         return []
@@ -222,17 +258,27 @@ def _impacts(run: str, body: str, obs: Track, sim: Track, ev: np.ndarray, pos: S
     r = np.asarray(ratios)
     short = r[:, 1] - r[:, 0]
     mean, se = float(short.mean()), float(short.std(ddof=1) / math.sqrt(len(short)))
-    values = {"impacts": float(len(short)), "observed_speed_ratio": float(r[:, 0].mean()), "simulated_speed_ratio": float(r[:, 1].mean())}
+    values = {
+        "impacts": float(len(short)),
+        "observed_speed_ratio": float(r[:, 0].mean()),
+        "simulated_speed_ratio": float(r[:, 1].mean()),
+    }
     if abs(mean) < max(Z_REPORT * se, 0.02):
         return []
-    text = (f"{body}: across {len(short)} impacts the observed speed keeps {r[:, 0].mean():.0%} where the model keeps "
-            f"{r[:, 1].mean():.0%}")
+    text = (
+        f"{body}: across {len(short)} impacts the observed speed keeps {r[:, 0].mean():.0%} where the model keeps "
+        f"{r[:, 1].mean():.0%}"
+    )
     if len(short) >= 3 and np.ptp(speeds) > 0:
         slope, sse, _ = _line(np.asarray(speeds), short)
         values["shortfall_per_mps"] = slope
         if abs(slope) > Z_REPORT * sse:
             text += f"; the shortfall {'grows' if slope > 0 else 'shrinks'} with the impact speed ({slope:+.2g} per m/s)"
-    text += " (energy lost beyond what restitution allows)" if mean > 0 else " (the model loses too much at impacts)"
+    text += (
+        " (energy lost beyond what restitution allows)"
+        if mean > 0
+        else " (the model loses too much at impacts)"
+    )
     return [Finding("impacts", run, body, text, values, ("velocity_dependent_restitution",))]
 
 
@@ -253,8 +299,16 @@ def _drift(run: str, body: str, obs: Track, sim: Track, pos: Sequence[str]) -> l
         return []
     vec = ", ".join(f"{f} {acc[f]:+.3g}" for f in pos)
     values = {f"a{f}": acc[f] for f in pos}
-    return [Finding("drift", run, body, f"{body}: the residual drifts as if the model missed a uniform acceleration ({vec} m/s²)",
-                    values, ("constant_force", "table_tilt"))]
+    return [
+        Finding(
+            "drift",
+            run,
+            body,
+            f"{body}: the residual drifts as if the model missed a uniform acceleration ({vec} m/s²)",
+            values,
+            ("constant_force", "table_tilt"),
+        )
+    ]
 
 
 def _offset(run: str, body: str, obs: Track, sim: Track, fields: Sequence[str]) -> list[Finding]:
@@ -266,10 +320,20 @@ def _offset(run: str, body: str, obs: Track, sim: Track, fields: Sequence[str]) 
         if d.size < 8:
             continue
         mean, sd = float(d.mean()), float(d.std())
-        if abs(mean) > 0.7 * math.sqrt(mean * mean + sd * sd) and abs(mean) > Z_REPORT * sd / math.sqrt(d.size):
+        if abs(mean) > 0.7 * math.sqrt(mean * mean + sd * sd) and abs(
+            mean
+        ) > Z_REPORT * sd / math.sqrt(d.size):
             unit = "rad" if f == "angle" else "m"
-            out.append(Finding("offset", run, body, f"{body}: observed {f} sits {mean:+.3g} {unit} from the simulated one throughout",
-                               {f"d{f}": mean}, ("sensor_offset",)))
+            out.append(
+                Finding(
+                    "offset",
+                    run,
+                    body,
+                    f"{body}: observed {f} sits {mean:+.3g} {unit} from the simulated one throughout",
+                    {f"d{f}": mean},
+                    ("sensor_offset",),
+                )
+            )
     return out
 
 
@@ -286,29 +350,63 @@ def _oscillation(run: str, body: str, obs: Track, sim: Track) -> list[Finding]:
         d = po[:-1] - po[1:]  # loss per half swing
         amp = 0.5 * (po[:-1] + po[1:])
         fits = {}
-        for name, basis in (("coulomb", np.ones_like(amp)), ("viscous", amp), ("quadratic", amp * amp)):
+        for name, basis in (
+            ("coulomb", np.ones_like(amp)),
+            ("viscous", amp),
+            ("quadratic", amp * amp),
+        ):
             c = float(basis @ d / (basis @ basis))
             fits[name] = float(np.sum((d - c * basis) ** 2))
         law = min(fits, key=fits.__getitem__)
-        effect = {"coulomb": "joint_coulomb_friction", "viscous": "joint_viscous_damping", "quadratic": "joint_quadratic_damping"}[law]
-        what = {"coulomb": "about constant (dry, Coulomb-like friction)", "viscous": "about proportional to the amplitude (viscous)",
-                "quadratic": "about proportional to the squared amplitude (air-drag-like)"}[law]
-        values = {"observed_first": float(po[0]), "observed_last": float(po[-1]), "simulated_first": float(ps[0]),
-                  "simulated_last": float(ps[-1]), "half_swings": float(po.size)}
+        effect = {
+            "coulomb": "joint_coulomb_friction",
+            "viscous": "joint_viscous_damping",
+            "quadratic": "joint_quadratic_damping",
+        }[law]
+        what = {
+            "coulomb": "about constant (dry, Coulomb-like friction)",
+            "viscous": "about proportional to the amplitude (viscous)",
+            "quadratic": "about proportional to the squared amplitude (air-drag-like)",
+        }[law]
+        values = {
+            "observed_first": float(po[0]),
+            "observed_last": float(po[-1]),
+            "simulated_first": float(ps[0]),
+            "simulated_last": float(ps[-1]),
+            "half_swings": float(po.size),
+        }
         sim_loss = float(ps[0] - ps[-1]) / max(ps.size - 1, 1)
         obs_loss = float(po[0] - po[-1]) / max(po.size - 1, 1)
         if obs_loss > 1.5 * max(sim_loss, 0.0) + 1e-4:
-            text = (f"{body}: the observed amplitude falls from {po[0]:.3g} to {po[-1]:.3g} rad over {po.size - 1} half swings, "
-                    f"the simulated one from {ps[0]:.3g} to {ps[-1]:.3g}; the loss per swing is {what}")
+            text = (
+                f"{body}: the observed amplitude falls from {po[0]:.3g} to {po[-1]:.3g} rad over {po.size - 1} half swings, "
+                f"the simulated one from {ps[0]:.3g} to {ps[-1]:.3g}; the loss per swing is {what}"
+            )
             out.append(Finding("envelope", run, body, text, values, (effect,)))
     per_o, per_s = oscillation_periods(t, ao, co), oscillation_periods(t, asim, cs)
     if per_o.size >= 2 and per_s.size >= 2:
         ratio = float(np.median(per_o) / np.median(per_s))
         spread = float(np.std(per_o) / np.sqrt(per_o.size) / np.median(per_s))
         if abs(ratio - 1) > max(Z_REPORT * spread, 0.002):
-            out.append(Finding("period", run, body, f"{body}: the observed period is {ratio:.4f} × the simulated one",
-                               {"period_ratio": ratio}, ("clock_scale",)))
+            out.append(
+                Finding(
+                    "period",
+                    run,
+                    body,
+                    f"{body}: the observed period is {ratio:.4f} × the simulated one",
+                    {"period_ratio": ratio},
+                    ("clock_scale",),
+                )
+            )
     if abs(co - cs) > 0.005:
-        out.append(Finding("centre", run, body, f"{body}: the observed swing is centred {co - cs:+.3g} rad from the simulated one",
-                           {"dangle": co - cs}, ("sensor_offset",)))
+        out.append(
+            Finding(
+                "centre",
+                run,
+                body,
+                f"{body}: the observed swing is centred {co - cs:+.3g} rad from the simulated one",
+                {"dangle": co - cs},
+                ("sensor_offset",),
+            )
+        )
     return out

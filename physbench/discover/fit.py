@@ -79,7 +79,18 @@ def least_squares(
     steps = [h for h in horizons if 0 < h < 1] + ([1.0] if final else [])
     for h in steps[:-1]:
         _lsq(model, free, role, runs, max_nfev, budget, diff_step, tol, h, covariance_needed=False)
-    fr = _lsq(model, free, role, runs, max_nfev, budget, diff_step, tol, steps[-1], covariance_needed=final)
+    fr = _lsq(
+        model,
+        free,
+        role,
+        runs,
+        max_nfev,
+        budget,
+        diff_step,
+        tol,
+        steps[-1],
+        covariance_needed=final,
+    )
     fr.simulations = model.problem.simulations - sims0
     return fr
 
@@ -89,8 +100,17 @@ class _OutOfBudget(Exception):
 
 
 def _lsq(
-    model: Model, free: Sequence[str], role: str, runs: Sequence[int] | None, max_nfev: int, budget: int | None,
-    diff_step: float, tol: float, horizon: float, *, covariance_needed: bool = True,
+    model: Model,
+    free: Sequence[str],
+    role: str,
+    runs: Sequence[int] | None,
+    max_nfev: int,
+    budget: int | None,
+    diff_step: float,
+    tol: float,
+    horizon: float,
+    *,
+    covariance_needed: bool = True,
 ) -> FitResult:
     from scipy.optimize import least_squares as lsq
 
@@ -106,7 +126,16 @@ def _lsq(
         raise DiscoverError(f"the model's starting point does not simulate: {exc}") from exc
     n = r0.size
     if not free or n == 0:
-        return FitResult(dict(model.values), list(free), {}, float(r0 @ r0), n, 1, model.problem.simulations - sims0, "nothing to fit")
+        return FitResult(
+            dict(model.values),
+            list(free),
+            {},
+            float(r0 @ r0),
+            n,
+            1,
+            model.problem.simulations - sims0,
+            "nothing to fit",
+        )
     bad = FAILED_RESIDUAL * max(float(np.sqrt(np.mean(r0 * r0))), 1e-9)
     best: list[tuple[float, np.ndarray]] = [(float(r0 @ r0), np.zeros(len(free)))]
     limit = math.inf if budget is None else sims0 + budget
@@ -145,8 +174,18 @@ def _lsq(
 
     status, nfev, j = "", 0, None
     try:
-        res = lsq(fun, np.zeros(len(free)), jac=jac, bounds=(lo_z, hi_z), method="dogbox", x_scale=1.0,
-                  max_nfev=max_nfev, ftol=tol, xtol=tol, gtol=tol)
+        res = lsq(
+            fun,
+            np.zeros(len(free)),
+            jac=jac,
+            bounds=(lo_z, hi_z),
+            method="dogbox",
+            x_scale=1.0,
+            max_nfev=max_nfev,
+            ftol=tol,
+            xtol=tol,
+            gtol=tol,
+        )
         status, nfev = str(res.message), int(res.nfev)
         if float(res.fun @ res.fun) <= best[0][0]:
             best[0], j = (float(res.fun @ res.fun), res.x), res.jac
@@ -164,11 +203,17 @@ def _lsq(
             limit = math.inf
             j = jac(z)
         stderr, corr = covariance(j, ssr, n, scale, free)
-    return FitResult(values, list(free), stderr, ssr, n, nfev, model.problem.simulations - sims0, status, corr)
+    return FitResult(
+        values, list(free), stderr, ssr, n, nfev, model.problem.simulations - sims0, status, corr
+    )
 
 
 def probe_start(
-    model: Model, keys: Sequence[str], *, role: str = "fit", multiples: Sequence[float] = (2.5, 10.0, 25.0)
+    model: Model,
+    keys: Sequence[str],
+    *,
+    role: str = "fit",
+    multiples: Sequence[float] = (2.5, 10.0, 25.0),
 ) -> float:
     """Move ``keys`` to the best of a few probe points before a local fit: each key alone at its
     current value ± ``multiples`` of its scale (:attr:`Param.scale`), then all keys at their best
@@ -210,7 +255,9 @@ def probe_start(
     return best
 
 
-def covariance(jac: np.ndarray, ssr: float, n: int, scale: np.ndarray, keys: Sequence[str]) -> tuple[dict[str, float], dict[str, dict[str, float]]]:
+def covariance(
+    jac: np.ndarray, ssr: float, n: int, scale: np.ndarray, keys: Sequence[str]
+) -> tuple[dict[str, float], dict[str, dict[str, float]]]:
     """Standard errors and correlations from the Jacobian (in scaled units) at the optimum."""
     p = len(keys)
     if p == 0:
@@ -223,7 +270,10 @@ def covariance(jac: np.ndarray, ssr: float, n: int, scale: np.ndarray, keys: Seq
     stderr = {k: float(sd[i] * scale[i]) for i, k in enumerate(keys)}
     with np.errstate(invalid="ignore", divide="ignore"):
         c = cov / np.outer(sd, sd)
-    corr = {k: {q: float(c[i, j]) for j, q in enumerate(keys) if j != i and np.isfinite(c[i, j])} for i, k in enumerate(keys)}
+    corr = {
+        k: {q: float(c[i, j]) for j, q in enumerate(keys) if j != i and np.isfinite(c[i, j])}
+        for i, k in enumerate(keys)
+    }
     return stderr, corr
 
 
@@ -253,11 +303,25 @@ def estimator_fit(
     if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
         raise DiscoverError(f"estimator iterations = {iterations!r}: expected a whole number >= 1")
     ps = [model.param(k) for k in free]
-    space = ParamSpace(tuple(Unknown(k.rpartition(".")[0], k.rpartition(".")[2], p.low, p.high) for k, p in zip(free, ps, strict=True)))
+    space = ParamSpace(
+        tuple(
+            Unknown(k.rpartition(".")[0], k.rpartition(".")[2], p.low, p.high)
+            for k, p in zip(free, ps, strict=True)
+        )
+    )
     current = {k: min(max(model.values[k], p.low), p.high) for k, p in zip(free, ps, strict=True)}
     r0 = model.residuals("fit", current)
     worst = FAILED_RESIDUAL**2 * max(float(np.mean(r0 * r0)), 1e-18)
-    est.start(Task(scene=model.problem.runs[0].scene, space=space, observation=np.zeros((0, 1, 1, 1), np.float32), initial=current, meta={"iterations": iterations}), seed=seed)
+    est.start(
+        Task(
+            scene=model.problem.runs[0].scene,
+            space=space,
+            observation=np.zeros((0, 1, 1, 1), np.float32),
+            initial=current,
+            meta={"iterations": iterations},
+        ),
+        seed=seed,
+    )
     best, best_loss = dict(current), float(np.mean(r0 * r0))
     params = dict(current)
     for k in range(iterations):

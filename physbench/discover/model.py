@@ -84,7 +84,11 @@ def _cross(w: float, r: np.ndarray) -> np.ndarray:
     return np.array([-w * r[1], w * r[0]])
 
 
-def apply_initial(scene: Scene, state: Mapping[str, Mapping[str, float]], forces: Mapping[int, Mapping[str, float]]) -> Scene:
+def apply_initial(
+    scene: Scene,
+    state: Mapping[str, Mapping[str, float]],
+    forces: Mapping[int, Mapping[str, float]],
+) -> Scene:
     """``scene`` with initial-state changes ``{body: {"vx0": ...}}`` (absolute values) and force
     vector changes ``{force index: {"fx": ..., "fy": ...}}`` applied."""
     if not state and not forces:
@@ -129,17 +133,27 @@ def apply_initial(scene: Scene, state: Mapping[str, Mapping[str, float]], forces
                 new[name] = (centre, angle, vel, omega)
                 joints[ji] = replace(scene.joints[ji], anchor=(float(anchor[0]), float(anchor[1])))
                 bodies[name] = replace(
-                    b, position=(float(centre[0]), float(centre[1])), angle=float(angle),
-                    velocity=(float(vel[0]), float(vel[1])), angular_velocity=float(omega),
+                    b,
+                    position=(float(centre[0]), float(centre[1])),
+                    angle=float(angle),
+                    velocity=(float(vel[0]), float(vel[1])),
+                    angular_velocity=float(omega),
                 )
     fs = list(scene.forces)
     for i, ch in forces.items():
         f = fs[i]
         fs[i] = replace(f, vector=(ch.get("fx", f.vector[0]), ch.get("fy", f.vector[1])))
-    return replace(scene, bodies=tuple(bodies[b.name] for b in scene.bodies), joints=tuple(joints), forces=tuple(fs))
+    return replace(
+        scene,
+        bodies=tuple(bodies[b.name] for b in scene.bodies),
+        joints=tuple(joints),
+        forces=tuple(fs),
+    )
 
 
-def nuisance_params(run: Run, index: int, prefix: str, names: Sequence[str] | str = "auto") -> list[Param]:
+def nuisance_params(
+    run: Run, index: int, prefix: str, names: Sequence[str] | str = "auto"
+) -> list[Param]:
     """The nuisance parameters of one run. ``"auto"``: angle and rate of every jointed body (when the
     joints form chains hanging from the world); position and velocity (plus angle and rate when the
     data hold angles) of every free body moving at t = 0; the vector of every scheduled impulse.
@@ -147,7 +161,9 @@ def nuisance_params(run: Run, index: int, prefix: str, names: Sequence[str] | st
     scene = run.scene
     parents = chain_parents(scene)
     jointed = {j.a for j in scene.joints} | {j.b for j in scene.joints if j.b is not None}
-    has_angle = run.recording is None or any(tr.angle is not None for tr in run.recording.tracks.values())
+    has_angle = run.recording is None or any(
+        tr.angle is not None for tr in run.recording.tracks.values()
+    )
     wanted: list[tuple[str, str]] = []
     if names == "none":
         return []
@@ -178,9 +194,13 @@ def nuisance_params(run: Run, index: int, prefix: str, names: Sequence[str] | st
                     f"({', '.join(scene.body_names)}) and NAME one of {', '.join(NUISANCE)}, or force<i>.fx/fy"
                 )
             elif target in jointed and name not in ("angle0", "omega0"):
-                raise DiscoverError(f"nuisance {item!r}: a jointed body's initial state is its angle0 and omega0")
+                raise DiscoverError(
+                    f"nuisance {item!r}: a jointed body's initial state is its angle0 and omega0"
+                )
             elif target in jointed and (parents is None or target not in parents):
-                raise DiscoverError(f"nuisance {item!r}: the joints of scene {scene.name!r} do not form chains from the world")
+                raise DiscoverError(
+                    f"nuisance {item!r}: the joints of scene {scene.name!r} do not form chains from the world"
+                )
             wanted.append((target, name))
     out = []
     xmin, ymin, xmax, ymax = scene.bounds
@@ -194,8 +214,12 @@ def nuisance_params(run: Run, index: int, prefix: str, names: Sequence[str] | st
         else:
             b = scene.bodies[scene.body_index(target)]
             start = {
-                "x0": b.position[0], "y0": b.position[1], "angle0": b.angle,
-                "vx0": b.velocity[0], "vy0": b.velocity[1], "omega0": b.angular_velocity,
+                "x0": b.position[0],
+                "y0": b.position[1],
+                "angle0": b.angle,
+                "vx0": b.velocity[0],
+                "vy0": b.velocity[1],
+                "omega0": b.angular_velocity,
             }[name]
             scale = _NUISANCE_SCALE[name]
             if name in ("x0", "y0"):
@@ -208,7 +232,19 @@ def nuisance_params(run: Run, index: int, prefix: str, names: Sequence[str] | st
                 half = max(2.0, abs(start)) if name != "omega0" else max(3.0, abs(start))
                 low, high = start - half, start + half
         key = f"{prefix}{target}.{name}"
-        out.append(Param(key, "nuisance", target, name, float(start), float(low), float(high), float(scale), run=index))
+        out.append(
+            Param(
+                key,
+                "nuisance",
+                target,
+                name,
+                float(start),
+                float(low),
+                float(high),
+                float(scale),
+                run=index,
+            )
+        )
     return out
 
 
@@ -220,7 +256,18 @@ def body_params(scene: Scene) -> list[Param]:
         v = getattr(b, u.param)
         if v is None:  # moment from the shape
             v = b.inertia()
-        out.append(Param(u.key, "body", u.body, u.param, float(min(max(v, u.low), u.high)), u.low, u.high, 0.02 * (u.high - u.low)))
+        out.append(
+            Param(
+                u.key,
+                "body",
+                u.body,
+                u.param,
+                float(min(max(v, u.low), u.high)),
+                u.low,
+                u.high,
+                0.02 * (u.high - u.low),
+            )
+        )
     return out
 
 
@@ -231,7 +278,18 @@ def effect_params(effect: Effect, starts: Mapping[str, float] | None = None) -> 
     out = []
     for p in effect.params:
         v = (starts or {}).get(p.name, values.get(p.name, p.default))
-        out.append(Param(f"{key}.{p.name}", "effect", key, p.name, float(v), p.low, p.high, 0.01 * (p.high - p.low)))
+        out.append(
+            Param(
+                f"{key}.{p.name}",
+                "effect",
+                key,
+                p.name,
+                float(v),
+                p.low,
+                p.high,
+                0.01 * (p.high - p.low),
+            )
+        )
     return out
 
 
@@ -243,7 +301,12 @@ def resample(traj: Trajectory, times: np.ndarray) -> Trajectory:
     left at the nearest earlier frame's."""
     if traj.times.shape == times.shape and np.allclose(traj.times, times, rtol=0, atol=1e-12):
         return traj
-    rec = Recording({b: Track(times, np.zeros_like(times), np.zeros_like(times), np.zeros_like(times)) for b in traj.bodies})
+    rec = Recording(
+        {
+            b: Track(times, np.zeros_like(times), np.zeros_like(times), np.zeros_like(times))
+            for b in traj.bodies
+        }
+    )
     got = rec.sample(traj)
     k = np.clip(np.searchsorted(traj.times, times, side="right") - 1, 0, traj.frames - 1)
     states = traj.states[k].copy()
@@ -267,14 +330,20 @@ class Problem:
     _truncated: dict[tuple[str, int, float], tuple[Part, np.ndarray]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        for role, parts in (("fit", self.split.fit), ("lead", self.split.lead), ("held", self.split.held)):
+        for role, parts in (
+            ("fit", self.split.fit),
+            ("lead", self.split.lead),
+            ("held", self.split.held),
+        ):
             for p in parts:
                 run = self.runs[p.run]
                 if p.recording is not None:
                     self.layouts[(role, p.run)] = Layout.of_recording(p.recording, run.scene)
                 else:
                     assert run.frames is not None and p.frames is not None
-                    self.layouts[(role, p.run)] = Layout.of_frames(p.frames, run.frames.shape, run.scene.fps)
+                    self.layouts[(role, p.run)] = Layout.of_frames(
+                        p.frames, run.frames.shape, run.scene.fps
+                    )
         if any(r.frames is not None for r in self.runs) and self.renderer is None:
             raise DiscoverError("runs with frames need a renderer for the image loss")
 
@@ -321,14 +390,18 @@ class Model:
     """Effects plus parameters over a :class:`Problem`. ``values`` holds every parameter's current
     value; :meth:`residuals` simulates the parts of one role with some values overridden."""
 
-    def __init__(self, problem: Problem, effects: Sequence[Effect], params: Sequence[Param]) -> None:
+    def __init__(
+        self, problem: Problem, effects: Sequence[Effect], params: Sequence[Param]
+    ) -> None:
         self.problem = problem
         self.effects = list(effects)
         self.params = list(params)
         keys = [p.key for p in self.params]
         if len(set(keys)) != len(keys):
             dup = sorted({k for k in keys if keys.count(k) > 1})
-            raise DiscoverError(f"parameter keys {dup} appear twice; give effects of one kind distinct labels")
+            raise DiscoverError(
+                f"parameter keys {dup} appear twice; give effects of one kind distinct labels"
+            )
         self.values: dict[str, float] = {p.key: p.start for p in self.params}
         self._cache: dict[tuple[Any, ...], np.ndarray] = {}
 
@@ -342,7 +415,9 @@ class Model:
 
     def extended(self, effect: Effect, starts: Mapping[str, float] | None = None) -> Model:
         """This model plus ``effect`` (its parameters starting at ``starts``), values carried over."""
-        m = Model(self.problem, [*self.effects, effect], [*self.params, *effect_params(effect, starts)])
+        m = Model(
+            self.problem, [*self.effects, effect], [*self.params, *effect_params(effect, starts)]
+        )
         m.values.update(self.values)
         return m
 
@@ -373,7 +448,9 @@ class Model:
                 sim[p.key] = v
         return apply_initial(self.problem.runs[run].scene, state, forces), sim
 
-    def simulate(self, run: int, values: Mapping[str, float], t_end: float | None = None) -> tuple[Trajectory, Trajectory]:
+    def simulate(
+        self, run: int, values: Mapping[str, float], t_end: float | None = None
+    ) -> tuple[Trajectory, Trajectory]:
         """The run simulated up to ``t_end`` (default: its end) on the data's clock: the engine's
         trajectory and the measured one (after the measurement effects)."""
         r = self.problem.runs[run]
@@ -386,7 +463,9 @@ class Model:
         traj = self.problem.simulator.simulate(scene, sim, effects=self.effects)
         return traj, apply_measurements(traj, self.effects)  # measurement values were set in setup
 
-    def part_residuals(self, role: str, part: Part, values: Mapping[str, float], horizon: float = 1.0) -> np.ndarray:
+    def part_residuals(
+        self, role: str, part: Part, values: Mapping[str, float], horizon: float = 1.0
+    ) -> np.ndarray:
         """Weighted residuals (simulated minus observed) of one part, or of its first ``horizon``
         share of time."""
         run = self.problem.runs[part.run]
@@ -394,7 +473,9 @@ class Model:
         _, measured = self.simulate(part.run, values, part.t_end)
         if part.recording is not None:
             return part.recording.residuals(measured) * weight
-        assert run.frames is not None and part.frames is not None and self.problem.renderer is not None
+        assert (
+            run.frames is not None and part.frames is not None and self.problem.renderer is not None
+        )
         times = np.arange(int(part.frames[-1]) + 1) / run.scene.fps
         seen = resample(measured, times)
         scene = replace(run.scene, frames=times.size)
@@ -402,7 +483,11 @@ class Model:
         return (img[part.frames] - run.frames[part.frames]).astype(float).ravel()
 
     def residuals(
-        self, role: str, values: Mapping[str, float] | None = None, runs: Sequence[int] | None = None, horizon: float = 1.0
+        self,
+        role: str,
+        values: Mapping[str, float] | None = None,
+        runs: Sequence[int] | None = None,
+        horizon: float = 1.0,
     ) -> np.ndarray:
         """Concatenated residuals of the parts of ``role`` (``fit``, ``lead``, ``held``), for the
         runs ``runs`` (default all of that role), at ``values`` (default the current ones), over
@@ -416,7 +501,11 @@ class Model:
         if hit is not None:
             return hit
         parts = [p for p in self.problem.parts(role) if runs is None or p.run in runs]
-        out = np.concatenate([self.part_residuals(role, p, vals, horizon) for p in parts]) if parts else np.zeros(0)
+        out = (
+            np.concatenate([self.part_residuals(role, p, vals, horizon) for p in parts])
+            if parts
+            else np.zeros(0)
+        )
         if len(self._cache) > 16:
             self._cache.clear()
         self._cache[key] = out
@@ -433,7 +522,12 @@ class Model:
         return m
 
 
-def safe_residuals(model: Model, role: str, values: Mapping[str, float] | None = None, runs: Sequence[int] | None = None) -> np.ndarray | None:
+def safe_residuals(
+    model: Model,
+    role: str,
+    values: Mapping[str, float] | None = None,
+    runs: Sequence[int] | None = None,
+) -> np.ndarray | None:
     """:meth:`Model.residuals`, or None when the simulation explodes."""
     try:
         return model.residuals(role, values, runs)

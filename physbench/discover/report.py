@@ -25,7 +25,9 @@ MAX_RUNS, MAX_BODIES = 3, 3
 DPI = 80
 
 
-def _field_series(v: RunView, body: str, f: str) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+def _field_series(
+    v: RunView, body: str, f: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     assert v.recording is not None
     tr = v.recording.track(body)
     if f not in tr.fields or (v.recording.fields is not None and f not in v.recording.fields):
@@ -49,7 +51,11 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
     base_v = views(disc.base)
     final_v = views(disc.final) if disc.causes else base_v
     split = disc.split
-    cut = {p.run: p.t_end for p in split.fit} if split.kind == "time" else {p.run: p.t_end for p in split.lead}
+    cut = (
+        {p.run: p.t_end for p in split.fit}
+        if split.kind == "time"
+        else {p.run: p.t_end for p in split.lead}
+    )
     figures: list[tuple[str, str]] = []
     # held-out runs first: they show how the models predict data they were not fitted on
     order = list(split.test_runs) + [i for i in range(len(disc.runs)) if i not in split.test_runs]
@@ -86,7 +92,10 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
             rb = base_v[i].simulated.track(body).values(f) - obs
             rf = final_v[i].simulated.track(body).values(f) - obs
             if f == "angle":
-                rb, rf = (rb + math.pi) % (2 * math.pi) - math.pi, (rf + math.pi) % (2 * math.pi) - math.pi
+                rb, rf = (
+                    (rb + math.pi) % (2 * math.pi) - math.pi,
+                    (rf + math.pi) % (2 * math.pi) - math.pi,
+                )
             axr.plot(t, rb, "-", lw=0.8, color="tab:blue", label="base")
             if disc.causes:
                 axr.plot(t, rf, "-", lw=0.8, color="tab:red", label=ext)
@@ -103,7 +112,12 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         fig.tight_layout()
         fig.savefig(out / "trajectories.png", dpi=dpi)
         plt.close(fig)
-        figures.append(("trajectories.png", "Observed vs simulated (left) and residuals (right), base and extended model."))
+        figures.append(
+            (
+                "trajectories.png",
+                "Observed vs simulated (left) and residuals (right), base and extended model.",
+            )
+        )
 
     # ------------------------------------------------------------------ frames: residual per frame
     frame_runs = [i for i in shown if disc.runs[i].frames is not None]
@@ -118,7 +132,12 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
                 assert f is not None
                 per = int(np.prod(f.shape[1:]))
                 k = r.size // per
-                ax.plot(np.arange(k) / disc.runs[i].scene.fps, np.sqrt(np.mean(r[: k * per].reshape(k, per) ** 2, axis=1)), color=color, label=label)
+                ax.plot(
+                    np.arange(k) / disc.runs[i].scene.fps,
+                    np.sqrt(np.mean(r[: k * per].reshape(k, per) ** 2, axis=1)),
+                    color=color,
+                    label=label,
+                )
         ax.set_xlabel("t (s), fitted part")
         ax.set_ylabel("pixel RMS residual")
         ax.legend(fontsize=7)
@@ -135,9 +154,21 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         if labels:
             fig, ax = plt.subplots(figsize=(max(5, 0.8 * len(labels)), 3))
             x = np.arange(len(labels))
-            ax.bar(x - 0.2, [bb.per_event[b][e] for b, e in labels], 0.4, label="base", color="tab:blue")
+            ax.bar(
+                x - 0.2,
+                [bb.per_event[b][e] for b, e in labels],
+                0.4,
+                label="base",
+                color="tab:blue",
+            )
             if disc.causes and bf is not None:
-                ax.bar(x + 0.2, [bf.per_event.get(b, {}).get(e, np.nan) for b, e in labels], 0.4, label=ext, color="tab:red")
+                ax.bar(
+                    x + 0.2,
+                    [bf.per_event.get(b, {}).get(e, np.nan) for b, e in labels],
+                    0.4,
+                    label=ext,
+                    color="tab:red",
+                )
             ax.set_xticks(x, [f"{b}\n{e}" for b, e in labels], fontsize=7)
             ax.set_ylabel(f"RMS residual ({disc.unit})", fontsize=8)
             ax.legend(fontsize=7)
@@ -151,7 +182,11 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         first = [c for c in disc.candidates if c.round == 1]
         fig, ax = plt.subplots(figsize=(7, 0.35 * len(first) + 1.2))
         y = np.arange(len(first))
-        ax.barh(y, [c.heldout_error for c in first], color=["tab:red" if c.chosen else "tab:gray" for c in first])
+        ax.barh(
+            y,
+            [c.heldout_error for c in first],
+            color=["tab:red" if c.chosen else "tab:gray" for c in first],
+        )
         ax.axvline(disc.base.heldout, color="tab:blue", ls="--", lw=1, label="base")
         ax.set_yticks(y, [c.effect for c in first], fontsize=7)
         ax.set_xlabel(f"held-out error ({disc.unit}), round 1", fontsize=8)
@@ -178,9 +213,15 @@ def _html(disc: Discovery, figures: list[tuple[str, str]]) -> str:
             f"<tr{' class=chosen' if c.chosen else ''}><td>{c.round}</td><td>{e(c.effect)}</td><td>{e(params_text(c))}</td>"
             f"<td>{c.heldout_error:.5g}</td><td>{c.gain:+.1%}</td><td>{c.delta_criterion:+.1f}</td><td>{verdict}</td><td>{e(c.note)}</td></tr>"
         )
-    figs = "\n".join(f'<figure><img src="{f}" alt="{e(cap)}"><figcaption>{e(cap)}</figcaption></figure>' for f, cap in figures)
+    figs = "\n".join(
+        f'<figure><img src="{f}" alt="{e(cap)}"><figcaption>{e(cap)}</figcaption></figure>'
+        for f, cap in figures
+    )
     findings: dict[str, Any] = disc.findings
-    items = "".join(f"<li>{e(f.text)}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>" for f in findings.get("base", []))
+    items = "".join(
+        f"<li>{e(f.text)}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>"
+        for f in findings.get("base", [])
+    )
     title = "physbench discover: " + (", ".join(disc.causes) if disc.causes else "no cause found")
     return f"""<!doctype html>
 <html><head><meta charset="utf-8"><title>{e(title)}</title>
@@ -190,8 +231,8 @@ img{{max-width:100%}} figcaption{{font-size:12px;color:#555}}</style></head><bod
 <h1>{e(title)}</h1>
 <p>Gain on held-out data: <b>{disc.gain:.1%}</b> (held-out error {disc.base.heldout:.5g} → {disc.final.heldout:.5g} {e(disc.unit)}).
 Engine {e(disc.engine)}; {e(disc.split.describe(disc.runs))}.</p>
-<h2>What is wrong with the base model</h2><ul>{items or '<li>no summary statistic stands out from the noise</li>'}</ul>
-<h2>Candidates</h2><table>{''.join(rows)}</table>
+<h2>What is wrong with the base model</h2><ul>{items or "<li>no summary statistic stands out from the noise</li>"}</ul>
+<h2>Candidates</h2><table>{"".join(rows)}</table>
 <h2>Figures</h2>{figs}
 <h2>Verdict</h2><pre>{e(text(disc))}</pre>
 </body></html>

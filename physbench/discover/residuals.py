@@ -61,14 +61,23 @@ class Layout:
                 t.append(tr.t)
                 w.append(np.full(n, size if (mixed and f == "angle") else 1.0))
         unit = "rad" if fields == ("angle",) else ("m (angles × body size)" if mixed else "m")
-        return cls(names, np.concatenate(body), np.concatenate(field), np.concatenate(t), np.concatenate(w), unit)
+        return cls(
+            names,
+            np.concatenate(body),
+            np.concatenate(field),
+            np.concatenate(t),
+            np.concatenate(w),
+            unit,
+        )
 
     @classmethod
     def of_frames(cls, frame_index: np.ndarray, shape: tuple[int, ...], fps: float) -> Layout:
         per = int(np.prod(shape[1:]))
         t = np.repeat(np.asarray(frame_index, dtype=float) / fps, per)
         n = t.size
-        return cls(("image",), np.zeros(n, dtype=int), np.full(n, -1), t, np.ones(n), "pixel intensity")
+        return cls(
+            ("image",), np.zeros(n, dtype=int), np.full(n, -1), t, np.ones(n), "pixel intensity"
+        )
 
 
 def rms(r: np.ndarray) -> float:
@@ -93,7 +102,10 @@ def _static_distance(scene: Scene, p: np.ndarray) -> np.ndarray:
             best = np.minimum(best, _segment_distance(p, s.a, s.b) - s.radius)
         else:
             pts = s.points
-            d = np.min([_segment_distance(p, pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))], axis=0)
+            d = np.min(
+                [_segment_distance(p, pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))],
+                axis=0,
+            )
             best = np.minimum(best, d)
     return best
 
@@ -148,10 +160,16 @@ class Breakdown:
     counts: dict[str, dict[str, int]]
 
     def to_dict(self) -> dict[str, object]:
-        return {"per_field": self.per_field, "per_event": self.per_event, "samples_per_event": self.counts}
+        return {
+            "per_field": self.per_field,
+            "per_event": self.per_event,
+            "samples_per_event": self.counts,
+        }
 
 
-def breakdown(parts: Sequence[tuple[Layout, np.ndarray, np.ndarray | None, Sequence[str]]]) -> Breakdown:
+def breakdown(
+    parts: Sequence[tuple[Layout, np.ndarray, np.ndarray | None, Sequence[str]]],
+) -> Breakdown:
     """Summaries over several (layout, residuals, sample events, body-name map) parts, pooled by
     body name."""
     sq_f: dict[str, dict[str, list[float]]] = {}

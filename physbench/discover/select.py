@@ -76,7 +76,15 @@ class Settings:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int | float) or not 0 <= v < 1:
                 raise DiscoverError(f"{name} = {v!r}: expected a number in [0, 1)")
-        for name in ("max_causes", "shortlist", "max_nfev", "base_max_nfev", "budget", "quick_budget", "screen"):
+        for name in (
+            "max_causes",
+            "shortlist",
+            "max_nfev",
+            "base_max_nfev",
+            "budget",
+            "quick_budget",
+            "screen",
+        ):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
                 raise DiscoverError(f"{name} = {v!r}: expected a whole number >= 1")
@@ -101,12 +109,18 @@ class Scored:
         return self.fit.bic()
 
     def summary(self, keys: Sequence[str] | None = None) -> dict[str, Any]:
-        shown = [p.key for p in self.model.params if p.kind != "nuisance"] if keys is None else list(keys)
+        shown = (
+            [p.key for p in self.model.params if p.kind != "nuisance"]
+            if keys is None
+            else list(keys)
+        )
         return {
             "effects": list(self.causes),
             "params": {k: self.model.values[k] for k in shown},
             "stderr": {k: self.fit.stderr.get(k) for k in shown},
-            "nuisance": {p.key: self.model.values[p.key] for p in self.model.params if p.kind == "nuisance"},
+            "nuisance": {
+                p.key: self.model.values[p.key] for p in self.model.params if p.kind == "nuisance"
+            },
             "fit_error": self.fit.rms,
             "heldout_error": self.heldout,
             "criterion": self.bic,
@@ -141,11 +155,21 @@ class CandidateResult:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "effect": self.effect, "name": self.name, "round": self.round, "params": self.params,
-            "stderr": self.stderr, "fixed": self.fixed, "heldout_error": _num(self.heldout_error),
-            "gain": _num(self.gain), "gain_vs_base": _num(self.gain_vs_base), "criterion": _num(self.criterion),
-            "delta_criterion": _num(self.delta_criterion), "significant": self.significant, "chosen": self.chosen,
-            "note": self.note, "quick_fit_only": self.quick,
+            "effect": self.effect,
+            "name": self.name,
+            "round": self.round,
+            "params": self.params,
+            "stderr": self.stderr,
+            "fixed": self.fixed,
+            "heldout_error": _num(self.heldout_error),
+            "gain": _num(self.gain),
+            "gain_vs_base": _num(self.gain_vs_base),
+            "criterion": _num(self.criterion),
+            "delta_criterion": _num(self.delta_criterion),
+            "significant": self.significant,
+            "chosen": self.chosen,
+            "note": self.note,
+            "quick_fit_only": self.quick,
         }
 
 
@@ -186,7 +210,9 @@ def _check_unknowns(runs: Sequence[Run]) -> None:
     for r in runs[1:]:
         got = [u.key for u in r.scene.unknowns]
         if got != first:
-            raise DiscoverError(f"run {r.name!r} declares unknowns {got} but run {runs[0].name!r} declares {first}; runs share their unknowns")
+            raise DiscoverError(
+                f"run {r.name!r} declares unknowns {got} but run {runs[0].name!r} declares {first}; runs share their unknowns"
+            )
 
 
 def _sensitivity(model: Model, role: str, key: str, runs: Sequence[int] | None = None) -> float:
@@ -195,7 +221,9 @@ def _sensitivity(model: Model, role: str, key: str, runs: Sequence[int] | None =
     return _response(model, role, key, 0.05, runs)[0]
 
 
-def _response(model: Model, role: str, key: str, share: float, runs: Sequence[int] | None = None) -> tuple[float, float]:
+def _response(
+    model: Model, role: str, key: str, share: float, runs: Sequence[int] | None = None
+) -> tuple[float, float]:
     """RMS change of the residuals when ``key`` moves ``share`` of its range inwards, and the move."""
     p = model.param(key)
     base = model.residuals(role, None, runs)
@@ -248,22 +276,47 @@ def _prune_nuisance(model: Model) -> Model:
     return m
 
 
-def _fit(model: Model, settings: Settings, *, base: bool, free: Sequence[str] | None = None,
-         probe: Sequence[str] = (), horizons: Sequence[float] | None = None) -> FitResult:
+def _fit(
+    model: Model,
+    settings: Settings,
+    *,
+    base: bool,
+    free: Sequence[str] | None = None,
+    probe: Sequence[str] = (),
+    horizons: Sequence[float] | None = None,
+) -> FitResult:
     keys = model.free_keys() if free is None else list(free)
     if base and settings.estimator != "lsq" and keys:
-        estimator_fit(model, keys, settings.estimator, iterations=settings.estimator_iterations,
-                      seed=settings.seed, options=settings.estimator_options)
+        estimator_fit(
+            model,
+            keys,
+            settings.estimator,
+            iterations=settings.estimator_iterations,
+            seed=settings.seed,
+            options=settings.estimator_options,
+        )
     if probe:
         probe_start(model, probe)
-    fr = least_squares(model, keys, max_nfev=settings.base_max_nfev if base else settings.max_nfev,
-                       budget=_budget(settings, len(keys)) * (2 if base else 1), diff_step=settings.diff_step,
-                       horizons=horizons or _horizons(model, settings))
+    fr = least_squares(
+        model,
+        keys,
+        max_nfev=settings.base_max_nfev if base else settings.max_nfev,
+        budget=_budget(settings, len(keys)) * (2 if base else 1),
+        diff_step=settings.diff_step,
+        horizons=horizons or _horizons(model, settings),
+    )
     for i in model.problem.split.test_runs if model.problem.split.kind == "runs" else ():
         own = [p.key for p in model.params if p.kind == "nuisance" and p.run == i]
         if own:
-            least_squares(model, own, role="lead", runs=[i], max_nfev=settings.max_nfev,
-                          budget=_budget(settings, len(own)), diff_step=settings.diff_step)
+            least_squares(
+                model,
+                own,
+                role="lead",
+                runs=[i],
+                max_nfev=settings.max_nfev,
+                budget=_budget(settings, len(own)),
+                diff_step=settings.diff_step,
+            )
     return fr
 
 
@@ -278,7 +331,11 @@ def _rough(runs: Sequence[Run]) -> bool:
     other when not jointed), so that impacts detected at discrete steps put a saw-tooth into the
     residuals, or the loss is on images, which stop pulling once shapes no longer overlap."""
     scene = runs[0].scene
-    return bool(scene.statics) or (len(scene.bodies) > 1 and not scene.joints) or any(r.frames is not None for r in runs)
+    return (
+        bool(scene.statics)
+        or (len(scene.bodies) > 1 and not scene.joints)
+        or any(r.frames is not None for r in runs)
+    )
 
 
 def _horizons(model: Model, settings: Settings) -> tuple[float, ...]:
@@ -310,8 +367,15 @@ def _restart_nuisance(model: Model, settings: Settings) -> None:
         if hits.size and part.t_end > t0:
             share = min(share, (float(measured.times[hits[0]]) - t0) / (part.t_end - t0))
     share = min(max(share * 0.9, 0.15), 0.5)
-    least_squares(model, keys, max_nfev=settings.max_nfev, budget=_budget(settings, len(keys)), diff_step=settings.diff_step,
-                  horizons=(share,), final=False)
+    least_squares(
+        model,
+        keys,
+        max_nfev=settings.max_nfev,
+        budget=_budget(settings, len(keys)),
+        diff_step=settings.diff_step,
+        horizons=(share,),
+        final=False,
+    )
 
 
 def _score(label: str, causes: tuple[str, ...], model: Model, fr: FitResult) -> Scored:
@@ -372,13 +436,17 @@ def discover(
             base_model, base_fit = other, other_fit
     base = _score("base", (), base_model, base_fit)
     if not math.isfinite(base.heldout):
-        raise DiscoverError(f"the fitted base model fails on the held-out data ({base.failure}); check the scene and the recording")
+        raise DiscoverError(
+            f"the fitted base model fails on the held-out data ({base.failure}); check the scene and the recording"
+        )
 
     if candidates is None:
         specs, skipped = candidates_for(runs[0].scene, settings.effects)
         if settings.effects is not None and not specs:
             why = "; ".join(f"{n}: {r}" for n, r in skipped)
-            raise DiscoverError(f"none of the requested effects applies to scene {runs[0].scene.name!r} ({why})")
+            raise DiscoverError(
+                f"none of the requested effects applies to scene {runs[0].scene.name!r} ({why})"
+            )
     else:
         specs, skipped = list(candidates), []
     current, causes = base, []
@@ -388,8 +456,13 @@ def discover(
     pool = list(specs)
     for rnd in range(1, settings.max_causes + 1):
         contacts = _rough(runs)
-        round_results = [c for c in (_try(spec, current, base, rnd, settings, skipped, quick=contacts) for spec in pool)
-                         if c is not None]
+        round_results = [
+            c
+            for c in (
+                _try(spec, current, base, rnd, settings, skipped, quick=contacts) for spec in pool
+            )
+            if c is not None
+        ]
         if contacts:
             # Rough scenes: every candidate got a quick fit from the current optimum; the most
             # promising ones (by fitted error, never by held-out error) and the ones the current
@@ -397,8 +470,14 @@ def discover(
             from physbench.discover.diagnostics import findings, views
 
             suggested = {e for f in findings(views(current)) for e in f.suggests}
-            ranked = sorted((c for c in round_results if c.delta_criterion < 0), key=lambda c: c.criterion)
-            chosen_full = ranked[: settings.screen] + [c for c in round_results if c.name in suggested and c not in ranked[: settings.screen]]
+            ranked = sorted(
+                (c for c in round_results if c.delta_criterion < 0), key=lambda c: c.criterion
+            )
+            chosen_full = ranked[: settings.screen] + [
+                c
+                for c in round_results
+                if c.name in suggested and c not in ranked[: settings.screen]
+            ]
             for c in chosen_full:
                 spec = next(sp for sp in pool if sp.label == c.effect)
                 full = _try(spec, current, base, rnd, settings, [], quick=False)
@@ -434,12 +513,17 @@ def discover(
         chosen.append(best)
         causes.append(best.effect)
         alternatives[best.effect] = [
-            c.effect for c in round_results
-            if c is not best and c.significant and c.heldout_error <= best.heldout_error * (1 + settings.ambiguity)
+            c.effect
+            for c in round_results
+            if c is not best
+            and c.significant
+            and c.heldout_error <= best.heldout_error * (1 + settings.ambiguity)
         ]
         assert best.scored is not None
         current = best.scored
-        ranked = sorted((c for c in round_results if c is not best and c.gain > 0), key=lambda c: -c.gain)
+        ranked = sorted(
+            (c for c in round_results if c is not best and c.gain > 0), key=lambda c: -c.gain
+        )
         names = {c.effect for c in ranked[: settings.shortlist]}
         from physbench.discover.diagnostics import findings, views
 
@@ -451,10 +535,18 @@ def discover(
     if len(causes) > 1:
         current, causes = _eliminate(current, causes, results, settings)
     disc = Discovery(
-        runs=runs, split=split, settings=settings, engine=str(getattr(sim, "name", type(sim).__name__)),
-        unit=problem.unit, base=base, final=current, candidates=results, causes=causes,
+        runs=runs,
+        split=split,
+        settings=settings,
+        engine=str(getattr(sim, "name", type(sim).__name__)),
+        unit=problem.unit,
+        base=base,
+        final=current,
+        candidates=results,
+        causes=causes,
         gain=1.0 - current.heldout / base.heldout if base.heldout > 0 else 0.0,
-        skipped=skipped, alternatives=alternatives,
+        skipped=skipped,
+        alternatives=alternatives,
     )
     if diagnose:
         from physbench.discover.diagnostics import diagnose as run_diagnostics
@@ -464,14 +556,24 @@ def discover(
     return disc
 
 
-def _try(spec: CandidateSpec, current: Scored, base: Scored, rnd: int, settings: Settings,
-         skipped: list[tuple[str, str]], *, quick: bool = False) -> CandidateResult | None:
+def _try(
+    spec: CandidateSpec,
+    current: Scored,
+    base: Scored,
+    rnd: int,
+    settings: Settings,
+    skipped: list[tuple[str, str]],
+    *,
+    quick: bool = False,
+) -> CandidateResult | None:
     """Fit ``current`` + the effect of ``spec``; None (and a note in ``skipped``) when the data
     cannot see any of its parameters. ``quick``: one horizon from the current optimum with a
     small budget (the screening fit of contact scenes)."""
     eff: Effect = spec.make()
     scene = current.model.problem.runs[0].scene
-    fitted = scene.with_params({p.key: current.model.values[p.key] for p in current.model.params if p.kind == "body"})
+    fitted = scene.with_params(
+        {p.key: current.model.values[p.key] for p in current.model.params if p.kind == "body"}
+    )
     model = current.model.extended(eff, start_values(eff, fitted))
     key = str(getattr(eff, "key", eff.name))
     own = [p.key for p in model.params if p.kind == "effect" and p.target == key]
@@ -492,10 +594,20 @@ def _try(spec: CandidateSpec, current: Scored, base: Scored, rnd: int, settings:
     # near the current, better optimum those steps are far too large for finite differences (the
     # cause would not move and the new effect could not trade off against it): rescale them too.
     # Not in rough scenes, whose large steps are meant to average over the contact saw-tooth.
-    earlier = [] if rough else [
-        p.key for p in model.params if p.kind == "effect" and p.target != key and p.key in current.fit.free
-    ]
-    _rescale(model, {k: _unit_sensitivity(model, k, rough) for k in [*visible, *earlier]}, current.fit.rms)
+    earlier = (
+        []
+        if rough
+        else [
+            p.key
+            for p in model.params
+            if p.kind == "effect" and p.target != key and p.key in current.fit.free
+        ]
+    )
+    _rescale(
+        model,
+        {k: _unit_sensitivity(model, k, rough) for k in [*visible, *earlier]},
+        current.fit.rms,
+    )
     for k in visible:  # off the bound: a bounded least-squares step from a bound can stall there
         p = model.param(k)
         v = model.values[k]
@@ -505,8 +617,13 @@ def _try(spec: CandidateSpec, current: Scored, base: Scored, rnd: int, settings:
             model.values[k] = max(p.high - p.scale, p.low)
     if quick:
         probe_start(model, visible)
-        fr = least_squares(model, free, max_nfev=settings.max_nfev, budget=max(settings.quick_budget, 3 * (len(free) + 1)),
-                           diff_step=settings.diff_step)
+        fr = least_squares(
+            model,
+            free,
+            max_nfev=settings.max_nfev,
+            budget=max(settings.quick_budget, 3 * (len(free) + 1)),
+            diff_step=settings.diff_step,
+        )
     else:
         if _rough(current.model.problem.runs):
             # The current optimum's initial state was bent to make up for what the current model
@@ -514,10 +631,20 @@ def _try(spec: CandidateSpec, current: Scored, base: Scored, rnd: int, settings:
             _restart_nuisance(model, settings)
         before = dict(model.values)
         fr = _fit(model, settings, base=False, free=free, probe=visible)
-        if fr.ssr > current.fit.ssr and earlier and all(abs(model.values[k] - before[k]) < 1e-3 * model.param(k).scale for k in visible):
+        if (
+            fr.ssr > current.fit.ssr
+            and earlier
+            and all(abs(model.values[k] - before[k]) < 1e-3 * model.param(k).scale for k in visible)
+        ):
             # Stuck where it started, on top of earlier causes: the step to where the new effect
             # trades off against them can be too long for a local fit. Once more, from further in.
-            model.values = {**before, **{k: min(before[k] + 3.0 * model.param(k).scale, model.param(k).high) for k in visible}}
+            model.values = {
+                **before,
+                **{
+                    k: min(before[k] + 3.0 * model.param(k).scale, model.param(k).high)
+                    for k in visible
+                },
+            }
             again = _fit(model, settings, base=False, free=free)
             if again.ssr < fr.ssr:
                 fr = again
@@ -525,15 +652,32 @@ def _try(spec: CandidateSpec, current: Scored, base: Scored, rnd: int, settings:
         # Worse than the model it extends (the fit stalled away from the effect's neutral start):
         # the extended model can always do at least as well with the effect switched off.
         model.values = {**current.model.values, **{k: model.param(k).start for k in own}}
-        fr = FitResult(dict(model.values), list(free), {k: current.fit.stderr.get(k, math.nan) for k in free},
-                       current.fit.ssr, current.fit.n, fr.nfev, fr.simulations, "no better than the current model")
+        fr = FitResult(
+            dict(model.values),
+            list(free),
+            {k: current.fit.stderr.get(k, math.nan) for k in free},
+            current.fit.ssr,
+            current.fit.n,
+            fr.nfev,
+            fr.simulations,
+            "no better than the current model",
+        )
     scored = _score(f"{current.label} + {key}", (*current.causes, key), model, fr)
     c = CandidateResult(
-        round=rnd, effect=key, name=eff.name,
+        round=rnd,
+        effect=key,
+        name=eff.name,
         params={k.rpartition(".")[2]: model.values[k] for k in visible},
         stderr={k.rpartition(".")[2]: fr.stderr.get(k, math.nan) for k in visible},
-        fixed=fixed, heldout_error=scored.heldout, gain=0.0, gain_vs_base=0.0,
-        criterion=scored.bic, delta_criterion=0.0, significant=False, scored=scored, quick=quick,
+        fixed=fixed,
+        heldout_error=scored.heldout,
+        gain=0.0,
+        gain_vs_base=0.0,
+        criterion=scored.bic,
+        delta_criterion=0.0,
+        significant=False,
+        scored=scored,
+        quick=quick,
     )
     _judge(c, current, base, settings)
     return c
@@ -573,7 +717,9 @@ def _judge(c: CandidateResult, current: Scored, base: Scored, settings: Settings
     c.gain = 1.0 - c.heldout_error / current.heldout if current.heldout > 0 else 0.0
     c.gain_vs_base = 1.0 - c.heldout_error / base.heldout if base.heldout > 0 else 0.0
     c.delta_criterion = c.criterion - current.bic
-    c.significant = bool(c.gain >= settings.min_gain and c.delta_criterion <= -settings.min_delta_bic)
+    c.significant = bool(
+        c.gain >= settings.min_gain and c.delta_criterion <= -settings.min_delta_bic
+    )
     why = []
     if c.gain < settings.min_gain:
         why.append(f"held-out gain {c.gain:+.1%} < {settings.min_gain:.0%}")
@@ -592,8 +738,9 @@ def _without(scored: Scored, key: str) -> Model:
     return out
 
 
-def _eliminate(current: Scored, causes: list[str], results: list[CandidateResult],
-               settings: Settings) -> tuple[Scored, list[str]]:
+def _eliminate(
+    current: Scored, causes: list[str], results: list[CandidateResult], settings: Settings
+) -> tuple[Scored, list[str]]:
     """Backward check after the greedy additions: drop a cause whose removal (and a refit of the
     rest) costs less than ``min_gain`` of held-out error, e.g. one added first that a later,
     better cause made redundant."""
@@ -610,8 +757,10 @@ def _eliminate(current: Scored, causes: list[str], results: list[CandidateResult
                 for c in results:
                     if c.chosen and c.effect == key:
                         c.chosen = False
-                        c.note = (f"added in round {c.round}, then dropped: without it the other causes predict the held-out "
-                                  f"data within {loss:+.1%}")
+                        c.note = (
+                            f"added in round {c.round}, then dropped: without it the other causes predict the held-out "
+                            f"data within {loss:+.1%}"
+                        )
                 causes = [c for c in causes if c != key]
                 current, changed = reduced, True
                 break
@@ -647,5 +796,7 @@ def renderer_for(runs: Sequence[Run], mode: str | None = None) -> Renderer:
     r = RasterRenderer(resolution=int(w), mode=mode)  # square pixels: the height follows the world
     exp = r.shape(runs[0].scene)
     if exp[1:] != (c, h, w):
-        raise DiscoverError(f"frames have (C, H, W) = {(c, h, w)} but the raster renderer in {mode!r} mode gives {exp[1:]}")
+        raise DiscoverError(
+            f"frames have (C, H, W) = {(c, h, w)} but the raster renderer in {mode!r} mode gives {exp[1:]}"
+        )
     return r

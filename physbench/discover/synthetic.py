@@ -58,9 +58,23 @@ def projectile(rng: np.random.Generator, kick: bool = False) -> Scene:
     forces: tuple[Force, ...] = ()
     if kick:
         t0 = float(rng.uniform(0.7, 0.9))
-        forces = (Force("ball", (m * float(rng.uniform(-25, -15)), m * float(rng.uniform(5, 15))), t0, t0 + 0.1),)
-    return Scene("projectile" + ("_kicked" if kick else ""), (Body("ball", Circle(0.05), (0.5, 1.0), velocity=v, mass=m),),
-                 bounds=(-2.0, -12.0, 10.0, 8.0), fps=20.0, frames=41, substeps=4, forces=forces)
+        forces = (
+            Force(
+                "ball",
+                (m * float(rng.uniform(-25, -15)), m * float(rng.uniform(5, 15))),
+                t0,
+                t0 + 0.1,
+            ),
+        )
+    return Scene(
+        "projectile" + ("_kicked" if kick else ""),
+        (Body("ball", Circle(0.05), (0.5, 1.0), velocity=v, mass=m),),
+        bounds=(-2.0, -12.0, 10.0, 8.0),
+        fps=20.0,
+        frames=41,
+        substeps=4,
+        forces=forces,
+    )
 
 
 def puck(rng: np.random.Generator, kicks: bool = False) -> Scene:
@@ -70,10 +84,20 @@ def puck(rng: np.random.Generator, kicks: bool = False) -> Scene:
     forces: tuple[Force, ...] = ()
     if kicks:
         t1, t2 = float(rng.uniform(0.6, 0.9)), float(rng.uniform(1.5, 1.8))
-        forces = (Force("puck", (0.0, m * float(rng.uniform(10, 20))), t1, t1 + 0.1),
-                  Force("puck", (-m * float(rng.uniform(10, 15)), 0.0), t2, t2 + 0.1))
-    return Scene("puck" + ("_kicked" if kicks else ""), (Body("puck", Circle(0.05), (0.5, 2.0), velocity=v, mass=m),),
-                 bounds=(-2.0, -2.0, 8.0, 6.0), gravity=(0.0, 0.0), fps=20.0, frames=51, substeps=4, forces=forces)
+        forces = (
+            Force("puck", (0.0, m * float(rng.uniform(10, 20))), t1, t1 + 0.1),
+            Force("puck", (-m * float(rng.uniform(10, 15)), 0.0), t2, t2 + 0.1),
+        )
+    return Scene(
+        "puck" + ("_kicked" if kicks else ""),
+        (Body("puck", Circle(0.05), (0.5, 2.0), velocity=v, mass=m),),
+        bounds=(-2.0, -2.0, 8.0, 6.0),
+        gravity=(0.0, 0.0),
+        fps=20.0,
+        frames=51,
+        substeps=4,
+        forces=forces,
+    )
 
 
 def pucks(rng: np.random.Generator, slow: bool = False) -> Scene:
@@ -82,30 +106,78 @@ def pucks(rng: np.random.Generator, slow: bool = False) -> Scene:
     if slow:
         v = float(rng.uniform(0.5, 0.8))
         ang = float(rng.uniform(-0.5, 0.5))
-        bodies = (Body("puck", Circle(0.05), (1.0, 2.0), velocity=(v * math.cos(ang), v * math.sin(ang)), mass=float(rng.uniform(0.2, 1.0))),)
+        bodies = (
+            Body(
+                "puck",
+                Circle(0.05),
+                (1.0, 2.0),
+                velocity=(v * math.cos(ang), v * math.sin(ang)),
+                mass=float(rng.uniform(0.2, 1.0)),
+            ),
+        )
     else:
         a1 = float(rng.uniform(-0.4, 0.4))
         a2 = a1 + float(rng.uniform(1.8, 2.6))
         s1, s2 = float(rng.uniform(1.0, 1.6)), float(rng.uniform(1.0, 1.6))
         bodies = (
-            Body("a", Circle(0.05), (3.0, 2.0), velocity=(s1 * math.cos(a1), s1 * math.sin(a1)), mass=float(rng.uniform(0.2, 1.0))),
-            Body("b", Circle(0.05), (2.0, 3.0), velocity=(s2 * math.cos(a2), s2 * math.sin(a2)), mass=float(rng.uniform(0.2, 1.0))),
+            Body(
+                "a",
+                Circle(0.05),
+                (3.0, 2.0),
+                velocity=(s1 * math.cos(a1), s1 * math.sin(a1)),
+                mass=float(rng.uniform(0.2, 1.0)),
+            ),
+            Body(
+                "b",
+                Circle(0.05),
+                (2.0, 3.0),
+                velocity=(s2 * math.cos(a2), s2 * math.sin(a2)),
+                mass=float(rng.uniform(0.2, 1.0)),
+            ),
         )
-    return Scene("puck_slow" if slow else "pucks", bodies, bounds=(-2.0, -2.0, 8.0, 7.0), gravity=(0.0, 0.0), fps=20.0,
-                 frames=51, substeps=4)
+    return Scene(
+        "puck_slow" if slow else "pucks",
+        bodies,
+        bounds=(-2.0, -2.0, 8.0, 7.0),
+        gravity=(0.0, 0.0),
+        fps=20.0,
+        frames=51,
+        substeps=4,
+    )
 
 
 def two_bodies(rng: np.random.Generator, gravity: bool) -> Scene:
     """Two free balls of quite different masses (side view with gravity, or top-down)."""
     m1, m2 = float(rng.uniform(0.3, 0.6)), float(rng.uniform(1.5, 3.0))
     vy = (3.0, 2.0) if gravity else (0.4, -0.4)
-    a = Body("light", Circle(0.05), (1.0, 2.0), velocity=(float(rng.uniform(1.0, 2.0)), vy[0] + float(rng.uniform(-0.5, 0.5))), mass=m1)
-    b = Body("heavy", Circle(0.08), (1.0, 3.5), velocity=(float(rng.uniform(1.0, 2.0)), vy[1] + float(rng.uniform(-0.5, 0.5))), mass=m2)
-    return Scene("two_projectiles" if gravity else "two_pucks", (a, b), bounds=(-3.0, -10.0, 9.0, 8.0),
-                 gravity=(0.0, -G) if gravity else (0.0, 0.0), fps=20.0, frames=41, substeps=4)
+    a = Body(
+        "light",
+        Circle(0.05),
+        (1.0, 2.0),
+        velocity=(float(rng.uniform(1.0, 2.0)), vy[0] + float(rng.uniform(-0.5, 0.5))),
+        mass=m1,
+    )
+    b = Body(
+        "heavy",
+        Circle(0.08),
+        (1.0, 3.5),
+        velocity=(float(rng.uniform(1.0, 2.0)), vy[1] + float(rng.uniform(-0.5, 0.5))),
+        mass=m2,
+    )
+    return Scene(
+        "two_projectiles" if gravity else "two_pucks",
+        (a, b),
+        bounds=(-3.0, -10.0, 9.0, 8.0),
+        gravity=(0.0, -G) if gravity else (0.0, 0.0),
+        fps=20.0,
+        frames=41,
+        substeps=4,
+    )
 
 
-def pendulum(rng: np.random.Generator, amplitude: tuple[float, float] = (0.6, 1.0), tracked: str = "") -> Scene:
+def pendulum(
+    rng: np.random.Generator, amplitude: tuple[float, float] = (0.6, 1.0), tracked: str = ""
+) -> Scene:
     """A rigid arm on a pivot, released from rest; ``tracked`` names the recording ("": encoder
     angle, "_xy": camera position, "_both": both)."""
     length, m = float(rng.uniform(0.3, 0.5)), float(rng.uniform(0.3, 1.0))
@@ -113,8 +185,15 @@ def pendulum(rng: np.random.Generator, amplitude: tuple[float, float] = (0.6, 1.
     pivot = (1.0, 1.5)
     centre = (pivot[0] + math.sin(theta) * length / 2, pivot[1] - math.cos(theta) * length / 2)
     arm = Body("arm", Box(0.04, length), centre, angle=theta, mass=m, friction=0.0)
-    return Scene("pendulum" + tracked, (arm,), bounds=(0.0, 0.0, 2.0, 2.0), fps=20.0, frames=81, substeps=10,
-                 joints=(Joint("arm", pivot),))
+    return Scene(
+        "pendulum" + tracked,
+        (arm,),
+        bounds=(0.0, 0.0, 2.0, 2.0),
+        fps=20.0,
+        frames=81,
+        substeps=10,
+        joints=(Joint("arm", pivot),),
+    )
 
 
 def double_pendulum(rng: np.random.Generator) -> Scene:
@@ -126,21 +205,64 @@ def double_pendulum(rng: np.random.Generator) -> Scene:
     u2 = np.array([math.sin(t2), -math.cos(t2)])
     c1, elbow = p + u1 * l1 / 2, p + u1 * l1
     c2 = elbow + u2 * l2 / 2
-    a = Body("upper", Box(0.04, l1), (float(c1[0]), float(c1[1])), angle=t1, mass=float(rng.uniform(0.4, 0.8)), friction=0.0)
-    b = Body("lower", Box(0.04, l2), (float(c2[0]), float(c2[1])), angle=t2, mass=float(rng.uniform(0.2, 0.5)), friction=0.0)
-    return Scene("double_pendulum", (a, b), bounds=(0.0, 0.0, 2.0, 2.0), fps=20.0, frames=81, substeps=10,
-                 joints=(Joint("upper", (float(p[0]), float(p[1]))), Joint("lower", (float(elbow[0]), float(elbow[1])), "upper")))
+    a = Body(
+        "upper",
+        Box(0.04, l1),
+        (float(c1[0]), float(c1[1])),
+        angle=t1,
+        mass=float(rng.uniform(0.4, 0.8)),
+        friction=0.0,
+    )
+    b = Body(
+        "lower",
+        Box(0.04, l2),
+        (float(c2[0]), float(c2[1])),
+        angle=t2,
+        mass=float(rng.uniform(0.2, 0.5)),
+        friction=0.0,
+    )
+    return Scene(
+        "double_pendulum",
+        (a, b),
+        bounds=(0.0, 0.0, 2.0, 2.0),
+        fps=20.0,
+        frames=81,
+        substeps=10,
+        joints=(
+            Joint("upper", (float(p[0]), float(p[1]))),
+            Joint("lower", (float(elbow[0]), float(elbow[1])), "upper"),
+        ),
+    )
 
 
 def bouncer(rng: np.random.Generator) -> Scene:
     """A ball bouncing in a box seen from the side; its elasticity is a base-model unknown."""
     e = float(rng.uniform(0.75, 0.9))
-    ball = Body("ball", Circle(0.08), (0.6, float(rng.uniform(0.7, 0.9))), velocity=(float(rng.uniform(1.5, 2.5)), float(rng.uniform(0.0, 1.0))),
-                mass=float(rng.uniform(0.2, 1.0)), elasticity=e, friction=0.0)
-    walls = (Segment((0.0, 0.0), (2.0, 0.0)), Segment((0.0, 0.0), (0.0, 3.0)), Segment((2.0, 0.0), (2.0, 3.0)))
+    ball = Body(
+        "ball",
+        Circle(0.08),
+        (0.6, float(rng.uniform(0.7, 0.9))),
+        velocity=(float(rng.uniform(1.5, 2.5)), float(rng.uniform(0.0, 1.0))),
+        mass=float(rng.uniform(0.2, 1.0)),
+        elasticity=e,
+        friction=0.0,
+    )
+    walls = (
+        Segment((0.0, 0.0), (2.0, 0.0)),
+        Segment((0.0, 0.0), (0.0, 3.0)),
+        Segment((2.0, 0.0), (2.0, 3.0)),
+    )
     walls = tuple(Segment(s.a, s.b, elasticity=1.0, friction=0.0) for s in walls)
-    return Scene("bouncer", (ball,), bounds=(0.0, 0.0, 2.0, 3.0), fps=25.0, frames=41, substeps=20, statics=walls,
-                 unknowns=(Unknown("ball", "elasticity", 0.3, 1.0),))
+    return Scene(
+        "bouncer",
+        (ball,),
+        bounds=(0.0, 0.0, 2.0, 3.0),
+        fps=25.0,
+        frames=41,
+        substeps=20,
+        statics=walls,
+        unknowns=(Unknown("ball", "elasticity", 0.3, 1.0),),
+    )
 
 
 def drops(rng: np.random.Generator) -> Scene:
@@ -148,9 +270,33 @@ def drops(rng: np.random.Generator) -> Scene:
     span a wide range of speeds (about 5 m/s down to 1.5 m/s), which a single constant
     restitution cannot match."""
     floor = (Segment((-1.0, 0.0), (3.0, 0.0), elasticity=1.0, friction=0.0),)
-    low = Body("low", Circle(0.06), (0.5, float(rng.uniform(0.3, 0.4))), velocity=(0.0, -0.3), mass=0.2, elasticity=0.8, friction=0.0)
-    high = Body("high", Circle(0.06), (1.5, float(rng.uniform(1.0, 1.3))), velocity=(0.0, -0.3), mass=0.2, elasticity=0.8, friction=0.0)
-    return Scene("drops", (low, high), bounds=(0.0, 0.0, 2.0, 2.0), fps=25.0, frames=41, substeps=20, statics=floor)
+    low = Body(
+        "low",
+        Circle(0.06),
+        (0.5, float(rng.uniform(0.3, 0.4))),
+        velocity=(0.0, -0.3),
+        mass=0.2,
+        elasticity=0.8,
+        friction=0.0,
+    )
+    high = Body(
+        "high",
+        Circle(0.06),
+        (1.5, float(rng.uniform(1.0, 1.3))),
+        velocity=(0.0, -0.3),
+        mass=0.2,
+        elasticity=0.8,
+        friction=0.0,
+    )
+    return Scene(
+        "drops",
+        (low, high),
+        bounds=(0.0, 0.0, 2.0, 2.0),
+        fps=25.0,
+        frames=41,
+        substeps=20,
+        statics=floor,
+    )
 
 
 SCENES = {
@@ -203,19 +349,28 @@ def hidden_values(effect: str, scene: Scene, rng: np.random.Generator) -> dict[s
         k = ("fx", "fy") if effect == "constant_force" else ("ax", "ay")
         return {k[0]: mag * math.cos(ang), k[1]: mag * math.sin(ang)}
     if effect.startswith("joint_"):
-        inertia = sum(b.inertia() + b.mass * (b.shape.height / 2) ** 2 for b in scene.bodies if isinstance(b.shape, Box))
+        inertia = sum(
+            b.inertia() + b.mass * (b.shape.height / 2) ** 2
+            for b in scene.bodies
+            if isinstance(b.shape, Box)
+        )
         arm = scene.bodies[0]
         assert isinstance(arm.shape, Box)
         mgd = arm.mass * G * arm.shape.height / 2
         if effect == "joint_viscous_damping":
-            return {"c": inertia * float(rng.uniform(0.15, 0.35))}  # amplitude decay rate c / 2I: 0.08-0.18 /s
+            return {
+                "c": inertia * float(rng.uniform(0.15, 0.35))
+            }  # amplitude decay rate c / 2I: 0.08-0.18 /s
         if effect == "joint_coulomb_friction":
             return {"tau": mgd * float(rng.uniform(0.01, 0.02))}  # 0.04-0.08 rad lost per cycle
         return {"c": inertia * float(rng.uniform(0.03, 0.06))}
     if effect == "velocity_dependent_restitution":
         return {"e0": float(rng.uniform(0.9, 0.98)), "k": float(rng.uniform(0.08, 0.12))}
     if effect == "sensor_offset":
-        out = {"dx": _sign(rng) * float(rng.uniform(0.02, 0.05)), "dy": _sign(rng) * float(rng.uniform(0.02, 0.05))}
+        out = {
+            "dx": _sign(rng) * float(rng.uniform(0.02, 0.05)),
+            "dy": _sign(rng) * float(rng.uniform(0.02, 0.05)),
+        }
         if scene.name.endswith("_both"):
             out["dangle"] = _sign(rng) * float(rng.uniform(0.04, 0.1))
         return out
@@ -224,7 +379,9 @@ def hidden_values(effect: str, scene: Scene, rng: np.random.Generator) -> dict[s
     raise KeyError(effect)
 
 
-def _record(scene_kind: str, scene: Scene, traj: Trajectory, t_end: float, rng: np.random.Generator) -> Recording:
+def _record(
+    scene_kind: str, scene: Scene, traj: Trajectory, t_end: float, rng: np.random.Generator
+) -> Recording:
     """Samples at the scene's frame times up to ``t_end`` with tracking noise."""
     times = np.arange(0.0, t_end + 1e-9, 1.0 / scene.fps)
     base = Recording.from_trajectory(traj, times=times)
@@ -233,7 +390,9 @@ def _record(scene_kind: str, scene: Scene, traj: Trajectory, t_end: float, rng: 
     for b, tr in base.tracks.items():
         n = len(tr)
         angle = None if tr.angle is None else tr.angle + rng.normal(0, NOISE_ANGLE, n)
-        tracks[b] = Track(tr.t, tr.x + rng.normal(0, sigma, n), tr.y + rng.normal(0, sigma, n), angle)
+        tracks[b] = Track(
+            tr.t, tr.x + rng.normal(0, sigma, n), tr.y + rng.normal(0, sigma, n), angle
+        )
     if scene_kind.endswith("_both"):
         fields: tuple[str, ...] = ("x", "y", "angle")
     elif scene.joints and not scene_kind.endswith("_xy"):
@@ -258,11 +417,19 @@ def make_case(effect: str | None, scene_kind: str, seed: int, engine: Any) -> Ca
         effects = [get_registry().get("effect", effect)(**truth)]
     t_end = (scene.frames - 1) / scene.fps
     scale = truth.get("scale", 1.0)
-    sim_scene = scene if scale <= 1 else replace(scene, frames=math.ceil(t_end * scale * scene.fps) + 2)
+    sim_scene = (
+        scene if scale <= 1 else replace(scene, frames=math.ceil(t_end * scale * scene.fps) + 2)
+    )
     traj = apply_measurements(engine.simulate(sim_scene, effects=effects), effects)
     rec = _record(scene_kind, scene, traj, t_end, rng)
     name = f"{effect or 'control'}/{scene_kind}/{seed}"
-    return Case(name, scene_kind, Run(name, _blur(scene, rng), recording=rec, source="synthetic"), effect, truth)
+    return Case(
+        name,
+        scene_kind,
+        Run(name, _blur(scene, rng), recording=rec, source="synthetic"),
+        effect,
+        truth,
+    )
 
 
 def _blur(scene: Scene, rng: np.random.Generator) -> Scene:
@@ -275,11 +442,17 @@ def _blur(scene: Scene, rng: np.random.Generator) -> Scene:
         if b.name in parents:
             state[b.name] = {"angle0": b.angle + float(rng.normal(0, 0.01))}
         elif math.hypot(*b.velocity) > 0:
-            state[b.name] = {"x0": b.position[0] + float(rng.normal(0, 0.005)), "y0": b.position[1] + float(rng.normal(0, 0.005)),
-                             "vx0": b.velocity[0] * (1 + float(rng.normal(0, 0.03))), "vy0": b.velocity[1] * (1 + float(rng.normal(0, 0.03)))}
+            state[b.name] = {
+                "x0": b.position[0] + float(rng.normal(0, 0.005)),
+                "y0": b.position[1] + float(rng.normal(0, 0.005)),
+                "vx0": b.velocity[0] * (1 + float(rng.normal(0, 0.03))),
+                "vy0": b.velocity[1] * (1 + float(rng.normal(0, 0.03))),
+            }
     scene = apply_initial(scene, state, {})
     for u in scene.unknowns:
         b = scene.bodies[scene.body_index(u.body)]
-        guess = float(np.clip(getattr(b, u.param) + 0.1 * (u.high - u.low) * _sign(rng), u.low, u.high))
+        guess = float(
+            np.clip(getattr(b, u.param) + 0.1 * (u.high - u.low) * _sign(rng), u.low, u.high)
+        )
         scene = scene.with_params({u.key: guess})
     return scene

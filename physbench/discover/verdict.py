@@ -56,7 +56,9 @@ def text(disc: Discovery) -> str:
     u = disc.unit
     lines = []
     runs = ", ".join(r.name for r in disc.runs[:6]) + (" ..." if len(disc.runs) > 6 else "")
-    lines.append(f"discovery on {len(disc.runs)} run(s) [{runs}] with {disc.engine}; {disc.split.describe(disc.runs)}")
+    lines.append(
+        f"discovery on {len(disc.runs)} run(s) [{runs}] with {disc.engine}; {disc.split.describe(disc.runs)}"
+    )
     b = disc.base
     lines.append(
         f"base model: fit error {b.fit.rms:.4g} {u}, held-out error {b.heldout:.4g} {u} "
@@ -64,7 +66,10 @@ def text(disc: Discovery) -> str:
     )
     shown = {k: v for k, v in b.summary()["params"].items()}
     if shown:
-        lines.append("  fitted: " + ", ".join(f"{k} = {format_value(v, b.fit.stderr.get(k))}" for k, v in shown.items()))
+        lines.append(
+            "  fitted: "
+            + ", ".join(f"{k} = {format_value(v, b.fit.stderr.get(k))}" for k, v in shown.items())
+        )
     lines.append("")
     lines.append("what is wrong with the base model:")
     fs = disc.findings.get("base", [])
@@ -83,7 +88,9 @@ def text(disc: Discovery) -> str:
             lines.append(f"  - residual RMS of {body} by event ({u}): {cells}")
     lines.append("")
     if disc.causes:
-        lines.append("cause" + ("s" if len(disc.causes) > 1 else "") + " found (in the order added):")
+        lines.append(
+            "cause" + ("s" if len(disc.causes) > 1 else "") + " found (in the order added):"
+        )
         for i, c in enumerate(disc.cause_results, 1):
             lines.append(
                 f"  {i}. {c.effect}: {params_text(c)}  (held-out gain {c.gain:+.1%} over the model before it, "
@@ -91,17 +98,25 @@ def text(disc: Discovery) -> str:
             )
             alts = disc.alternatives.get(c.effect, [])
             if alts:
-                lines.append(f"     about as good on held-out data: {', '.join(alts)} (the data hardly tell them apart)")
+                lines.append(
+                    f"     about as good on held-out data: {', '.join(alts)} (the data hardly tell them apart)"
+                )
             if c.fixed:
-                lines.append("     not visible in the data, kept fixed: " + ", ".join(f"{k} = {v:.4g}" for k, v in c.fixed.items()))
+                lines.append(
+                    "     not visible in the data, kept fixed: "
+                    + ", ".join(f"{k} = {v:.4g}" for k, v in c.fixed.items())
+                )
         f = disc.final
         lines.append(
             f"extended model: held-out error {f.heldout:.4g} {u} (base {b.heldout:.4g}); gain = 1 - extended/base = {disc.gain:.1%}"
         )
     else:
         best = min(disc.candidates, key=lambda c: c.heldout_error, default=None)
-        why = (f"; best was {best.effect} with held-out gain {best.gain:+.1%}, ΔBIC {best.delta_criterion:+.1f}"
-               if best is not None else "")
+        why = (
+            f"; best was {best.effect} with held-out gain {best.gain:+.1%}, ΔBIC {best.delta_criterion:+.1f}"
+            if best is not None
+            else ""
+        )
         lines.append(
             f"no cause found: no candidate improves the held-out error by >= {disc.settings.min_gain:.0%} with "
             f"ΔBIC <= -{disc.settings.min_delta_bic:g}{why}. The base model explains the data as well as any extension."
@@ -140,25 +155,43 @@ def _clean(v: Any) -> Any:
 
 def to_dict(disc: Discovery) -> dict[str, Any]:
     """The JSON-ready verdict."""
-    return _clean({
-        "base": disc.base.summary(),
-        "candidates": [c.to_dict() for c in disc.candidates],
-        "causes": list(disc.causes),
-        "gain": disc.gain,
-        "final": disc.final.summary(),
-        "alternatives": disc.alternatives,
-        "engine": disc.engine,
-        "unit": disc.unit,
-        "runs": [{"name": r.name, "scene": r.scene.name, "kind": r.kind, "source": r.source, "t_end": r.t_end} for r in disc.runs],
-        "split": {"kind": disc.split.kind, "fraction": disc.split.fraction, "description": disc.split.describe(disc.runs),
-                  "train_runs": [disc.runs[i].name for i in disc.split.train_runs],
-                  "test_runs": [disc.runs[i].name for i in disc.split.test_runs]},
-        "findings": {k: [f.to_dict() for f in v] for k, v in disc.findings.items()},
-        "residuals": {k: v.to_dict() for k, v in disc.breakdowns.items()},
-        "skipped": [{"effect": n, "reason": r} for n, r in disc.skipped],
-        "settings": {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(disc.settings).items()},
-        "seconds": disc.seconds,
-    })
+    return _clean(
+        {
+            "base": disc.base.summary(),
+            "candidates": [c.to_dict() for c in disc.candidates],
+            "causes": list(disc.causes),
+            "gain": disc.gain,
+            "final": disc.final.summary(),
+            "alternatives": disc.alternatives,
+            "engine": disc.engine,
+            "unit": disc.unit,
+            "runs": [
+                {
+                    "name": r.name,
+                    "scene": r.scene.name,
+                    "kind": r.kind,
+                    "source": r.source,
+                    "t_end": r.t_end,
+                }
+                for r in disc.runs
+            ],
+            "split": {
+                "kind": disc.split.kind,
+                "fraction": disc.split.fraction,
+                "description": disc.split.describe(disc.runs),
+                "train_runs": [disc.runs[i].name for i in disc.split.train_runs],
+                "test_runs": [disc.runs[i].name for i in disc.split.test_runs],
+            },
+            "findings": {k: [f.to_dict() for f in v] for k, v in disc.findings.items()},
+            "residuals": {k: v.to_dict() for k, v in disc.breakdowns.items()},
+            "skipped": [{"effect": n, "reason": r} for n, r in disc.skipped],
+            "settings": {
+                k: (list(v) if isinstance(v, tuple) else v)
+                for k, v in asdict(disc.settings).items()
+            },
+            "seconds": disc.seconds,
+        }
+    )
 
 
 def to_json(disc: Discovery, **kwargs: Any) -> str:

@@ -69,11 +69,17 @@ class EffectBase:
     #: stepping loop then does not call them every substep.
     applies_forces: ClassVar[bool] = True
 
-    def __init__(self, *, bodies: Iterable[str] | None = None, label: str | None = None, **values: float) -> None:
+    def __init__(
+        self, *, bodies: Iterable[str] | None = None, label: str | None = None, **values: float
+    ) -> None:
         if isinstance(bodies, str):
-            raise EffectError(f"{self.name}: bodies must be a list of body names, not the string {bodies!r}")
+            raise EffectError(
+                f"{self.name}: bodies must be a list of body names, not the string {bodies!r}"
+            )
         if label is not None and (not isinstance(label, str) or not label or "." in label):
-            raise EffectError(f"{self.name}: label = {label!r}: expected a non-empty name without '.'")
+            raise EffectError(
+                f"{self.name}: label = {label!r}: expected a non-empty name without '.'"
+            )
         self.bodies = None if bodies is None else tuple(bodies)
         #: Prefix of this instance's parameter keys (``"<key>.<param>"``): the label, else the name.
         self.key: str = label or self.name
@@ -102,18 +108,26 @@ class EffectBase:
         for p in cls.params:
             if p.name == name:
                 return p
-        raise UnknownNameError(f"parameter of effect {cls.name!r}", name, [p.name for p in cls.params])
+        raise UnknownNameError(
+            f"parameter of effect {cls.name!r}", name, [p.name for p in cls.params]
+        )
 
     def _checked(self, values: Mapping[str, float]) -> dict[str, float]:
         out: dict[str, float] = {}
         for key, value in values.items():
             name = key.removeprefix(f"{self.key}.").removeprefix(f"{self.name}.")
             p = self.param(name)
-            if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
-                raise EffectError(f"{self.key}.{name} = {value!r}: must be a number in [{p.low:g}, {p.high:g}] {p.unit}")
+            if isinstance(value, bool) or not isinstance(
+                value, int | float | np.floating | np.integer
+            ):
+                raise EffectError(
+                    f"{self.key}.{name} = {value!r}: must be a number in [{p.low:g}, {p.high:g}] {p.unit}"
+                )
             v = float(value)
             if not math.isfinite(v) or not p.low <= v <= p.high:
-                raise EffectError(f"{self.key}.{name} = {v!r}: must lie in [{p.low:g}, {p.high:g}] {p.unit}".rstrip())
+                raise EffectError(
+                    f"{self.key}.{name} = {v!r}: must lie in [{p.low:g}, {p.high:g}] {p.unit}".rstrip()
+                )
             out[name] = v
         return out
 
@@ -128,7 +142,9 @@ class EffectBase:
         else:
             for b in self.bodies:
                 if b not in names:
-                    raise UnknownNameError(f"body of scene {scene.name!r} (effect {self.name})", b, names)
+                    raise UnknownNameError(
+                        f"body of scene {scene.name!r} (effect {self.name})", b, names
+                    )
             self.mask = np.array([n in self.bodies for n in names], dtype=bool)
         # Index of the selected bodies: a plain slice when all are selected (cheaper every substep).
         self.sel = slice(None) if self.mask.all() else np.nonzero(self.mask)[0]
@@ -178,7 +194,9 @@ class JointEffectBase(EffectBase):
     def configure(self, scene: Scene) -> None:
         chosen = range(len(scene.joints)) if self.joints is None else self.joints
         if not scene.joints:
-            raise EffectError(f"effect {self.name!r} needs a scene with joints; scene {scene.name!r} has none")
+            raise EffectError(
+                f"effect {self.name!r} needs a scene with joints; scene {scene.name!r} has none"
+            )
         for j in chosen:
             if not 0 <= j < len(scene.joints):
                 raise EffectError(
@@ -186,7 +204,9 @@ class JointEffectBase(EffectBase):
                 )
         sel = [scene.joints[j] for j in chosen]
         self.ia = np.array([scene.body_index(j.a) for j in sel], dtype=int)
-        self.ib = np.array([scene.body_index(j.b) if j.b is not None else -1 for j in sel], dtype=int)
+        self.ib = np.array(
+            [scene.body_index(j.b) if j.b is not None else -1 for j in sel], dtype=int
+        )
         ia_inv = 1.0 / self.inertias[self.ia]
         ib_inv = np.where(self.ib >= 0, 1.0 / self.inertias[np.maximum(self.ib, 0)], 0.0)
         # Smallest inertia the torque acts on: the pivot only adds inertia, so this bounds the

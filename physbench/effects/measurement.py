@@ -27,7 +27,9 @@ class _Measurement(EffectBase):
             return np.ones(len(traj.bodies), dtype=bool)
         missing = [b for b in self.bodies if b not in traj.bodies]
         if missing:
-            raise EffectError(f"{self.name}: bodies {missing} are not in the trajectory (bodies: {list(traj.bodies)})")
+            raise EffectError(
+                f"{self.name}: bodies {missing} are not in the trajectory (bodies: {list(traj.bodies)})"
+            )
         return np.array([b in self.bodies for b in traj.bodies], dtype=bool)
 
 

@@ -38,5 +38,7 @@ class RollingResistance(EffectBase):
         self._require_setup(states)
         f, tau = self.zeros(states.shape[0])
         m = self.masses[self.sel, None]
-        f[self.sel] = -self.values["mu"] * self.g * m * smooth_unit(states[self.sel, 3:5], self._eps)
+        f[self.sel] = (
+            -self.values["mu"] * self.g * m * smooth_unit(states[self.sel, 3:5], self._eps)
+        )
         return f, tau

@@ -25,12 +25,16 @@ class CMAES(AskTellEstimator):
 
     name: ClassVar[str] = "cmaes"
 
-    def __init__(self, sigma: float = 0.3, popsize: int | None = None, elitist: bool = False) -> None:
+    def __init__(
+        self, sigma: float = 0.3, popsize: int | None = None, elitist: bool = False
+    ) -> None:
         super().__init__()
         if not isinstance(elitist, bool):
             from physbench.estimators import EstimatorOptionError
 
-            raise EstimatorOptionError(f"{self.name}: elitist = {elitist!r}: expected true or false")
+            raise EstimatorOptionError(
+                f"{self.name}: elitist = {elitist!r}: expected true or false"
+            )
         self.options = {
             "sigma": float_option(self.name, "sigma", sigma, low=0.0, high=1.0),
             "popsize": int_option(self.name, "popsize", popsize, low=2, allow_none=True),
@@ -48,9 +52,13 @@ class CMAES(AskTellEstimator):
         # nevergrad starts CMA on a fully bounded parametrization with 0.3 x (0.15 x from 18
         # dimensions) the parametrization's sigma; undo that so ``sigma`` is the real first step.
         shrink = 0.3 if len(x0) < 18 else 0.15
-        param = ng.p.Array(init=x0, lower=0.0, upper=1.0).set_mutation(sigma=self.options["sigma"] / shrink)
+        param = ng.p.Array(init=x0, lower=0.0, upper=1.0).set_mutation(
+            sigma=self.options["sigma"] / shrink
+        )
         param.random_state = np.random.RandomState(seed % 2**32)
-        algo = ng.optimizers.ParametrizedCMA(popsize=self.options["popsize"], elitist=self.options["elitist"])
+        algo = ng.optimizers.ParametrizedCMA(
+            popsize=self.options["popsize"], elitist=self.options["elitist"]
+        )
         self._opt = algo(parametrization=param, budget=None, num_workers=1)
         self._opt.suggest(x0)
         self._pending: Any = self._opt.ask()

@@ -55,7 +55,9 @@ class Optuna(AskTellEstimator):
         try:
             import cmaes  # noqa: F401  (optuna imports it lazily and fails late otherwise)
         except ImportError:
-            raise PhysbenchError("optuna: sampler = 'cmaes' needs the 'cmaes' package: pip install cmaes") from None
+            raise PhysbenchError(
+                "optuna: sampler = 'cmaes' needs the 'cmaes' package: pip install cmaes"
+            ) from None
         return optuna.samplers.CmaEsSampler(
             n_startup_trials=max(startup, 1),
             seed=seed,

@@ -33,7 +33,9 @@ class TPE(AskTellEstimator):
 
     name: ClassVar[str] = "tpe"
 
-    def __init__(self, startup: int = DEFAULT_STARTUP, candidates: int = 24, gamma: float = 0.25) -> None:
+    def __init__(
+        self, startup: int = DEFAULT_STARTUP, candidates: int = 24, gamma: float = 0.25
+    ) -> None:
         super().__init__()
         self.options = {
             "startup": int_option(self.name, "startup", startup, low=0),
@@ -48,7 +50,9 @@ class TPE(AskTellEstimator):
         self._domain = Domain(lambda _: 0.0, {k: hp.uniform(k, 0.0, 1.0) for k in self._keys})
         self._trials = Trials()
         self._rng = np.random.default_rng(seed)
-        self._pending: dict[str, Any] = {k: float(v) for k, v in zip(self._keys, self.x0, strict=True)}
+        self._pending: dict[str, Any] = {
+            k: float(v) for k, v in zip(self._keys, self.x0, strict=True)
+        }
 
     def _tell(self, loss: float) -> None:
         from hyperopt import JOB_STATE_DONE, STATUS_OK
@@ -61,7 +65,9 @@ class TPE(AskTellEstimator):
             "idxs": {k: [tid] for k in self._keys},
             "vals": {k: [self._pending[k]] for k in self._keys},
         }
-        (doc,) = self._trials.new_trial_docs([tid], [None], [{"loss": loss, "status": STATUS_OK}], [misc])
+        (doc,) = self._trials.new_trial_docs(
+            [tid], [None], [{"loss": loss, "status": STATUS_OK}], [misc]
+        )
         doc["state"] = JOB_STATE_DONE
         self._trials.insert_trial_docs([doc])
         self._trials.refresh()

@@ -51,7 +51,9 @@ def plot_convergence(
     panels = [("best_nmse", "best-so-far normalized MSE"), ("best_loss", "best-so-far image MSE")]
     if any(_curves(runs, "best_nmse") is None for runs in groups.values()):
         panels = panels[1:]
-    fig, axes = plt.subplots(len(panels), 1, figsize=(6, 2.6 * len(panels) + 0.6), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(
+        len(panels), 1, figsize=(6, 2.6 * len(panels) + 0.6), sharex=True, squeeze=False
+    )
     for ax, (field, ylabel) in zip(axes[:, 0], panels, strict=True):
         for label, runs in groups.items():
             y = _curves(runs, field)
@@ -60,7 +62,13 @@ def plot_convergence(
             x = np.arange(1, y.shape[1] + 1)
             lo, mid, hi = np.percentile(y, [25, 50, 75], axis=0)
             what = "median, IQR" if len(runs) > 1 else "one run"
-            (line,) = ax.plot(x, mid, marker="o", ms=3, label=f"{label} ({what}, n={len(runs)})" if len(runs) > 1 else label)
+            (line,) = ax.plot(
+                x,
+                mid,
+                marker="o",
+                ms=3,
+                label=f"{label} ({what}, n={len(runs)})" if len(runs) > 1 else label,
+            )
             if len(runs) > 1:
                 ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.2)
         ax.set_yscale("log")

@@ -21,7 +21,9 @@ class SceneGenerator(Protocol):
     def __call__(self, seed: int = 0) -> Scene: ...
 
 
-def scene_generator(name: str, description: str) -> Callable[[Callable[[int], Scene]], SceneGenerator]:
+def scene_generator(
+    name: str, description: str
+) -> Callable[[Callable[[int], Scene]], SceneGenerator]:
     """Decorator: mark a ``(seed) -> Scene`` function as a registrable scene generator."""
 
     def wrap(fn: Callable[[int], Scene]) -> SceneGenerator:
@@ -53,7 +55,10 @@ def _builtins() -> list[Any]:
         three_circles,
     )
 
-    return [m.generate for m in (three_circles, second_order, stacked_boxes, bouncing_balls, pendulum, ball_drop)]
+    return [
+        m.generate
+        for m in (three_circles, second_order, stacked_boxes, bouncing_balls, pendulum, ball_drop)
+    ]
 
 
 @hookimpl

@@ -66,8 +66,18 @@ def generate(
     rng = np.random.default_rng([seed, 6])
     y0 = rng.uniform(45.5, 49.5) if height is None else float(height)
     w = HALF_WIDTH
-    ground = StaticPolygon(((-w, -2.0), (w, -2.0), (w, 0.0), (-w, 0.0)), elasticity=1.0, friction=1.0)
-    body = Body("ball", Circle(radius), (0.0, y0), velocity=(0.0, velocity), mass=mass, elasticity=0.5, friction=0.5)
+    ground = StaticPolygon(
+        ((-w, -2.0), (w, -2.0), (w, 0.0), (-w, 0.0)), elasticity=1.0, friction=1.0
+    )
+    body = Body(
+        "ball",
+        Circle(radius),
+        (0.0, y0),
+        velocity=(0.0, velocity),
+        mass=mass,
+        elasticity=0.5,
+        friction=0.5,
+    )
     return Scene(
         name="ball_drop",
         bodies=(body,),

@@ -34,7 +34,9 @@ MAX_BALLS = 6
 SLOTS = ((0, 0.0), (1, 0.5), (1, -0.5), (2, 0.0), (2, 1.0), (2, -1.0))
 
 
-@scene_generator("bouncing_balls", "top-down pool table: a test ball shot into a rack of 2-6 unknown balls")
+@scene_generator(
+    "bouncing_balls", "top-down pool table: a test ball shot into a rack of 2-6 unknown balls"
+)
 def generate(seed: int = 0, n_balls: int | None = None) -> Scene:
     """A pool table with ``n_balls`` unknown-mass balls ``b0..`` (None: 2-6, drawn from the seed)."""
     rng = np.random.default_rng([seed, 4])

@@ -55,7 +55,9 @@ RIGS: dict[str, Rig] = {
 FPS = 1000.0
 
 
-@scene_generator("pendulum", "rigid arm on a pivot, the real single-pendulum rigs (1 kHz encoder angles)")
+@scene_generator(
+    "pendulum", "rigid arm on a pivot, the real single-pendulum rigs (1 kHz encoder angles)"
+)
 def generate(
     seed: int = 0,
     rig: str = "kaheman",

@@ -26,7 +26,9 @@ XA = 1.6  # m, x of circle a (+-0.1 per seed)
 GAP = (0.35, 0.5)  # m between a and b
 
 
-@scene_generator("second_order", "test circle shot sideways into one unknown circle, which strikes the other")
+@scene_generator(
+    "second_order", "test circle shot sideways into one unknown circle, which strikes the other"
+)
 def generate(seed: int = 0) -> Scene:
     """Three circles on the floor of a bin; ``a`` and ``b`` have unknown mass and elasticity."""
     rng = np.random.default_rng([seed, 2])

@@ -31,7 +31,9 @@ XA = 1.8  # m, x of circle a (+-0.1 per seed)
 START_Y = 1.8  # m, height of the test circle (+-0.2 per seed)
 
 
-@scene_generator("three_circles", "test circle shot down from above onto two unknown circles in a bin")
+@scene_generator(
+    "three_circles", "test circle shot down from above onto two unknown circles in a bin"
+)
 def generate(seed: int = 0) -> Scene:
     """Three circles in a bin; ``a`` and ``b`` have unknown mass and elasticity."""
     rng = np.random.default_rng([seed, 1])

@@ -144,7 +144,9 @@ def _add_body(world: Any, b: Body, v: tuple[float, float], w: float) -> Any:
     dx, dy = b.com_offset
     # The Box2D body origin is the shape centre; the CoM is set through the mass data.
     # allowSleep=False: pybox2d bodies fall asleep even in a world with allowSleeping off.
-    body = world.CreateDynamicBody(position=b.position, angle=b.angle, bullet=True, allowSleep=False)
+    body = world.CreateDynamicBody(
+        position=b.position, angle=b.angle, bullet=True, allowSleep=False
+    )
     if isinstance(b.shape, Circle):
         shape = Box2D.b2CircleShape(radius=b.shape.radius)
     else:
@@ -155,7 +157,10 @@ def _add_body(world: Any, b: Body, v: tuple[float, float], w: float) -> Any:
     md.I = b.inertia() + b.mass * (dx * dx + dy * dy)  # Box2D wants I about the body origin
     body.massData = md
     # Box2D stores float32 and silently turns a mass it cannot hold into 1 kg.
-    if not (math.isclose(body.mass, b.mass, rel_tol=1e-5) and math.isclose(body.inertia, md.I, rel_tol=1e-5)):
+    if not (
+        math.isclose(body.mass, b.mass, rel_tol=1e-5)
+        and math.isclose(body.inertia, md.I, rel_tol=1e-5)
+    ):
         raise SimulationError(
             f"mass {b.mass:g} kg / moment {md.I:g} kg·m² is outside Box2D's float32 range",
             engine="box2d",
@@ -186,11 +191,16 @@ class Box2DWorld:
                 raise
             except Exception as exc:  # e.g. more vertices than Box2D's b2_maxPolygonVertices
                 raise SimulationError(
-                    f"cannot build the body: {type(exc).__name__}: {exc}", engine="box2d", frame=0, body=b.name
+                    f"cannot build the body: {type(exc).__name__}: {exc}",
+                    engine="box2d",
+                    frame=0,
+                    body=b.name,
                 ) from exc
         index = {b.name: body for b, body in zip(scene.bodies, self.bodies, strict=True)}
         for j in scene.joints:
-            world.CreateRevoluteJoint(bodyA=index[j.a], bodyB=index[j.b] if j.b else ground, anchor=j.anchor)
+            world.CreateRevoluteJoint(
+                bodyA=index[j.a], bodyB=index[j.b] if j.b else ground, anchor=j.anchor
+            )
         self.world = world
         self.vi, self.pi = velocity_iterations, position_iterations
         h = scene.dt / scene.substeps

@@ -127,7 +127,12 @@ class PymunkWorld:
                 ia, ib = index.get(a), index.get(b)
                 if points and (ia is not None or ib is not None):
                     p = points[0].point_a
-                    speed = max(0.0, -(b.velocity_at_world_point(p) - a.velocity_at_world_point(p)).dot(arbiter.normal))
+                    speed = max(
+                        0.0,
+                        -(b.velocity_at_world_point(p) - a.velocity_at_world_point(p)).dot(
+                            arbiter.normal
+                        ),
+                    )
                     e = hook(speed, ia, ib) if ia is not None else hook(speed, ib, None)  # type: ignore[arg-type]
                     if e is not None and speed < threshold:
                         e = 0.0  # as the begin handler of velocity_threshold would
@@ -185,7 +190,12 @@ def _batch_layout_ok() -> bool:
         space = pymunk.Space()
         for k in (1.0, 2.0):
             b = pymunk.Body(1.0, 1.0)
-            b.position, b.angle, b.velocity, b.angular_velocity = (k, k + 0.1), k + 0.2, (k + 0.3, k + 0.4), k + 0.5
+            b.position, b.angle, b.velocity, b.angular_velocity = (
+                (k, k + 0.1),
+                k + 0.2,
+                (k + 0.3, k + 0.4),
+                k + 0.5,
+            )
             space.add(b, pymunk.Circle(b, 0.1))
         expected = [v for k in (1.0, 2.0) for v in (k, k + 0.1, k + 0.2, k + 0.3, k + 0.4, k + 0.5)]
         return _BatchReader(space, 2).read() == expected
@@ -203,7 +213,9 @@ def _inelastic_below(threshold: float) -> Callable[[Any, Any, Any], None]:
             return
         a, b = arbiter.bodies
         p = points[0].point_a
-        if (b.velocity_at_world_point(p) - a.velocity_at_world_point(p)).dot(arbiter.normal) > -threshold:
+        if (b.velocity_at_world_point(p) - a.velocity_at_world_point(p)).dot(
+            arbiter.normal
+        ) > -threshold:
             arbiter.restitution = 0.0
 
     return begin

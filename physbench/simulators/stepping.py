@@ -124,7 +124,16 @@ def initial_com_state(scene: Scene) -> list[tuple[float, float, float, float, fl
         c, s = math.cos(b.angle), math.sin(b.angle)
         rx, ry = c * dx - s * dy, s * dx + c * dy
         w = b.angular_velocity
-        out.append((b.position[0] + rx, b.position[1] + ry, b.angle, b.velocity[0] - w * ry, b.velocity[1] + w * rx, w))
+        out.append(
+            (
+                b.position[0] + rx,
+                b.position[1] + ry,
+                b.angle,
+                b.velocity[0] - w * ry,
+                b.velocity[1] + w * rx,
+                w,
+            )
+        )
     return out
 
 
@@ -148,7 +157,9 @@ def _schedule(scene: Scene, h: float, n_sub: int) -> dict[int, list[Action]]:
             for k in range(max(0, k0), k1):
                 frac = (min(f.end, (k + 1) * h) - max(f.start, k * h)) / h
                 if frac > 1e-12:
-                    sched.setdefault(k, []).append((False, i, f.vector[0] * frac, f.vector[1] * frac))
+                    sched.setdefault(k, []).append(
+                        (False, i, f.vector[0] * frac, f.vector[1] * frac)
+                    )
     return sched
 
 
@@ -185,7 +196,9 @@ class SteppingSimulator:
             raise
         except Exception as exc:  # engines reject absurd values with assorted exception types
             raise SimulationError(
-                f"engine cannot build the scene: {type(exc).__name__}: {exc}", engine=self.name, frame=0
+                f"engine cannot build the scene: {type(exc).__name__}: {exc}",
+                engine=self.name,
+                frame=0,
             ) from exc
         if effects:
             hook = first_restitution(effects)
@@ -195,7 +208,9 @@ class SteppingSimulator:
                     names = [e.name for e in effects if callable(getattr(e, "restitution", None))]
                     raise SimulationError(
                         f"effects {names} change contacts, but this engine has no contact hook "
-                        "(EngineWorld.set_restitution_hook)", engine=self.name, frame=0
+                        "(EngineWorld.set_restitution_hook)",
+                        engine=self.name,
+                        frame=0,
                     )
                 install(hook)
             effects = [e for e in effects if getattr(e, "applies_forces", True)]
@@ -225,14 +240,19 @@ class SteppingSimulator:
                         step(h)
                 row = read()
                 rows.append(row)
-                if not math.isfinite(sum(row)):  # stop early: NaN only spreads (and can stall engines)
+                if not math.isfinite(
+                    sum(row)
+                ):  # stop early: NaN only spreads (and can stall engines)
                     break
         except _EffectFailed as exc:
             raise exc.__cause__ from None  # type: ignore[misc]
         except Exception as exc:
             body = scene.bodies[culprit].name if culprit is not None else None
             raise SimulationError(
-                f"engine failed: {type(exc).__name__}: {exc}", engine=self.name, frame=frame, body=body
+                f"engine failed: {type(exc).__name__}: {exc}",
+                engine=self.name,
+                frame=frame,
+                body=body,
             ) from exc
         states = np.asarray(rows, dtype=float).reshape(len(rows), n, 6)
         self._check(scene, states, world)
@@ -274,7 +294,10 @@ class SteppingSimulator:
                 fxy, tau = fxy + f2, tau + t2
         except Exception as exc:
             raise _EffectFailed from exc
-        forces, torques = np.asarray(fxy, dtype=float).tolist(), np.asarray(tau, dtype=float).tolist()
+        forces, torques = (
+            np.asarray(fxy, dtype=float).tolist(),
+            np.asarray(tau, dtype=float).tolist(),
+        )
         for i in range(n):
             fx, fy = forces[i]
             if fx or fy:
@@ -291,7 +314,10 @@ class SteppingSimulator:
         nan = ~np.isfinite(states).all(axis=2)
         out = (x < xmin - mx) | (x > xmax + mx) | (y < ymin - my) | (y > ymax + my)
         fast = np.zeros_like(out)
-        vmax, wmax = getattr(world, "max_speed", math.inf), getattr(world, "max_angular_speed", math.inf)
+        vmax, wmax = (
+            getattr(world, "max_speed", math.inf),
+            getattr(world, "max_angular_speed", math.inf),
+        )
         if math.isfinite(vmax):
             with np.errstate(invalid="ignore", over="ignore"):
                 fast |= np.hypot(states[:, :, 3], states[:, :, 4]) >= SPEED_LIMIT_FRACTION * vmax

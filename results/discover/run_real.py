@@ -49,7 +49,10 @@ def save(name: str, disc, *, report: bool = True) -> dict:
     if report:
         write_report(disc, folder / "report", dpi=70)
     print(text(disc), flush=True)
-    print(f"[{name}] {disc.seconds:.0f} s, {disc.base.model.problem.simulations} simulations", flush=True)
+    print(
+        f"[{name}] {disc.seconds:.0f} s, {disc.base.model.problem.simulations} simulations",
+        flush=True,
+    )
     return d
 
 
@@ -67,29 +70,55 @@ def ball_drops() -> None:
         cases = load("ball_drops", balls=[stem])
         runs = runs_from_cases(cases)
         disc = discover(runs, sim, settings=Settings(split="time", shortlist=10))
-        d = save(f"ball_drops/{stem}", disc, report=stem in ("whiffle_ball_1", "golf_ball", "blue_basketball"))
+        d = save(
+            f"ball_drops/{stem}",
+            disc,
+            report=stem in ("whiffle_ball_1", "golf_ball", "blue_basketball"),
+        )
         by = {c["effect"]: c for c in d["candidates"] if c["round"] == 1}
         mass = cases[0].notes["mass_kg"]
 
-        def per_mass(effect: str, key: str, by: dict = by, mass: float = mass) -> list[float] | None:
+        def per_mass(
+            effect: str, key: str, by: dict = by, mass: float = mass
+        ) -> list[float] | None:
             c = by.get(effect)
-            return None if c is None else [c["params"][key] / mass, c["stderr"].get(key, float("nan")) / mass]
+            return (
+                None
+                if c is None
+                else [c["params"][key] / mass, c["stderr"].get(key, float("nan")) / mass]
+            )
 
-        rows.append({
-            "ball": stem, "mass_kg": mass, "mass_assumed": cases[0].notes["mass_and_size_assumed"],
-            "causes": d["causes"], "gain": d["gain"], "alternatives": d["alternatives"],
-            "chosen": [{"effect": c["effect"], "params": c["params"], "stderr": c["stderr"]} for c in d["candidates"] if c["chosen"]],
-            "heldout": {"base": d["base"]["heldout_error"], "final": d["final"]["heldout_error"],
-                        **{e: c["heldout_error"] for e, c in by.items()}},
-            "gain_round1": {e: c["gain"] for e, c in by.items()},
-            # drag per unit mass: linear c/m (1/s), quadratic k = c/m (1/m); constant force fy/m (m/s²)
-            "linear_c_per_m": per_mass("linear_drag", "c"), "quadratic_k": per_mass("quadratic_drag", "c"),
-            "constant_accel": per_mass("constant_force", "fy"),
-        })
+        rows.append(
+            {
+                "ball": stem,
+                "mass_kg": mass,
+                "mass_assumed": cases[0].notes["mass_and_size_assumed"],
+                "causes": d["causes"],
+                "gain": d["gain"],
+                "alternatives": d["alternatives"],
+                "chosen": [
+                    {"effect": c["effect"], "params": c["params"], "stderr": c["stderr"]}
+                    for c in d["candidates"]
+                    if c["chosen"]
+                ],
+                "heldout": {
+                    "base": d["base"]["heldout_error"],
+                    "final": d["final"]["heldout_error"],
+                    **{e: c["heldout_error"] for e, c in by.items()},
+                },
+                "gain_round1": {e: c["gain"] for e, c in by.items()},
+                # drag per unit mass: linear c/m (1/s), quadratic k = c/m (1/m); constant force fy/m (m/s²)
+                "linear_c_per_m": per_mass("linear_drag", "c"),
+                "quadratic_k": per_mass("quadratic_drag", "c"),
+                "constant_accel": per_mass("constant_force", "fy"),
+            }
+        )
     (OUT / "ball_drops" / "summary.json").write_text(json.dumps(rows, indent=1) + "\n")
-    lines = ["| ball | mass (kg) | causes | gain | held-out base / linear / quadratic / constant force (m) "
-             "| linear c/m (1/s) | quadratic k = c/m (1/m) | constant force / m (m/s²) |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| ball | mass (kg) | causes | gain | held-out base / linear / quadratic / constant force (m) "
+        "| linear c/m (1/s) | quadratic k = c/m (1/m) | constant force / m (m/s²) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
 
     def pm(v: list[float] | None, fmt: str) -> str:
         return "-" if v is None else f"{v[0]:{fmt}} ± {v[1]:.1g}"
@@ -127,12 +156,18 @@ def ball_drops_check() -> None:
 
     laws = {"none": 0.0, "linear": 0.3, "quadratic": 0.02, "constant": 1.0}
 
-    def fit(t: np.ndarray, h: np.ndarray, law: str, k: float | None = None) -> tuple[float, float, float]:
+    def fit(
+        t: np.ndarray, h: np.ndarray, law: str, k: float | None = None
+    ) -> tuple[float, float, float]:
         if k is not None or law == "none":
             kk = 0.0 if k is None else k
             r = lsq(lambda p: height(t, p[0], p[1], law, kk) - h, [h[0], 0.0])
             return float(r.x[0]), float(r.x[1]), kk
-        r = lsq(lambda p: height(t, p[0], p[1], law, p[2]) - h, [h[0], 0.0, laws[law]], x_scale=[1.0, 1.0, laws[law]])
+        r = lsq(
+            lambda p: height(t, p[0], p[1], law, p[2]) - h,
+            [h[0], 0.0, laws[law]],
+            x_scale=[1.0, 1.0, laws[law]],
+        )
         return float(r.x[0]), float(r.x[1]), float(r.x[2])
 
     def rms(e: list[np.ndarray]) -> float:
@@ -140,13 +175,18 @@ def ball_drops_check() -> None:
 
     rows = []
     for stem in BALLS:
-        drops = [(c.recording.tracks["ball"].t, c.recording.tracks["ball"].y) for c in load("ball_drops", balls=[stem])]
+        drops = [
+            (c.recording.tracks["ball"].t, c.recording.tracks["ball"].y)
+            for c in load("ball_drops", balls=[stem])
+        ]
         row: dict = {"ball": stem, "time_split": {}, "run_split": {}, "k": {}}
         for law in laws:
             late, other, ks = [], [], []
             for i, (t, h) in enumerate(drops):
                 m = t <= 0.7 * t[-1]
-                late.append(height(t, *fit(t[m], h[m], law)[:2], law, fit(t[m], h[m], law)[2])[~m] - h[~m])
+                late.append(
+                    height(t, *fit(t[m], h[m], law)[:2], law, fit(t[m], h[m], law)[2])[~m] - h[~m]
+                )
                 ks.append(fit(t, h, law)[2])
                 to, ho = drops[1 - i]
                 k = fit(to, ho, law)[2]
@@ -158,19 +198,25 @@ def ball_drops_check() -> None:
         for t, h in drops:
             v, dec = [], []
             for i in range(0, len(t) - 15, 5):
-                p = np.polyfit(t[i:i + 15] - t[i + 7], h[i:i + 15], 2)
+                p = np.polyfit(t[i : i + 15] - t[i + 7], h[i : i + 15], 2)
                 v.append(-p[1])
                 dec.append(9.81 + 2 * p[0])
             v, dec = np.array(v), np.array(dec)
             ok = (v > 3) & (dec > 0)
-            ns.append(float(np.polyfit(np.log(v[ok]), np.log(dec[ok]), 1)[0]) if ok.sum() > 2 else math.nan)
+            ns.append(
+                float(np.polyfit(np.log(v[ok]), np.log(dec[ok]), 1)[0])
+                if ok.sum() > 2
+                else math.nan
+            )
         row["exponent"] = ns
         rows.append(row)
         print(stem, row, flush=True)
     (OUT / "ball_drops" / "direct_check.json").write_text(json.dumps(rows, indent=1) + "\n")
-    lines = ["| ball | held-out, last 30 % (m): base / linear / quadratic / constant | held-out, other drop (m): "
-             "base / linear / quadratic / constant | linear c/m (1/s) | quadratic k (1/m) | exponent n of the excess deceleration |",
-             "|---|---|---|---|---|---|"]
+    lines = [
+        "| ball | held-out, last 30 % (m): base / linear / quadratic / constant | held-out, other drop (m): "
+        "base / linear / quadratic / constant | linear c/m (1/s) | quadratic k (1/m) | exponent n of the excess deceleration |",
+        "|---|---|---|---|---|---|",
+    ]
     for r in rows:
         a, b = r["time_split"], r["run_split"]
         lines.append(
@@ -192,7 +238,9 @@ MIN_SEGMENT = 3.0  # s
 SETTLE = 1.0  # s
 
 
-def rolling_segments(shots=BILLIARD_SHOTS, count: int = SEGMENTS, max_speed: float | None = None) -> list[Run]:
+def rolling_segments(
+    shots=BILLIARD_SHOTS, count: int = SEGMENTS, max_speed: float | None = None
+) -> list[Run]:
     """Runs of one ball each: its track from SETTLE after its last contact with another ball (so
     that only rolling and cushions act) to the end of the shot, at least MIN_SEGMENT long;
     with ``max_speed``, from when the ball is first slower than that (m/s)."""
@@ -214,7 +262,12 @@ def rolling_segments(shots=BILLIARD_SHOTS, count: int = SEGMENTS, max_speed: flo
                 if close.any():
                     t_last = max(t_last, float(tr.t[np.nonzero(close)[0][-1]]))
                 if len(o) > 2:  # when a ball starts to move, something hit it
-                    t_last = max(t_last, float(o.t[0]) if o.t[0] > 0.05 else float(o.t[np.argmax(np.diff(o.t) <= 0.1)]))
+                    t_last = max(
+                        t_last,
+                        float(o.t[0])
+                        if o.t[0] > 0.05
+                        else float(o.t[np.argmax(np.diff(o.t) <= 0.1)]),
+                    )
             t0 = t_last + SETTLE
             if max_speed is not None:
                 sp = np.hypot(np.diff(tr.x), np.diff(tr.y)) / np.diff(tr.t)
@@ -238,12 +291,29 @@ def rolling_segments(shots=BILLIARD_SHOTS, count: int = SEGMENTS, max_speed: flo
             scene = replace(
                 case.scene,
                 name=f"billiards_{case.name}_{name}",
-                bodies=(Body("ball", Circle(BALL_RADIUS), (float(x[0]), float(y[0])), velocity=(float(vx), float(vy)),
-                             mass=0.21, elasticity=0.85, friction=0.0),),
-                statics=cushions(1.0), forces=(), frames=2, unknowns=(Unknown("ball", "elasticity", 0.4, 1.0),),
+                bodies=(
+                    Body(
+                        "ball",
+                        Circle(BALL_RADIUS),
+                        (float(x[0]), float(y[0])),
+                        velocity=(float(vx), float(vy)),
+                        mass=0.21,
+                        elasticity=0.85,
+                        friction=0.0,
+                    ),
+                ),
+                statics=cushions(1.0),
+                forces=(),
+                frames=2,
+                unknowns=(Unknown("ball", "elasticity", 0.4, 1.0),),
                 description=f"{case.name}: {name} after its last ball contact",
             )
-            run_rec = Recording({"ball": Track(t, x, y)}, run=f"{case.name}/{name}", fields=("x", "y"), source=rec.source)
+            run_rec = Recording(
+                {"ball": Track(t, x, y)},
+                run=f"{case.name}/{name}",
+                fields=("x", "y"),
+                source=rec.source,
+            )
             out.append(Run(f"{case.name}/{name}", scene, recording=run_rec, source=rec.source))
             if len(out) >= count:
                 return out
@@ -295,9 +365,17 @@ def billiards_cushions() -> None:
                     n, tg = axis, 1 - axis
                     if abs(vin[n]) < 0.05 or abs(vin[tg]) < 1e-3:
                         continue
-                    bounces.append({"run": run.name, "t": float(th), "vn_in": float(abs(vin[n])), "vt_in": float(vin[tg]),
-                                    "e_n": float(abs(vout[n]) / abs(vin[n])), "t_kept": float(vout[tg] / vin[tg]),
-                                    "speed_kept": float(np.hypot(*vout) / np.hypot(*vin))})
+                    bounces.append(
+                        {
+                            "run": run.name,
+                            "t": float(th),
+                            "vn_in": float(abs(vin[n])),
+                            "vt_in": float(vin[tg]),
+                            "e_n": float(abs(vout[n]) / abs(vin[n])),
+                            "t_kept": float(vout[tg] / vin[tg]),
+                            "speed_kept": float(np.hypot(*vout) / np.hypot(*vin)),
+                        }
+                    )
         # rolling deceleration on straight stretches at least 5 cm from every cushion, >= 1 s long
         away = (np.minimum(np.abs(p - np.array(lo)), np.abs(p - np.array(hi))) > 0.05).all(axis=1)
         idx = np.nonzero(away)[0]
@@ -306,29 +384,50 @@ def billiards_cushions() -> None:
                 continue
             path = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p[part], axis=0).T))])
             c2, c1, _ = np.polyfit(t[part] - t[part[0]], path, 2)
-            if c1 > 0.05 and c1 + 2 * c2 * (t[part[-1]] - t[part[0]]) > 0.02:  # still rolling at the end
-                stretches.append({"run": run.name, "deceleration": float(-2 * c2), "speed": float(c1),
-                                  "seconds": float(t[part[-1]] - t[part[0]])})
-    (OUT / "billiards" / "cushions.json").write_text(json.dumps({"bounces": bounces, "stretches": stretches}, indent=1) + "\n")
+            if (
+                c1 > 0.05 and c1 + 2 * c2 * (t[part[-1]] - t[part[0]]) > 0.02
+            ):  # still rolling at the end
+                stretches.append(
+                    {
+                        "run": run.name,
+                        "deceleration": float(-2 * c2),
+                        "speed": float(c1),
+                        "seconds": float(t[part[-1]] - t[part[0]]),
+                    }
+                )
+    (OUT / "billiards" / "cushions.json").write_text(
+        json.dumps({"bounces": bounces, "stretches": stretches}, indent=1) + "\n"
+    )
     vn = np.array([b["vn_in"] for b in bounces])
-    lines = [f"{len(bounces)} cushion bounces in {len({b['run'] for b in bounces})} rolling segments (all 182 shots)", "",
-             "| normal impact speed (m/s) | bounces | restitution e_n (median, IQR) | tangential speed kept | speed kept |",
-             "|---|---|---|---|---|"]
+    lines = [
+        f"{len(bounces)} cushion bounces in {len({b['run'] for b in bounces})} rolling segments (all 182 shots)",
+        "",
+        "| normal impact speed (m/s) | bounces | restitution e_n (median, IQR) | tangential speed kept | speed kept |",
+        "|---|---|---|---|---|",
+    ]
     for a, c in ((0.05, 0.3), (0.3, 0.6), (0.6, 1.0), (1.0, 3.0)):
         sel = [b for b, v in zip(bounces, vn, strict=True) if a <= v < c]
         if not sel:
             continue
-        q = {k: np.percentile([b[k] for b in sel], [25, 50, 75]) for k in ("e_n", "t_kept", "speed_kept")}
-        lines.append(f"| {a:.2f}-{c:.2f} | {len(sel)} | {q['e_n'][1]:.2f} ({q['e_n'][0]:.2f}-{q['e_n'][2]:.2f}) | "
-                     f"{q['t_kept'][1]:.2f} ({q['t_kept'][0]:.2f}-{q['t_kept'][2]:.2f}) | "
-                     f"{q['speed_kept'][1]:.2f} ({q['speed_kept'][0]:.2f}-{q['speed_kept'][2]:.2f}) |")
+        q = {
+            k: np.percentile([b[k] for b in sel], [25, 50, 75])
+            for k in ("e_n", "t_kept", "speed_kept")
+        }
+        lines.append(
+            f"| {a:.2f}-{c:.2f} | {len(sel)} | {q['e_n'][1]:.2f} ({q['e_n'][0]:.2f}-{q['e_n'][2]:.2f}) | "
+            f"{q['t_kept'][1]:.2f} ({q['t_kept'][0]:.2f}-{q['t_kept'][2]:.2f}) | "
+            f"{q['speed_kept'][1]:.2f} ({q['speed_kept'][0]:.2f}-{q['speed_kept'][2]:.2f}) |"
+        )
     e = np.array([b["e_n"] for b in bounces])
     slope = np.polyfit(vn, e, 1) if len(bounces) > 2 else [math.nan, math.nan]
     lines += ["", f"least-squares line: e_n = {slope[1]:.3f} {slope[0]:+.3f} · v_n (m/s)"]
     dec = np.array([x["deceleration"] for x in stretches])
     q = np.percentile(dec, [25, 50, 75])
-    lines += ["", f"rolling deceleration on {len(stretches)} straight stretches (>= 1 s, >= 5 cm from the cushions): "
-              f"median {q[1]:.4f} m/s² (IQR {q[0]:.4f}-{q[2]:.4f}), mu = {q[1] / 9.81:.5f}"]
+    lines += [
+        "",
+        f"rolling deceleration on {len(stretches)} straight stretches (>= 1 s, >= 5 cm from the cushions): "
+        f"median {q[1]:.4f} m/s² (IQR {q[0]:.4f}-{q[2]:.4f}), mu = {q[1] / 9.81:.5f}",
+    ]
     (OUT / "billiards" / "cushions.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
@@ -350,7 +449,9 @@ def pendulum_kaheman() -> None:
     runs = []
     for c in cases:
         arm = c.scene.bodies[0]
-        scene = replace(c.scene, unknowns=(Unknown("arm1", "moment", 0.5 * arm.inertia(), 1.5 * arm.inertia()),))
+        scene = replace(
+            c.scene, unknowns=(Unknown("arm1", "moment", 0.5 * arm.inertia(), 1.5 * arm.inertia()),)
+        )
         runs.append(Run(c.name, scene, recording=c.recording, source=c.recording.source))
     sim = create("simulator", "pymunk")
     disc = discover(runs, sim, settings=Settings(split="runs", holdout=0.25, shortlist=10))
@@ -364,7 +465,9 @@ def pendulum_benard() -> None:
     runs = []
     for c in cases:  # the rod's inertia is uncertain (the author added 0.08 kg to match the period)
         rod = c.scene.bodies[0]
-        scene = replace(c.scene, unknowns=(Unknown("rod", "moment", 0.5 * rod.inertia(), 4.0 * rod.inertia()),))
+        scene = replace(
+            c.scene, unknowns=(Unknown("rod", "moment", 0.5 * rod.inertia(), 4.0 * rod.inertia()),)
+        )
         runs.append(Run(c.name, scene, recording=c.recording, source=c.recording.source))
     sim = create("simulator", "pymunk")
     disc = discover(runs, sim, settings=Settings(split="runs", holdout=0.34, shortlist=10))
@@ -387,15 +490,33 @@ def pendulum_peaks() -> None:
     for n in (1, 2, 3):
         deg, _ = read_benard(n)
         a = np.deg2rad(deg)
-        records[f"pendulum_benard/free_swing_{n:02d}"] = (a[first_extreme(a):], 150)
+        records[f"pendulum_benard/free_swing_{n:02d}"] = (a[first_extreme(a) :], 150)
     k = read_kaheman(1)
     records["pendulum_kaheman/single"] = (k[:, 3] - np.median(k[:, 3]), 30)
-    fits = {"coulomb": [0], "viscous": [1], "viscous + coulomb": [0, 1], "viscous + quadratic": [1, 2]}
-    out, lines = {}, ["| record | half swings | amplitude (rad) | " + " | ".join(f"{f}: rms of dA (rad)" for f in fits)
-                      + " | viscous + coulomb: b (rad), a |", "|---|---|---|" + "---|" * len(fits) + "---|"]
+    fits = {
+        "coulomb": [0],
+        "viscous": [1],
+        "viscous + coulomb": [0, 1],
+        "viscous + quadratic": [1, 2],
+    }
+    out, lines = (
+        {},
+        [
+            "| record | half swings | amplitude (rad) | "
+            + " | ".join(f"{f}: rms of dA (rad)" for f in fits)
+            + " | viscous + coulomb: b (rad), a |",
+            "|---|---|---|" + "---|" * len(fits) + "---|",
+        ],
+    )
     for name, (x, distance) in records.items():
-        pk = np.sort(np.concatenate([find_peaks(x, distance=distance, prominence=0.02)[0],
-                                     find_peaks(-x, distance=distance, prominence=0.02)[0]]))
+        pk = np.sort(
+            np.concatenate(
+                [
+                    find_peaks(x, distance=distance, prominence=0.02)[0],
+                    find_peaks(-x, distance=distance, prominence=0.02)[0],
+                ]
+            )
+        )
         ext = x[pk]
         amp = 0.5 * np.abs(np.diff(ext))  # half the peak-to-peak: free of the rest-angle offset
         d_a, a_m = amp[:-1] - amp[1:], 0.5 * (amp[:-1] + amp[1:])
@@ -403,11 +524,17 @@ def pendulum_peaks() -> None:
         res = {}
         for f, cols in fits.items():
             coef = np.linalg.lstsq(m[:, cols], d_a, rcond=None)[0]
-            res[f] = {"coef": coef.tolist(), "rms": float(np.sqrt(np.mean((d_a - m[:, cols] @ coef) ** 2)))}
+            res[f] = {
+                "coef": coef.tolist(),
+                "rms": float(np.sqrt(np.mean((d_a - m[:, cols] @ coef) ** 2))),
+            }
         out[name] = {"amplitudes": amp.tolist(), "fits": res}
         b, a = res["viscous + coulomb"]["coef"]
-        lines.append(f"| {name} | {amp.size} | {amp[0]:.2f} to {amp[-1]:.2f} | "
-                     + " | ".join(f"{res[f]['rms']:.4f}" for f in fits) + f" | {b:.4f}, {a:.4f} |")
+        lines.append(
+            f"| {name} | {amp.size} | {amp[0]:.2f} to {amp[-1]:.2f} | "
+            + " | ".join(f"{res[f]['rms']:.4f}" for f in fits)
+            + f" | {b:.4f}, {a:.4f} |"
+        )
     (OUT / "pendulum_peaks.json").write_text(json.dumps(out, indent=1) + "\n")
     (OUT / "pendulum_peaks.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
@@ -418,30 +545,50 @@ def hidden_table() -> None:
     the hidden-effect tests write with
     ``PHYSBENCH_DISCOVERY_SEEDS=0,1,2 PHYSBENCH_DISCOVERY_LOG=results/discover/hidden_effects.jsonl
     pytest tests/test_discover_hidden.py``."""
-    rows = [json.loads(line) for line in (OUT / "hidden_effects.jsonl").read_text().splitlines() if line.strip()]
+    rows = [
+        json.loads(line)
+        for line in (OUT / "hidden_effects.jsonl").read_text().splitlines()
+        if line.strip()
+    ]
     by: dict[str, list[dict]] = {}
     for r in rows:
         by.setdefault(r["effect"] or "", []).append(r)
-    lines = ["| effect | cases (seeds × scenes × engines) | named first | worst magnitude error (case) | median error | lowest gain |",
-             "|---|---|---|---|---|---|"]
+    lines = [
+        "| effect | cases (seeds × scenes × engines) | named first | worst magnitude error (case) | median error | lowest gain |",
+        "|---|---|---|---|---|---|",
+    ]
     for effect, rs in by.items():
         if not effect:
             continue
         ok = [r for r in rs if r["error"] is not None]
         worst = max(ok, key=lambda r: r["error"])
         errs = sorted(r["error"] for r in ok)
-        lines.append(f"| {effect} | {len(rs)} | {len(ok)}/{len(rs)} | {worst['error']:.1%} ({worst['scene']}, {worst['engine']}, "
-                     f"seed {worst['seed']}) | {errs[len(errs) // 2]:.1%} | {min(r['gain'] for r in rs):.0%} |")
+        lines.append(
+            f"| {effect} | {len(rs)} | {len(ok)}/{len(rs)} | {worst['error']:.1%} ({worst['scene']}, {worst['engine']}, "
+            f"seed {worst['seed']}) | {errs[len(errs) // 2]:.1%} | {min(r['gain'] for r in rs):.0%} |"
+        )
     controls = by.get("", [])
     alarms = [r for r in controls if r["causes"]]
-    lines += ["", f"Controls: {len(controls)} ({len({r['scene'] for r in controls})} scenes × 2 engines × "
-              f"{len({r['seed'] for r in controls})} seeds), false alarms: {len(alarms)}."]
+    lines += [
+        "",
+        f"Controls: {len(controls)} ({len({r['scene'] for r in controls})} scenes × 2 engines × "
+        f"{len({r['seed'] for r in controls})} seeds), false alarms: {len(alarms)}.",
+    ]
     (OUT / "hidden_effects.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 
 if __name__ == "__main__":
     t0 = time.perf_counter()
-    for name in sys.argv[1:] or ["ball_drops", "ball_drops_check", "billiards", "billiards_slow", "billiards_cushions", "pendulum_kaheman", "pendulum_benard", "pendulum_peaks"]:
+    for name in sys.argv[1:] or [
+        "ball_drops",
+        "ball_drops_check",
+        "billiards",
+        "billiards_slow",
+        "billiards_cushions",
+        "pendulum_kaheman",
+        "pendulum_benard",
+        "pendulum_peaks",
+    ]:
         globals()[name]()
     print(f"done in {time.perf_counter() - t0:.0f} s")

@@ -80,7 +80,11 @@ class PairMaker:
             except SimulationError:
                 continue
             sims.append((p, {b: self.renderer.render(scene, traj, focus=b) for b in space.bodies}))
-        observed = [self._blurred(frames, rng) for _, frames in sims] if spec.blur_max > 0 else [f for _, f in sims]
+        observed = (
+            [self._blurred(frames, rng) for _, frames in sims]
+            if spec.blur_max > 0
+            else [f for _, f in sims]
+        )
         xs, ys = [], []
         for body in space.bodies:
             sub = space.subset(body)
@@ -88,11 +92,15 @@ class PairMaker:
             for i, (pi, _) in enumerate(sims):
                 for j, (pj, fj) in enumerate(sims):
                     if i != j:
-                        xs.append(make_input(observed[i][body], fj[body], spec.frames, spec.resolution))
+                        xs.append(
+                            make_input(observed[i][body], fj[body], spec.frames, spec.resolution)
+                        )
                         ys.append((sub.to_vector(pi) - sub.to_vector(pj)) / scale)
         return np.stack(xs), np.asarray(ys, dtype=np.float32)
 
-    def _blurred(self, frames: dict[str, np.ndarray], rng: np.random.Generator) -> dict[str, np.ndarray]:
+    def _blurred(
+        self, frames: dict[str, np.ndarray], rng: np.random.Generator
+    ) -> dict[str, np.ndarray]:
         """One simulation's marked views as a blurry camera might see them (one sigma for all)."""
         from physbench.render.observe import gaussian_blur
 
@@ -109,7 +117,9 @@ def validation_set(spec: DataSpec, groups: int) -> tuple[np.ndarray, np.ndarray]
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
-def stream(spec: DataSpec, start_group: int, worker: int = 0, workers: int = 1, buffer: int = 256) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+def stream(
+    spec: DataSpec, start_group: int, worker: int = 0, workers: int = 1, buffer: int = 256
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Endless shuffled samples from training groups ``start_group + worker + k·workers``."""
     maker = PairMaker(spec)
     rng = np.random.default_rng([start_group, worker])

@@ -27,7 +27,9 @@ class ResNet3DEstimator:
     name: ClassVar[str] = "resnet3d"
     per_object: ClassVar[bool] = True
 
-    def __init__(self, weights: str | None = None, threads: int = 1, symmetric: bool = False) -> None:
+    def __init__(
+        self, weights: str | None = None, threads: int = 1, symmetric: bool = False
+    ) -> None:
         self.weights_path, self.threads, self.symmetric = weights, threads, symmetric
 
     def start(self, task: Task, *, seed: int) -> None:
@@ -72,7 +74,9 @@ class ResNet3DEstimator:
                     "give marked_<body> arrays in the observation file"
                 )
             by_key = {u.key: u for u in sub.unknowns}
-            self.targets.append((body, keys, np.array([by_key[k].high - by_key[k].low for k in keys])))
+            self.targets.append(
+                (body, keys, np.array([by_key[k].high - by_key[k].low for k in keys]))
+            )
 
     def propose(self, step: Step) -> Params:
         import torch
@@ -81,14 +85,25 @@ class ResNet3DEstimator:
 
         marked = getattr(step, "marked", None)
         if not marked:
-            raise PhysbenchError("resnet3d corrects one marked object at a time: the loop must pass marked frames")
-        x = np.stack([
-            make_input(self.observed[body], marked[body], self.cfg.frames, self.cfg.resolution)
-            for body, _, _ in self.targets
-        ])
+            raise PhysbenchError(
+                "resnet3d corrects one marked object at a time: the loop must pass marked frames"
+            )
+        x = np.stack(
+            [
+                make_input(self.observed[body], marked[body], self.cfg.frames, self.cfg.resolution)
+                for body, _, _ in self.targets
+            ]
+        )
         if self.symmetric:
             # Swapped order predicts -Δp; averaging both halves the variance of independent errors.
-            x = np.concatenate([x, np.concatenate([x[:, :, self.cfg.frames :], x[:, :, : self.cfg.frames]], axis=2)])
+            x = np.concatenate(
+                [
+                    x,
+                    np.concatenate(
+                        [x[:, :, self.cfg.frames :], x[:, :, : self.cfg.frames]], axis=2
+                    ),
+                ]
+            )
         with torch.no_grad():
             delta = self.net(torch.from_numpy(x)).numpy().astype(float)
         if self.symmetric:

@@ -44,7 +44,18 @@ def evaluate_weights(
         space = ParamSpace.from_scene(scene, spec.params, bodies)
         truth, initial = draw_problem(space, seed)
         obs = simulate_observation(scene, truth, sim, observer, marked=space.bodies)
-        hist = refine(obs, scene, space, sim, model, ResNet3DEstimator(weights=str(path)),
-                      iterations=iterations, seed=seed, initial=initial)
-        rows.append({r.iteration + 1: float(r.best_nmse) for r in hist.records if r.best_nmse is not None})
+        hist = refine(
+            obs,
+            scene,
+            space,
+            sim,
+            model,
+            ResNet3DEstimator(weights=str(path)),
+            iterations=iterations,
+            seed=seed,
+            initial=initial,
+        )
+        rows.append(
+            {r.iteration + 1: float(r.best_nmse) for r in hist.records if r.best_nmse is not None}
+        )
     return rows

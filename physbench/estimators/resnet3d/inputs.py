@@ -32,7 +32,9 @@ def resize(frames: np.ndarray, size: int) -> np.ndarray:
     return zoom(frames, z, order=1)
 
 
-def make_input(observed: np.ndarray, simulated: np.ndarray, frames: int, resolution: int) -> np.ndarray:
+def make_input(
+    observed: np.ndarray, simulated: np.ndarray, frames: int, resolution: int
+) -> np.ndarray:
     """One sample ``(C, 2·frames, R, R')`` float32 from two ``(T, C, H, W)`` marked sequences."""
     idx = time_indices(observed.shape[0], frames)
     both = np.concatenate([observed[idx], simulated[idx]], axis=0)  # (2F, C, H, W)

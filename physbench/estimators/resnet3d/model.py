@@ -56,7 +56,9 @@ def build_net(cfg: NetConfig) -> Any:
             # Average before subsampling the shortcut: a strided 1x1 conv would drop 7 of 8 voxels,
             # and objects here are a few pixels wide, so the shortcut would lose them entirely.
             if stride != 1:
-                self.skip: nn.Module = nn.Sequential(nn.AvgPool3d(stride, stride, ceil_mode=True), nn.Conv3d(cin, cout, 1))
+                self.skip: nn.Module = nn.Sequential(
+                    nn.AvgPool3d(stride, stride, ceil_mode=True), nn.Conv3d(cin, cout, 1)
+                )
             elif cin != cout:
                 self.skip = nn.Conv3d(cin, cout, 1)
             else:
@@ -71,7 +73,10 @@ def build_net(cfg: NetConfig) -> Any:
         def __init__(self) -> None:
             super().__init__()
             w = cfg.widths
-            self.stem = nn.Sequential(nn.Conv3d(cfg.in_channels, w[0], (3, 5, 5), (1, 2, 2), (1, 2, 2)), nn.ReLU(inplace=True))
+            self.stem = nn.Sequential(
+                nn.Conv3d(cfg.in_channels, w[0], (3, 5, 5), (1, 2, 2), (1, 2, 2)),
+                nn.ReLU(inplace=True),
+            )
             layers: list[nn.Module] = []
             cin = w[0]
             for i, (cout, n) in enumerate(zip(w, cfg.blocks, strict=True)):

@@ -29,7 +29,9 @@ class TrainConfig:
     threads: int = 0  # torch threads; 0 = torch's default
     seed: int = 0
     device: str = "cpu"  # "cuda" trains on a GPU; the weights are the same either way
-    minutes: float = 0.0  # wall-clock budget (0 = none); training stops at whichever budget ends first
+    minutes: float = (
+        0.0  # wall-clock budget (0 = none); training stops at whichever budget ends first
+    )
     init: str = ""  # start from these weights (fine-tuning) instead of a fresh network
 
 
@@ -144,20 +146,34 @@ def train(
     if cfg.init and not (resume and ckpt.is_file()):
         state, meta = weights.load(cfg.init)
         if NetConfig.from_dict(meta["net"]) != net_cfg:
-            raise PhysbenchError(f"--init {cfg.init!r} has architecture {meta['net']}, expected {net_cfg.to_dict()}")
+            raise PhysbenchError(
+                f"--init {cfg.init!r} has architecture {meta['net']}, expected {net_cfg.to_dict()}"
+            )
         net.load_state_dict({k: v.float() for k, v in state.items()})
     if resume and ckpt.is_file():
         tensors, meta = weights.load(ckpt)
         net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
-        _load_optimizer(opt, {k: v for k, v in tensors.items() if k.startswith("opt.")}, meta["optimizer"])
-        seen, best, history, wall0 = meta["samples"], meta["best_val"], meta["history"], meta["wall_s"]
+        _load_optimizer(
+            opt, {k: v for k, v in tensors.items() if k.startswith("opt.")}, meta["optimizer"]
+        )
+        seen, best, history, wall0 = (
+            meta["samples"],
+            meta["best_val"],
+            meta["history"],
+            meta["wall_s"],
+        )
     vx, vy = validation_set(spec, cfg.val_groups)
     loader = torch.utils.data.DataLoader(
-        _pairs_dataset(spec, seen), batch_size=cfg.batch, num_workers=cfg.workers,
-        persistent_workers=cfg.workers > 0, prefetch_factor=4 if cfg.workers else None,
+        _pairs_dataset(spec, seen),
+        batch_size=cfg.batch,
+        num_workers=cfg.workers,
+        persistent_workers=cfg.workers > 0,
+        prefetch_factor=4 if cfg.workers else None,
         pin_memory=device.type == "cuda",
     )
-    bar = tqdm(total=cfg.samples, initial=seen, disable=not progress, unit="sample", dynamic_ncols=True)
+    bar = tqdm(
+        total=cfg.samples, initial=seen, disable=not progress, unit="sample", dynamic_ncols=True
+    )
     t0, ema, next_eval = time.perf_counter(), None, seen + cfg.eval_every
     net.train()
     it = iter(loader)
@@ -176,20 +192,38 @@ def train(
         value = loss.item()
         ema = value if ema is None else 0.98 * ema + 0.02 * value
         bar.update(len(x))
-        if seen >= next_eval or progress_fraction(cfg, seen, wall0 + time.perf_counter() - t0) >= 1.0:
+        if (
+            seen >= next_eval
+            or progress_fraction(cfg, seen, wall0 + time.perf_counter() - t0) >= 1.0
+        ):
             next_eval += cfg.eval_every
             val = evaluate_net(net, vx, vy)
             wall = wall0 + time.perf_counter() - t0
-            history.append({"samples": seen, "train_loss": ema, "val_mse": val, "wall_s": round(wall, 1)})
+            history.append(
+                {"samples": seen, "train_loss": ema, "val_mse": val, "wall_s": round(wall, 1)}
+            )
             if val < best:
                 best = val
-                weights.save(out / "best.safetensors", dict(net.state_dict()), {"samples": seen, "val_mse": val})
+                weights.save(
+                    out / "best.safetensors",
+                    dict(net.state_dict()),
+                    {"samples": seen, "val_mse": val},
+                )
             tensors, groups = _optimizer_tensors(opt)
-            weights.save(ckpt, {**{f"net.{k}": v for k, v in net.state_dict().items()}, **tensors}, {
-                "samples": seen, "best_val": best, "history": history, "wall_s": wall,
-                "optimizer": groups,
-            })
-        bar.set_postfix(loss=f"{ema:.4f}", val=f"{best:.4f}", rate=f"{bar.format_dict.get('rate') or 0:.0f}/s")
+            weights.save(
+                ckpt,
+                {**{f"net.{k}": v for k, v in net.state_dict().items()}, **tensors},
+                {
+                    "samples": seen,
+                    "best_val": best,
+                    "history": history,
+                    "wall_s": wall,
+                    "optimizer": groups,
+                },
+            )
+        bar.set_postfix(
+            loss=f"{ema:.4f}", val=f"{best:.4f}", rate=f"{bar.format_dict.get('rate') or 0:.0f}/s"
+        )
     bar.close()
     best_state, _ = weights.load(out / "best.safetensors")
     meta = {
@@ -197,13 +231,19 @@ def train(
         "net": net_cfg.to_dict(),
         "ranges": _ranges(spec),
         "normalization": "target = (p_observed - p_simulated) / (high - low), per parameter of the marked body",
-        "training": {**asdict(cfg), "samples_seen": seen, "wall_s": round(history[-1]["wall_s"], 1) if history else 0.0},
+        "training": {
+            **asdict(cfg),
+            "samples_seen": seen,
+            "wall_s": round(history[-1]["wall_s"], 1) if history else 0.0,
+        },
         "val_mse": best,
         "history": history,
         "physbench_version": physbench.__version__,
         "torch_version": torch.__version__,
     }
     # Shipped weights are int8 per output channel (a quarter of the size; loading dequantises).
-    final = weights.save(out / weights_name(spec), weights.quantize(best_state), {**meta, "storage": weights.INT8})
+    final = weights.save(
+        out / weights_name(spec), weights.quantize(best_state), {**meta, "storage": weights.INT8}
+    )
     (out / "train_log.json").write_text(json.dumps(history, indent=1))
     return final, meta

@@ -33,11 +33,17 @@ class ScipyMinimize:
 
     def __init__(self, method: str = "nelder-mead", step: float = 0.2, xatol: float = 1e-3) -> None:
         if method not in METHODS:
-            raise PhysbenchError(f"scipy: method = {method!r}: expected one of {', '.join(METHODS)}")
+            raise PhysbenchError(
+                f"scipy: method = {method!r}: expected one of {', '.join(METHODS)}"
+            )
         for key, value, hi in (("step", step, 1.0), ("xatol", xatol, 1.0)):
             if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= hi:
                 raise PhysbenchError(f"scipy: {key} = {value!r}: expected a number in (0, {hi:g}]")
-        self.options: dict[str, Any] = {"method": method, "step": float(step), "xatol": float(xatol)}
+        self.options: dict[str, Any] = {
+            "method": method,
+            "step": float(step),
+            "xatol": float(xatol),
+        }
         self.space: ParamSpace | None = None
 
     def start(self, task: Task, *, seed: int) -> None:
@@ -80,10 +86,18 @@ class ScipyMinimize:
             simplex = np.vstack([self._x0, self._x0 + np.diag(sign * self.options["step"])])
             kwargs: dict[str, Any] = {
                 "method": "Nelder-Mead",
-                "options": {"initial_simplex": simplex, "xatol": self.options["xatol"], "fatol": 0.0, "maxfev": 10**9},
+                "options": {
+                    "initial_simplex": simplex,
+                    "xatol": self.options["xatol"],
+                    "fatol": 0.0,
+                    "maxfev": 10**9,
+                },
             }
         else:
-            kwargs = {"method": "Powell", "options": {"xtol": self.options["xatol"], "ftol": 1e-12, "maxfev": 10**9}}
+            kwargs = {
+                "method": "Powell",
+                "options": {"xtol": self.options["xatol"], "ftol": 1e-12, "maxfev": 10**9},
+            }
         try:
             minimize(self._objective, self._x0, bounds=bounds, **kwargs)
         except _Unseen as need:

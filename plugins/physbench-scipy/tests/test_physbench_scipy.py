@@ -18,7 +18,11 @@ from physbench.testing import EstimatorConformance, run_toy
 class TestNelderMeadConformance(EstimatorConformance):
     estimator = ScipyMinimize
     options: ClassVar[Mapping[str, Any]] = {"method": "nelder-mead"}
-    bad_options: ClassVar[Sequence[Mapping[str, Any]]] = [{"method": "bfgs"}, {"step": 0.0}, {"xatol": -1}]
+    bad_options: ClassVar[Sequence[Mapping[str, Any]]] = [
+        {"method": "bfgs"},
+        {"step": 0.0},
+        {"xatol": -1},
+    ]
 
 
 class TestPowellConformance(EstimatorConformance):
@@ -34,7 +38,12 @@ def test_found_through_the_entry_point() -> None:
 
 @pytest.mark.parametrize("method", ["nelder-mead", "powell"])
 def test_improves_on_the_initial_guess(method: str) -> None:
-    runs = [run_toy(ScipyMinimize, {"method": method}, iterations=30, params=("mass", "elasticity"), seed=s) for s in range(6)]
+    runs = [
+        run_toy(
+            ScipyMinimize, {"method": method}, iterations=30, params=("mass", "elasticity"), seed=s
+        )
+        for s in range(6)
+    ]
     assert all(h.min_loss < h.records[0].loss for h in runs)
     assert np.mean([h.min_nmse for h in runs]) < 0.5 * np.mean([h.initial_nmse for h in runs])
 
@@ -46,7 +55,18 @@ def test_restarts_after_converging() -> None:
 
 
 def test_physbench_run_uses_it(capsys: pytest.CaptureFixture[str]) -> None:
-    argv = ["run", "--estimator", "scipy", "-o", "method=powell", "--iterations", "6", "--resolution", "32", "-q"]
+    argv = [
+        "run",
+        "--estimator",
+        "scipy",
+        "-o",
+        "method=powell",
+        "--iterations",
+        "6",
+        "--resolution",
+        "32",
+        "-q",
+    ]
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "normalized min MSE after 6 iterations" in out
