@@ -9,7 +9,7 @@ scene is simulated in both engines, and the two trajectories are compared:
 
     python benchmarks/engine_divergence.py [--seeds 10] [--scenes three_circles,...]
 
-Prints a table (the numbers in docs/engines.md come from it). ``tests/test_simulators.py`` imports
+Prints a table (the numbers in docs/engines.md come from it). ``tests/simulators/test_simulators.py`` imports
 :func:`compare` and :func:`outcome` for its paper-scene test.
 """
 

@@ -133,7 +133,7 @@ def test_cli_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_shipped_specs_load() -> None:
-    root = Path(__file__).parent.parent / "benchmarks"
+    root = Path(__file__).resolve().parents[2] / "benchmarks"
     t1 = load_spec(root / "table1.toml")
     assert t1.seeds == tuple(range(50)) and t1.axes["iterations"] == (11,)
     assert {e.name for e in t1.estimators} >= {"tpe", "cmaes", "optuna", "random", "resnet3d"}

@@ -18,7 +18,7 @@ import pytest
 
 from physbench.bench.tables import PAPER, ratio_ci
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "results" / "resnet3d"
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-RESULTS = Path(__file__).resolve().parents[1] / "results" / "discover"
+RESULTS = Path(__file__).resolve().parents[2] / "results" / "discover"
 DATASETS = ["billiards", "billiards_slow", "pendulum_kaheman", "pendulum_benard"]
 WHIFFLE = ["whiffle_ball_1", "whiffle_ball_2", "yellow_whiffle_ball", "orange_whiffle_ball"]
 DENSE = ["golf_ball", "baseball", "bowling_ball"]

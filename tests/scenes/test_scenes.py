@@ -12,7 +12,7 @@ with true parameters drawn from the scene's ranges (``ParamSpace.sample``), in b
    64 x 64 raster renderer, default ``"mark"`` mode, focus on the changed body. A prototype bin gave
    0-4 for an unidentifiable mass and 30-400 for identifiable ones; 20 lies between.
 
-Run ``python tests/test_scenes.py`` to print the measured minima for docs/scenes.md.
+Run ``python tests/scenes/test_scenes.py`` to print the measured minima for docs/scenes.md.
 """
 
 from __future__ import annotations

@@ -552,7 +552,7 @@ def test_params_are_applied(sim: SteppingSimulator) -> None:
 def _divergence_module() -> ModuleType:
     if "engine_divergence" in sys.modules:
         return sys.modules["engine_divergence"]
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "engine_divergence.py"
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "engine_divergence.py"
     spec = importlib.util.spec_from_file_location("engine_divergence", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

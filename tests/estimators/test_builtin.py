@@ -73,7 +73,7 @@ def test_same_seed_same_history_in_a_fresh_process() -> None:
     ours = _three_circles("tpe", 4, ["mass", "elasticity"]).to_dict(timings=False)
     code = (
         "import json, sys; sys.path[:0] = [sys.argv[1]]\n"
-        "from test_estimators import _three_circles\n"
+        "from test_builtin import _three_circles\n"
         "print(json.dumps(_three_circles('tpe', 4, ['mass', 'elasticity']).to_dict(timings=False)))"
     )
     env = {**os.environ, "PYTHONHASHSEED": "99"}
