@@ -1,44 +1,54 @@
-"""One case of the correction loop, fully described by data: what ``physbench run`` executes once
+"""One run of the correction loop, fully described by data: what ``physbench run`` executes once
 and what the benchmark runner executes for every cell of a sweep.
 
-A :class:`Case` names everything that determines the result (scene, unknowns, estimator and its
-options, seed, iteration budget, model and observation engines, observation blur and noise,
-resolution, render mode), so the same case gives the same :class:`~physbench.loop.History` in any
-process. The observation is simulated from the seed (random truth, random initial guess) unless
-``observation`` names a frames file.
+A :class:`RunConfig` names everything that determines the result (scene, unknowns, estimator and
+its options, seed, iteration budget, model and observation engines, renderer and its options,
+observation blur and noise, resolution, channel layout), so the same configuration gives the same
+:class:`~physbench.loop.History` in any process. The observation is simulated from the seed (random
+truth, random initial guess) unless ``observation`` names a frames file.
 """
 
 from __future__ import annotations
 
 import inspect
 from collections.abc import Callable, Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from physbench.errors import PhysbenchError
+from physbench.errors import PhysbenchError, UnknownNameError
+from physbench.estimators.base import DEFAULT_ESTIMATOR
+from physbench.render.base import DEFAULT_RENDERER
+from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
-    from physbench.loop import History, Record
+    from physbench.estimators.base import CorrectionEstimator
+    from physbench.loop import History, Iteration
     from physbench.observation import Observation
     from physbench.params import ParamSpace
+    from physbench.render.base import Renderer
     from physbench.scene import Scene
 
 
 @dataclass(frozen=True)
-class Case:
+class RunConfig:
     """Settings of one run. ``params``: unknown parameter names (``("mass", "elasticity")``);
     ``bodies``: restrict them to these bodies (``None``: every body that has them);
-    ``observe_engine``: the engine that makes the observation (``None``: ``engine``)."""
+    ``observe_engine``: the engine that makes the observation (``None``: ``engine``);
+    ``renderer`` and ``renderer_options``: the renderer of the model and of the observation,
+    built with ``resolution`` and ``render_mode`` besides its options; ``blur`` and ``noise``:
+    the observation model applied to the observed frames only."""
 
     scene: str = "three_circles"
     params: tuple[str, ...] = ("mass",)
-    estimator: str = "tpe"
+    estimator: str = DEFAULT_ESTIMATOR
     options: Mapping[str, Any] = field(default_factory=dict)
     seed: int = 0
     iterations: int = 11
-    engine: str = "pymunk"
+    engine: str = DEFAULT_SIMULATOR
     observe_engine: str | None = None
+    renderer: str = DEFAULT_RENDERER
+    renderer_options: Mapping[str, Any] = field(default_factory=dict)
     blur: float = 0.0
     noise: float = 0.0
     resolution: int = 64
@@ -52,22 +62,39 @@ class Case:
         d["params"] = list(self.params)
         d["bodies"] = None if self.bodies is None else list(self.bodies)
         d["options"] = dict(self.options)
+        d["renderer_options"] = dict(self.renderer_options)
         return d
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> Case:
-        d = dict(d)
-        d["params"] = tuple(d.get("params", ("mass",)))
-        if d.get("bodies") is not None:
-            d["bodies"] = tuple(d["bodies"])
-        return cls(**d)
+    def from_dict(cls, d: Mapping[str, Any]) -> RunConfig:
+        """Settings from :meth:`to_dict`; keys written by older versions that lack a setting
+        (e.g. ``renderer``) take its default."""
+        known = {f.name for f in fields(cls)}
+        extra = sorted(set(d) - known)
+        if extra:
+            raise PhysbenchError(f"run settings: unknown keys {extra}; known: {sorted(known)}")
+        kw = dict(d)
+        kw["params"] = tuple(kw.get("params", ("mass",)))
+        if kw.get("bodies") is not None:
+            kw["bodies"] = tuple(kw["bodies"])
+        return cls(**kw)
 
     @property
     def observer_engine(self) -> str:
         return self.observe_engine or self.engine
 
 
-def make_estimator(name: str, options: Mapping[str, Any]) -> Any:
+def _accepted(cls: type) -> str:
+    try:
+        names = [
+            q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")
+        ]
+    except (TypeError, ValueError):
+        names = []
+    return ", ".join(names) or "none"
+
+
+def make_estimator(name: str, options: Mapping[str, Any]) -> CorrectionEstimator:
     """Instantiate the registered estimator ``name``; options it does not take are refused with
     the list of those it does."""
     from physbench.plugins import get_registry
@@ -76,70 +103,121 @@ def make_estimator(name: str, options: Mapping[str, Any]) -> Any:
     try:
         return cls(**dict(options))
     except TypeError as exc:
-        try:
-            accepted = [
-                q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")
-            ]
-        except (TypeError, ValueError):
-            accepted = []
         raise PhysbenchError(
-            f"estimator {name!r} does not take options {dict(options)}: {exc}; its options: {', '.join(accepted) or 'none'}"
+            f"estimator {name!r} does not take options {dict(options)}: {exc}; "
+            f"its options: {_accepted(cls)}"
         ) from None
 
 
-def case_space(case: Case, scene: Scene | None = None) -> ParamSpace:
-    """The unknowns of ``case`` on its scene instance (``scene`` saves regenerating it)."""
+def make_renderer(
+    name: str, options: Mapping[str, Any], *, resolution: int | tuple[int, int], mode: str
+) -> Renderer:
+    """Instantiate the registered renderer ``name`` with its ``options`` and the standard
+    ``resolution`` and ``mode``; options it does not take are refused with the list of those it
+    does."""
+    from physbench.plugins import get_registry
+
+    cls = get_registry().get("renderer", name)
+    clash = sorted({"resolution", "mode"} & set(options))
+    if clash:
+        raise PhysbenchError(
+            f"renderer option {clash[0]!r}: set it with --resolution / --render-mode (in a sweep "
+            "spec: the resolution and render_mode axes), not as a renderer option"
+        )
+    try:
+        return cls(resolution=resolution, mode=mode, **dict(options))
+    except TypeError as exc:
+        raise PhysbenchError(
+            f"renderer {name!r} does not take options {dict(options)}: {exc}; "
+            f"its options: {_accepted(cls)}"
+        ) from None
+
+
+def _check_observation(config: RunConfig) -> None:
+    if config.observation and (config.observe_engine or config.blur or config.noise):
+        raise PhysbenchError(
+            "--observe-engine, --blur and --noise shape a simulated observation; they cannot "
+            "apply to --observation frames"
+        )
+
+
+def config_space(config: RunConfig, scene: Scene | None = None) -> ParamSpace:
+    """The unknowns of ``config`` on its scene instance (``scene`` saves regenerating it)."""
     from physbench.params import ParamSpace
     from physbench.scenes import resolve_scene
 
-    scene = resolve_scene(case.scene, case.seed) if scene is None else scene
+    scene = resolve_scene(config.scene, config.seed) if scene is None else scene
     return ParamSpace.from_scene(
-        scene, list(case.params), None if case.bodies is None else list(case.bodies)
+        scene, list(config.params), None if config.bodies is None else list(config.bodies)
     )
 
 
-def run_case(
-    case: Case,
+def check_config(config: RunConfig) -> ParamSpace:
+    """Fail fast, before anything runs: every name is registered, the options are accepted, the
+    unknowns exist on the scene. Returns the unknowns."""
+    from physbench.plugins import get_registry
+
+    _check_observation(config)
+    reg = get_registry()
+    try:
+        for engine in {config.engine, config.observer_engine}:
+            reg.get("simulator", engine)
+    except UnknownNameError as exc:
+        raise PhysbenchError(str(exc)) from None
+    make_estimator(config.estimator, config.options)
+    make_renderer(
+        config.renderer,
+        config.renderer_options,
+        resolution=config.resolution,
+        mode=config.render_mode,
+    )
+    return config_space(config)
+
+
+def run_config(
+    config: RunConfig,
     *,
-    callback: Callable[[Record], None] | None = None,
+    callback: Callable[[Iteration], None] | None = None,
     save_observation: str | Path | None = None,
 ) -> History:
-    """Build the scene, observation, engines, renderer and estimator of ``case`` and run
+    """Build the scene, observation, engines, renderers and estimator of ``config`` and run
     :func:`~physbench.loop.refine`. The history's ``meta`` records the observation settings.
     ``callback`` receives each iteration's record; ``save_observation`` writes the frames used."""
-    if case.observation and (case.observe_engine or case.blur or case.noise):
-        raise PhysbenchError(
-            "--observe-engine, --blur and --noise shape a simulated observation; they cannot apply to --observation frames"
-        )
+    _check_observation(config)
     from physbench.loop import draw_problem, refine
     from physbench.observation import load_observation, simulate_observation
     from physbench.observation import save_observation as save_obs
     from physbench.plugins import create
+    from physbench.render.base import ObservationModel
     from physbench.scenes import resolve_scene
 
-    scene = resolve_scene(case.scene, case.seed)
-    space = case_space(case, scene)
-    estimator = make_estimator(case.estimator, case.options)
-    simulator = create("simulator", case.engine)
-    model_renderer = create("renderer", "raster", resolution=case.resolution, mode=case.render_mode)
-    per_object = bool(getattr(estimator, "per_object", False))
-    truth, initial = draw_problem(space, case.seed)
-    obs: Observation
-    if case.observation:
-        obs = load_observation(case.observation)
-    else:
-        observer = create("simulator", case.observer_engine)
-        obs_renderer = create(
-            "renderer",
-            "raster",
-            resolution=case.resolution,
-            mode=case.render_mode,
-            blur=case.blur,
-            noise=case.noise,
-            seed=case.seed,
+    scene = resolve_scene(config.scene, config.seed)
+    space = config_space(config, scene)
+    estimator = make_estimator(config.estimator, config.options)
+    simulator = create("simulator", config.engine)
+
+    def renderer() -> Renderer:
+        return make_renderer(
+            config.renderer,
+            config.renderer_options,
+            resolution=config.resolution,
+            mode=config.render_mode,
         )
+
+    model_renderer = renderer()
+    per_object = type(estimator).per_object
+    truth, initial = draw_problem(space, config.seed)
+    obs: Observation
+    if config.observation:
+        obs = load_observation(config.observation)
+    else:
         obs = simulate_observation(
-            scene, truth, observer, obs_renderer, marked=space.bodies if per_object else ()
+            scene,
+            truth,
+            create("simulator", config.observer_engine),
+            renderer(),
+            marked=space.bodies if per_object else (),
+            camera=ObservationModel(blur=config.blur, noise=config.noise, seed=config.seed),
         )
     if save_observation:
         save_obs(save_observation, obs)
@@ -150,16 +228,18 @@ def run_case(
         simulator,
         model_renderer,
         estimator,
-        iterations=case.iterations,
-        seed=case.seed,
+        iterations=config.iterations,
+        seed=config.seed,
         initial=initial,
         callback=callback,
     )
     history.meta.update(
-        observe_engine=None if case.observation else case.observer_engine,
-        blur=case.blur,
-        noise=case.noise,
-        resolution=case.resolution,
-        render_mode=case.render_mode,
+        observe_engine=None if config.observation else config.observer_engine,
+        renderer=config.renderer,
+        renderer_options=dict(config.renderer_options),
+        blur=config.blur,
+        noise=config.noise,
+        resolution=config.resolution,
+        render_mode=config.render_mode,
     )
     return history

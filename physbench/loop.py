@@ -1,6 +1,7 @@
 """The correction loop (paper Fig. 1): simulate, render, compare with the observation, propose.
 
-One iteration is exactly one simulation and one :meth:`~physbench.protocols.CorrectionEstimator.propose`
+One iteration is exactly one simulation and one
+:meth:`~physbench.estimators.base.CorrectionEstimator.propose`
 call, for every estimator kind, so an iteration count is a fair cost. Iteration 0 simulates the
 initial guess; iteration ``k`` simulates ``p_k`` and ``propose`` returns ``p_{k+1}`` (the last
 proposal is made, and timed, but not simulated).
@@ -22,16 +23,19 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from physbench.errors import PhysbenchError, SimulationError
+from physbench.estimators.base import Step, Task
 from physbench.metrics import image_mse
 from physbench.observation import Observation, expected_shape, validate
 from physbench.params import Params, ParamSpace
-from physbench.protocols import Step, Task
 
 if TYPE_CHECKING:
     import pandas as pd
 
-    from physbench.protocols import CorrectionEstimator, Effect, Renderer, Simulator
+    from physbench.effects.base import Effect
+    from physbench.estimators.base import CorrectionEstimator
+    from physbench.render.base import Renderer
     from physbench.scene import Scene
+    from physbench.simulators.base import Simulator
     from physbench.trajectory import Trajectory
 
 #: Loss given to the estimator when a simulation fails: the largest image MSE frames in [0, 1] allow.
@@ -40,15 +44,6 @@ FAILED_LOSS = 1.0
 
 class EstimatorError(PhysbenchError):
     """An estimator broke its contract (bad proposal, propose before start, ...)."""
-
-
-@dataclass
-class MarkedStep(Step):
-    """The :class:`~physbench.protocols.Step` a ``per_object`` estimator receives: additionally the
-    simulated frames rendered once per unknown body with that body marked (``focus=body``). The
-    matching observed frames are in ``task.meta["marked_observation"]``."""
-
-    marked: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -75,7 +70,7 @@ def draw_problem(space: ParamSpace, seed: int) -> tuple[Params, Params]:
 
 
 @dataclass(frozen=True)
-class Record:
+class Iteration:
     """One iteration. ``nmse``/``best_nmse`` are ``None`` when the truth is unknown; times in s."""
 
     iteration: int
@@ -96,9 +91,12 @@ TIMING_FIELDS = ("t_simulate", "t_render", "t_estimator")
 
 @dataclass
 class History:
-    """What :func:`refine` returns: one :class:`Record` per iteration plus the run's settings."""
+    """What :func:`refine` returns: one :class:`Iteration` per iteration plus the run's settings.
 
-    records: list[Record]
+    JSON written before the renames (``records``, ``min_nmse``) is still read by :meth:`from_dict`.
+    """
+
+    iterations: list[Iteration]
     keys: tuple[str, ...]
     estimator: str
     seed: int
@@ -108,34 +106,37 @@ class History:
     meta: dict[str, Any] = field(default_factory=dict)
 
     def __len__(self) -> int:
-        return len(self.records)
+        return len(self.iterations)
 
     @property
-    def best(self) -> Record:
+    def best(self) -> Iteration:
         """The iterate with the lowest image MSE so far (chosen without looking at the truth)."""
-        return self.records[self.records[-1].best_iteration]
+        return self.iterations[self.iterations[-1].best_iteration]
 
     @property
-    def min_nmse(self) -> float | None:
-        """The paper's score: normalized parameter MSE of the best-by-image-MSE iterate."""
-        return self.records[-1].best_nmse
+    def best_nmse(self) -> float | None:
+        """The paper's score ("normalized min MSE"): the normalized parameter MSE of the iterate
+        with the lowest image MSE, which is not the lowest parameter error of the run."""
+        return self.iterations[-1].best_nmse
 
     @property
     def min_loss(self) -> float:
-        return self.records[-1].best_loss
+        return self.iterations[-1].best_loss
 
     @property
     def initial_nmse(self) -> float | None:
-        return self.records[0].nmse
+        return self.iterations[0].nmse
 
     def timings(self) -> dict[str, float]:
         """Mean seconds per iteration for each phase (simulate, render, estimator)."""
-        return {f[2:]: float(np.mean([getattr(r, f) for r in self.records])) for f in TIMING_FIELDS}
+        return {
+            f[2:]: float(np.mean([getattr(r, f) for r in self.iterations])) for f in TIMING_FIELDS
+        }
 
     def to_dict(self, *, timings: bool = True) -> dict[str, Any]:
         """JSON-ready dict; ``timings=False`` drops everything that varies between identical runs."""
         recs = []
-        for r in self.records:
+        for r in self.iterations:
             d = asdict(r)
             if not timings:
                 for f in TIMING_FIELDS:
@@ -148,10 +149,10 @@ class History:
             "keys": list(self.keys),
             "initial": self.initial,
             "truth": self.truth,
-            "min_nmse": self.min_nmse,
+            "best_nmse": self.best_nmse,
             "min_loss": self.min_loss,
             "meta": {k: v for k, v in self.meta.items() if timings or not k.startswith("t_")},
-            "records": recs,
+            "iterations": recs,
         }
         if timings:
             out["timings"] = self.timings()
@@ -162,9 +163,10 @@ class History:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> History:
-        recs = [Record(**{**{f: 0.0 for f in TIMING_FIELDS}, **r}) for r in d["records"]]
+        raw = d["iterations"] if "iterations" in d else d["records"]
+        recs = [Iteration(**{**dict.fromkeys(TIMING_FIELDS, 0.0), **r}) for r in raw]
         return cls(
-            records=recs,
+            iterations=recs,
             keys=tuple(d["keys"]),
             estimator=d["estimator"],
             seed=d["seed"],
@@ -179,7 +181,7 @@ class History:
         import pandas as pd
 
         rows = []
-        for r in self.records:
+        for r in self.iterations:
             row = {k: v for k, v in asdict(r).items() if k != "params"}
             row.update(r.params)
             rows.append(row)
@@ -239,7 +241,7 @@ def refine(
     seed: int = 0,
     initial: Mapping[str, float] | None = None,
     effects: Sequence[Effect] = (),
-    callback: Callable[[Record], None] | None = None,
+    callback: Callable[[Iteration], None] | None = None,
 ) -> History:
     """Run ``iterations`` iterations of the correction loop and return the :class:`History`.
 
@@ -247,7 +249,7 @@ def refine(
     (``None``: all of them). ``initial`` defaults to a uniform draw from ``derive_seeds(seed)``; the
     estimator is started with that stream's estimator seed. ``renderer`` is the *model* renderer
     (sharp); an observation model (blur, noise) belongs to whoever made ``observation``.
-    ``callback`` is called with each :class:`Record` as it completes (progress displays).
+    ``callback`` is called with each :class:`Iteration` as it completes (progress displays).
     """
     if (
         isinstance(iterations, bool)
@@ -261,8 +263,8 @@ def refine(
         if isinstance(observation, Observation)
         else Observation(np.asarray(observation))
     )
-    name = str(getattr(type(estimator), "name", type(estimator).__name__))
-    per_object = bool(getattr(estimator, "per_object", False))
+    name = type(estimator).name or type(estimator).__name__
+    per_object = type(estimator).per_object
     obs = validate(obs, expected_shape(renderer, scene), bodies=space.bodies if per_object else ())
     truth = None
     if obs.truth is not None:
@@ -291,13 +293,14 @@ def refine(
         observation=obs.frames,
         initial=dict(first),
         renderer=renderer,
-        meta={"iterations": int(iterations), "marked_observation": obs.marked},
+        iterations=int(iterations),
+        marked_observation=obs.marked,
     )
     t = time.perf_counter()
     estimator.start(task, seed=seeds.estimator)
     t_start = time.perf_counter() - t
 
-    records: list[Record] = []
+    records: list[Iteration] = []
     best = 0
     for k in range(int(iterations)):
         failed: str | None = None
@@ -319,10 +322,7 @@ def refine(
                 marked = {b: renderer.render(scene, traj, focus=b) for b in space.bodies}
             loss = image_mse(frames, obs.frames)
         t2 = time.perf_counter()
-        if per_object:
-            step: Step = MarkedStep(k, dict(params), frames, loss, traj, marked=marked)
-        else:
-            step = Step(k, dict(params), frames, loss, traj)
+        step = Step(k, dict(params), frames, loss, traj, marked=marked)
         proposal = estimator.propose(step)
         t3 = time.perf_counter()
         nxt = _check_proposal(name, space, proposal, k)
@@ -333,7 +333,7 @@ def refine(
         best_loss, best_nmse = (
             (loss, nmse) if best == k else (records[best].loss, records[best].nmse)
         )
-        rec = Record(
+        rec = Iteration(
             k,
             dict(params),
             loss,
@@ -352,16 +352,16 @@ def refine(
         params = nxt
 
     return History(
-        records=records,
+        iterations=records,
         keys=space.keys,
         estimator=name,
         seed=int(seed),
         initial=first,
         truth=truth,
-        options=dict(getattr(estimator, "options", {}) or {}),
+        options=dict(estimator.options),
         meta={
             "scene": scene.name,
-            "simulator": getattr(simulator, "name", ""),
+            "simulator": type(simulator).name,
             "per_object": per_object,
             "observation": obs.source,
             "t_start": t_start,

@@ -25,9 +25,11 @@ import numpy as np
 from physbench.errors import PhysbenchError
 
 if TYPE_CHECKING:
+    from physbench.effects.base import Effect
     from physbench.params import Params
-    from physbench.protocols import Effect, Renderer, Simulator
+    from physbench.render.base import ObservationModel, Renderer
     from physbench.scene import Scene
+    from physbench.simulators.base import Simulator
 
 MARK_PREFIX = "marked_"
 
@@ -51,19 +53,8 @@ class Observation:
 
 
 def expected_shape(renderer: Renderer, scene: Scene) -> tuple[int, int, int, int]:
-    """``(T, C, H, W)`` the renderer produces for ``scene``: from its ``shape()`` method when it has
-    one, else by rendering a one-frame still of the initial state (no simulation needed)."""
-    shape = getattr(renderer, "shape", None)
-    if callable(shape):
-        return tuple(int(v) for v in shape(scene))  # type: ignore[return-value]
-    from physbench.trajectory import Trajectory
-
-    n = len(scene.bodies)
-    states = np.zeros((1, n, 6))
-    for i, b in enumerate(scene.bodies):
-        states[0, i, :3] = (*b.position, b.angle)
-    frame = renderer.render(scene, Trajectory(scene.body_names, np.zeros(1), states))
-    return (scene.frames, *frame.shape[1:])  # type: ignore[return-value]
+    """``(T, C, H, W)`` the renderer produces for ``scene`` (:meth:`Renderer.shape`)."""
+    return tuple(int(v) for v in renderer.shape(scene))  # type: ignore[return-value]
 
 
 def check_frames(
@@ -125,15 +116,17 @@ def simulate_observation(
     *,
     marked: Iterable[str] = (),
     effects: Sequence[Effect] = (),
+    camera: ObservationModel | None = None,
 ) -> Observation:
     """Simulate ``scene`` with the true parameters and render it (and once per ``marked`` body with
-    that body in focus). ``renderer`` is the observation model: blur or noise belong there."""
+    that body in focus); ``camera`` (blur, noise) degrades every rendered view."""
     traj = simulator.simulate(scene, dict(truth), effects=effects)
-    frames = renderer.render(scene, traj)
-    focus = {b: renderer.render(scene, traj, focus=b) for b in marked}
-    return Observation(
-        frames, dict(truth), focus, source=f"simulated ({getattr(simulator, 'name', '?')})"
-    )
+    views = {None: renderer.render(scene, traj)}
+    views.update({b: renderer.render(scene, traj, focus=b) for b in marked})
+    if camera is not None:
+        views = {b: camera.apply(f) for b, f in views.items()}
+    frames = views.pop(None)
+    return Observation(frames, dict(truth), views, source=f"simulated ({type(simulator).name})")
 
 
 def save_observation(path: str | Path, obs: Observation) -> None:

@@ -1,18 +1,23 @@
-"""ParamSpace: the named unknowns of a run, their ranges and normalisation.
+r"""ParamSpace: the unknowns of a run (:class:`~physbench.parameter.Parameter`\ s), their ranges
+and normalisation.
 
-Parameters travel as ``{"body.param": value}`` dicts (:data:`Params`); estimators that want vectors
-use :meth:`ParamSpace.to_unit` / :meth:`ParamSpace.from_unit` (each range mapped to [0, 1]).
+Values travel as ``{"body.param": value}`` dicts (:data:`Params`); estimators that want vectors use
+:meth:`ParamSpace.to_unit` / :meth:`ParamSpace.from_unit` (each range mapped to [0, 1]).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from physbench.errors import PhysbenchError, UnknownNameError
-from physbench.scene import Scene, Unknown
+from physbench.parameter import Parameter
+
+if TYPE_CHECKING:
+    from physbench.scene import Scene
 
 Params = dict[str, float]
 
@@ -21,7 +26,7 @@ Params = dict[str, float]
 class ParamSpace:
     """An ordered set of unknowns. Order is the vector order everywhere."""
 
-    unknowns: tuple[Unknown, ...]
+    unknowns: tuple[Parameter, ...]
 
     def __post_init__(self) -> None:
         if not self.unknowns:
@@ -40,20 +45,20 @@ class ParamSpace:
             raise PhysbenchError(f"scene {scene.name!r} declares no unknown parameters")
         if params is not None:
             params = list(params)
-            known = sorted({u.param for u in unknowns})
+            known = sorted({u.name for u in unknowns})
             for p in params:
                 if p not in known:
                     raise UnknownNameError("parameter", p, known, where=f"of scene {scene.name!r}")
-            unknowns = [u for u in unknowns if u.param in params]
+            unknowns = [u for u in unknowns if u.name in params]
         if bodies is not None:
             bodies = list(bodies)
-            known = sorted({u.body for u in unknowns})
+            known = sorted({u.owner for u in unknowns})
             for b in bodies:
                 if b not in known:
                     raise UnknownNameError(
                         "body", b, known, where=f"with unknowns in scene {scene.name!r}"
                     )
-            unknowns = [u for u in unknowns if u.body in bodies]
+            unknowns = [u for u in unknowns if u.owner in bodies]
         return cls(tuple(unknowns))
 
     @property
@@ -63,7 +68,7 @@ class ParamSpace:
     @property
     def bodies(self) -> tuple[str, ...]:
         """Bodies with at least one unknown, in first-appearance order."""
-        return tuple(dict.fromkeys(u.body for u in self.unknowns))
+        return tuple(dict.fromkeys(u.owner for u in self.unknowns))
 
     @property
     def low(self) -> np.ndarray:
@@ -114,4 +119,4 @@ class ParamSpace:
         return float(np.mean(d * d))
 
     def subset(self, body: str) -> ParamSpace:
-        return ParamSpace(tuple(u for u in self.unknowns if u.body == body))
+        return ParamSpace(tuple(u for u in self.unknowns if u.owner == body))

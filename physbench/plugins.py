@@ -1,9 +1,9 @@
-"""Plugin discovery: entry points of the group ``physbench`` -> name-keyed registries.
+"""The plugin registry: entry points of the group ``physbench`` -> name-keyed registries.
 
 Built-ins are declared in physbench's own ``[project.entry-points.physbench]``, the same path a
-third party uses. A plugin that fails to import (or whose hooks fail) is recorded in
-:attr:`Registry.failed` and skipped; two components of one kind with the same name raise
-:class:`~physbench.errors.PluginError`. ``PHYSBENCH_PLUGINS="pkg.mod,other.mod"`` registers
+third party uses. A plugin that fails to import (or whose hooks fail, or that returns a class that
+does not subclass its kind's base class) is recorded in :attr:`Registry.failed` and skipped; two
+components of one kind with the same name raise :class:`~physbench.errors.PluginError`. ``PHYSBENCH_PLUGINS="pkg.mod,other.mod"`` registers
 modules explicitly, without packaging (Gymnasium's ``module:Name`` idea, as a fallback).
 """
 
@@ -107,7 +107,34 @@ def _register(
     return True
 
 
-def discover(
+def _bases() -> dict[str, type]:
+    """Kind -> the base class its components subclass (scenes are plain callables)."""
+    from physbench.effects.base import Effect
+    from physbench.estimators.base import CorrectionEstimator
+    from physbench.render.base import Renderer
+    from physbench.simulators.base import Simulator
+
+    return {
+        "simulator": Simulator,
+        "renderer": Renderer,
+        "estimator": CorrectionEstimator,
+        "effect": Effect,
+    }
+
+
+def _contract_breach(kind: str, obj: object, bases: dict[str, type]) -> str | None:
+    base = bases.get(kind)
+    if base is None:
+        return None if callable(obj) else f"returned {obj!r}, which is not callable"
+    if not (isinstance(obj, type) and issubclass(obj, base)):
+        return (
+            f"returned {obj!r}, which does not subclass {base.__module__}.{base.__qualname__} "
+            f"(the {kind} contract)"
+        )
+    return None
+
+
+def build_registry(
     extra: Iterable[tuple[str, object]] = (), *, entry_points: bool = True, env: bool = True
 ) -> Registry:
     """Build a registry from the entry points, ``PHYSBENCH_PLUGINS``, and ``extra``
@@ -146,6 +173,7 @@ def discover(
         if _register(pm, reg, plugin, name, name, "-"):
             origin[name] = (name, "-")
 
+    bases = _bases()
     for hook, kind in KINDS.items():
         for impl in getattr(pm.hook, hook).get_hookimpls():
             pkg, ver = origin.get(impl.plugin_name, ("?", "?"))
@@ -159,16 +187,12 @@ def discover(
                 )
                 continue
             for obj in items:
-                name = getattr(obj, "name", None)
-                if not isinstance(name, str) or not name:
-                    reg.failed.append(
-                        FailedPlugin(
-                            impl.plugin_name,
-                            pkg,
-                            ver,
-                            f"{hook} returned {obj!r} without a string 'name'",
-                        )
-                    )
+                name = getattr(obj, "name", None)  # a plugin's object: checked, not trusted
+                breach = _contract_breach(kind, obj, bases)
+                if breach is None and (not isinstance(name, str) or not name):
+                    breach = f"returned {obj!r} without a string 'name'"
+                if breach is not None:
+                    reg.failed.append(FailedPlugin(impl.plugin_name, pkg, ver, f"{hook} {breach}"))
                     continue
                 reg.add(Component(kind, name, obj, impl.plugin_name, pkg, ver))
     return reg
@@ -181,7 +205,7 @@ def get_registry() -> Registry:
     """The process-wide registry, discovered on first use."""
     global _REGISTRY
     if _REGISTRY is None:
-        _REGISTRY = discover()
+        _REGISTRY = build_registry()
     return _REGISTRY
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from physbench.errors import SceneError
+from physbench.parameter import Parameter
 
 Vec = tuple[float, float]
 
@@ -177,18 +178,14 @@ class Joint:
     kind: Literal["pivot"] = "pivot"
 
 
-@dataclass(frozen=True)
-class Unknown:
-    """A parameter that may be unknown: ``body.param`` lies somewhere in ``[low, high]``."""
+#: Unit of each body parameter, for the :class:`~physbench.params.Parameter` of an unknown.
+BODY_UNITS: dict[str, str] = {"mass": "kg", "elasticity": "", "friction": "", "moment": "kg·m²"}
 
-    body: str
-    param: str
-    low: float
-    high: float
 
-    @property
-    def key(self) -> str:
-        return f"{self.body}.{self.param}"
+def body_unknown(body: str, param: str, low: float, high: float) -> Parameter:
+    """The declaration that ``body.param`` is unknown and lies somewhere in ``[low, high]``."""
+    unit = BODY_UNITS.get(param, "") if isinstance(param, str) else ""  # validated later
+    return Parameter(param, low, high, owner=body, unit=unit)
 
 
 @dataclass(frozen=True)
@@ -205,7 +202,7 @@ class Scene:
     statics: tuple[Static, ...] = ()
     forces: tuple[Force, ...] = ()
     joints: tuple[Joint, ...] = ()
-    unknowns: tuple[Unknown, ...] = ()
+    unknowns: tuple[Parameter, ...] = ()
     test_body: str | None = None
     description: str = ""
     meta: Mapping[str, object] = field(default_factory=dict, compare=True)
@@ -227,7 +224,7 @@ class Scene:
 
         raise UnknownNameError("body", name, self.body_names)
 
-    def unknown(self, key: str) -> Unknown:
+    def unknown(self, key: str) -> Parameter:
         for u in self.unknowns:
             if u.key == key:
                 return u
@@ -417,29 +414,29 @@ def validate_scene(scene: Scene) -> None:
     keys: set[str] = set()
     for i, u in enumerate(scene.unknowns):
         k = f"unknowns[{i}]"
-        if u.body not in seen:
+        if u.owner not in seen:
             raise SceneError(
-                f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=u.body
+                f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=u.owner
             )
-        if u.param not in BODY_PARAMS:
+        if u.name not in BODY_PARAMS:
             raise SceneError(
                 f"unknown parameter; known: {', '.join(BODY_PARAMS)}",
                 key=f"{k}.param",
-                value=u.param,
+                value=u.name,
             )
         lo, hi = _finite(f"{k}.range[0]", u.low), _finite(f"{k}.range[1]", u.high)
         if not lo < hi:
             raise SceneError(
                 "range must be [low, high] with low < high", key=f"{k}.range", value=[u.low, u.high]
             )
-        _check_param(f"{k}.range[0]", u.param, lo)
-        _check_param(f"{k}.range[1]", u.param, hi)
+        _check_param(f"{k}.range[0]", u.name, lo)
+        _check_param(f"{k}.range[1]", u.name, hi)
         if u.key in keys:
-            raise SceneError("parameter declared unknown twice", key=f"{k}.param", value=u.param)
+            raise SceneError("parameter declared unknown twice", key=f"{k}.param", value=u.name)
         keys.add(u.key)
-        if u.body == scene.test_body:
+        if u.owner == scene.test_body:
             raise SceneError(
-                "the test body's parameters are fixed by definition", key=f"{k}.body", value=u.body
+                "the test body's parameters are fixed by definition", key=f"{k}.body", value=u.owner
             )
 
     if scene.test_body is not None and scene.test_body not in seen:

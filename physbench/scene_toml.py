@@ -62,7 +62,7 @@ from physbench.scene import (
     Shape,
     Static,
     StaticPolygon,
-    Unknown,
+    body_unknown,
 )
 
 _TOP_KEYS = {
@@ -232,12 +232,7 @@ def scene_from_dict(data: dict[str, Any]) -> Scene:
         if not isinstance(rng, list) or len(rng) != 2:
             raise SceneError("must be [low, high]", key=f"{k}.range", value=rng)
         unknowns.append(
-            Unknown(
-                body=_require(k, raw, "body"),
-                param=_require(k, raw, "param"),
-                low=rng[0],
-                high=rng[1],
-            )
+            body_unknown(_require(k, raw, "body"), _require(k, raw, "param"), rng[0], rng[1])
         )
     top = {
         n: _vec_or_raw(data[n])
@@ -391,7 +386,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         ]
     if scene.unknowns:
         d["unknowns"] = [
-            {"body": u.body, "param": u.param, "range": [u.low, u.high]} for u in scene.unknowns
+            {"body": u.owner, "param": u.name, "range": [u.low, u.high]} for u in scene.unknowns
         ]
     return d
 

@@ -32,12 +32,15 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from physbench.effects.base import Effect
 from physbench.errors import PhysbenchError
+from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.loop import EstimatorError, History, draw_problem, refine
 from physbench.observation import Observation, simulate_observation
 from physbench.params import ParamSpace
-from physbench.protocols import CorrectionEstimator, Effect, Step, Task
-from physbench.scene import Body, Circle, Scene, Unknown
+from physbench.render.base import Renderer
+from physbench.scene import Body, Circle, Scene, body_unknown
+from physbench.simulators.base import Simulator
 from physbench.trajectory import Trajectory
 
 __all__ = [
@@ -71,14 +74,14 @@ def toy_scene(frames: int = 12) -> Scene:
         Body("b", Circle(0.3), (2.4, 1.0)),
     )
     unknowns = tuple(
-        Unknown(n, p, lo, hi)
+        body_unknown(n, p, lo, hi)
         for n in ("a", "b")
         for p, lo, hi in (("mass", 1.0, 10.0), ("elasticity", 0.1, 1.0))
     )
     return Scene("toy", bodies, frames=frames, unknowns=unknowns, test_body="test")
 
 
-class ToySimulator:
+class ToySimulator(Simulator):
     """Closed-form stand-in for a physics engine: a body's speed falls with its mass and its hop
     height grows with its elasticity. Deterministic, about 50 µs per call."""
 
@@ -103,16 +106,19 @@ class ToySimulator:
         return Trajectory(scene.body_names, t, states, engine=self.name)
 
 
-class ToyRenderer:
-    """Gaussian blobs on a ``size`` x ``size`` image; channel 1 holds the ``focus`` body."""
+class ToyRenderer(Renderer):
+    """Gaussian blobs on a square image of ``resolution`` pixels; channel 1 holds the ``focus``
+    body (the ``mark`` layout, its only mode)."""
 
     name: ClassVar[str] = "toy"
+    modes: ClassVar[tuple[str, ...]] = ("mark",)
 
-    def __init__(self, size: int = 16) -> None:
-        self.size = size
+    def __init__(self, resolution: int = 16, mode: str = "mark") -> None:
+        super().__init__(resolution, mode)
+        self.size = int(self.resolution)  # type: ignore[arg-type]
 
-    def shape(self, scene: Scene) -> tuple[int, int, int, int]:
-        return (scene.frames, 2, self.size, self.size)
+    def shape(self, scene: Scene, frames: int | None = None) -> tuple[int, int, int, int]:
+        return (scene.frames if frames is None else frames, 2, self.size, self.size)
 
     def render(
         self,
@@ -219,7 +225,7 @@ def check_protocol(cls: type, **options: Any) -> None:
             raise ConformanceError(f"{_label(cls)}: instances need a method {meth}()")
     if not isinstance(est, CorrectionEstimator):
         raise ConformanceError(
-            f"{_label(cls)}: instances do not satisfy physbench.protocols.CorrectionEstimator"
+            f"{_label(cls)}: instances do not satisfy physbench.CorrectionEstimator"
         )
 
 
@@ -240,7 +246,7 @@ def _trace(h: History) -> dict[str, Any]:
 
 
 def _first_difference(a: dict[str, Any], b: dict[str, Any]) -> str:
-    for ra, rb in zip(a["records"], b["records"], strict=False):
+    for ra, rb in zip(a["iterations"], b["iterations"], strict=False):
         if ra != rb:
             return f"iteration {ra['iteration']}: {ra['params']} (loss {ra['loss']}) vs {rb['params']} (loss {rb['loss']})"
     diff = [k for k in a if a[k] != b.get(k)]
@@ -363,7 +369,13 @@ def check_bad_input(
             est = cls(**{**options, **bad})
             est.start(
                 Task(
-                    t.scene, t.space, t.observation.frames, draw_problem(t.space, 0)[1], t.renderer
+                    t.scene,
+                    t.space,
+                    t.observation.frames,
+                    draw_problem(t.space, 0)[1],
+                    t.renderer,
+                    iterations=8,
+                    marked_observation=t.observation.marked,
                 ),
                 seed=0,
             )

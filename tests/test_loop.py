@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from physbench.errors import PhysbenchError, SimulationError
+from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.estimators.random_search import RandomSearch
 from physbench.loop import (
     FAILED_LOSS,
     EstimatorError,
     History,
-    MarkedStep,
     derive_seeds,
     draw_problem,
     refine,
@@ -28,11 +28,10 @@ from physbench.observation import (
     simulate_observation,
 )
 from physbench.params import ParamSpace
-from physbench.protocols import Step, Task
 from physbench.testing import ToyRenderer, ToySimulator, toy_task
 
 
-class Scripted:
+class Scripted(CorrectionEstimator):
     """Proposes a fixed list of points (then repeats the last); records what it was given."""
 
     name: ClassVar[str] = "scripted"
@@ -84,7 +83,7 @@ def test_one_simulation_and_one_propose_per_iteration() -> None:
     assert sim.calls[0] == initial == h.initial == est.task.initial  # type: ignore[union-attr]
     assert sim.calls[1:] == points[:6]  # iteration k simulates proposal k-1
     assert [s.iteration for s in est.steps] == list(range(7))
-    for s, r in zip(est.steps, h.records, strict=True):
+    for s, r in zip(est.steps, h.iterations, strict=True):
         assert (
             s.params == r.params
             and s.loss == r.loss
@@ -100,15 +99,15 @@ def test_best_is_chosen_by_image_mse_without_peeking_at_the_truth() -> None:
     frames = simulate_observation(t.scene, looks_right, t.simulator, t.renderer).frames
     obs = Observation(frames, truth=truly_right)
     h = _run(Scripted([truly_right, looks_right, truly_right]), iterations=4, obs=obs)
-    assert h.records[1].nmse == 0.0 and h.records[2].loss == 0.0
+    assert h.iterations[1].nmse == 0.0 and h.iterations[2].loss == 0.0
     assert h.best.iteration == 2 and h.best.params == looks_right
     assert (
-        h.min_nmse == pytest.approx(t.space.normalized_mse(looks_right, truly_right))
-        and h.min_nmse > 0
+        h.best_nmse == pytest.approx(t.space.normalized_mse(looks_right, truly_right))
+        and h.best_nmse > 0
     )
-    losses = [r.loss for r in h.records]
-    assert [r.best_iteration for r in h.records] == running_best(losses)
-    assert all(r.best_nmse == h.records[r.best_iteration].nmse for r in h.records)
+    losses = [r.loss for r in h.iterations]
+    assert [r.best_iteration for r in h.iterations] == running_best(losses)
+    assert all(r.best_nmse == h.iterations[r.best_iteration].nmse for r in h.iterations)
 
 
 def test_normalized_mse_divides_by_the_range_maximum() -> None:
@@ -126,7 +125,7 @@ def test_history_round_trips_through_json_and_pandas() -> None:
     assert d["timings"].keys() == {"simulate", "render", "estimator"}
     again = History.from_dict(d)
     assert again.to_dict() == h.to_dict()
-    assert again.min_nmse == h.min_nmse and again.best == h.best
+    assert again.best_nmse == h.best_nmse and again.best == h.best
     frame = h.to_frame()
     assert list(frame.index) == list(range(5))
     assert {"loss", "nmse", "best_nmse", "t_simulate", *h.keys} <= set(frame.columns)
@@ -231,11 +230,11 @@ def test_a_failed_simulation_costs_an_iteration_with_the_worst_loss() -> None:
     est = Scripted([{"a.mass": 9.0, "b.mass": 2.0}, {"a.mass": 2.0, "b.mass": 2.0}])
     h = _run(est, iterations=3, sim=Fragile())
     assert (
-        h.records[1].failed
-        and "exploded" in h.records[1].failed
-        and h.records[1].loss == FAILED_LOSS
+        h.iterations[1].failed
+        and "exploded" in h.iterations[1].failed
+        and h.iterations[1].loss == FAILED_LOSS
     )
-    assert h.records[2].failed is None and len(est.steps) == 3
+    assert h.iterations[2].failed is None and len(est.steps) == 3
 
 
 class PerObject(Scripted):
@@ -247,26 +246,29 @@ def test_per_object_estimators_get_each_unknown_body_marked() -> None:
     est = PerObject([{"a.mass": 3.0, "b.mass": 3.0}])
     h = _run(est, iterations=2, seed=1)
     assert h.meta["per_object"] is True
-    assert set(est.task.meta["marked_observation"]) == {"a", "b"}  # type: ignore[union-attr]
+    assert set(est.task.marked_observation) == {"a", "b"}  # type: ignore[union-attr]
     for step in est.steps:
-        assert isinstance(step, MarkedStep) and set(step.marked) == {"a", "b"}
+        assert set(step.marked) == {"a", "b"}
         assert step.marked["a"][:, 1].sum() > 0 and step.frames[:, 1].sum() == 0
     with pytest.raises(ObservationError, match="no marked frames for a, b"):
         _run(PerObject([{"a.mass": 3.0, "b.mass": 3.0}]), obs=Observation(t.observation.frames))
 
 
 def test_any_number_of_unknown_bodies() -> None:
-    from physbench.scene import Body, Circle, Scene, Unknown
+    from physbench.scene import Body, Circle, Scene, body_unknown
 
     bodies = tuple(Body(f"b{i}", Circle(0.2), (0.5 + 0.5 * i, 1.0)) for i in range(6))
     scene = Scene(
-        "six", bodies, frames=8, unknowns=tuple(Unknown(b.name, "mass", 1.0, 10.0) for b in bodies)
+        "six",
+        bodies,
+        frames=8,
+        unknowns=tuple(body_unknown(b.name, "mass", 1.0, 10.0) for b in bodies),
     )
     space = ParamSpace.from_scene(scene)
     sim, ren = ToySimulator(), ToyRenderer()
     obs = simulate_observation(scene, draw_problem(space, 0)[0], sim, ren)
     h = refine(obs, scene, space, sim, ren, RandomSearch(), iterations=4)
-    assert len(h.keys) == 6 and all(len(r.params) == 6 for r in h.records)
+    assert len(h.keys) == 6 and all(len(r.params) == 6 for r in h.iterations)
 
 
 def test_observation_files_round_trip_and_bad_files_are_explained(tmp_path) -> None:  # type: ignore[no-untyped-def]
@@ -307,8 +309,8 @@ def test_bouncing_balls_end_to_end_with_six_masses_and_marked_objects() -> None:
     obs = simulate_observation(scene, truth, sim, ren, marked=space.bodies)
     est = PerObject([space.sample(np.random.default_rng(1))])
     h = refine(obs, scene, space, sim, ren, est, iterations=2)
-    assert len(space) == 6 and set(est.task.meta["marked_observation"]) == set(space.bodies)  # type: ignore[union-attr]
+    assert len(space) == 6 and set(est.task.marked_observation) == set(space.bodies)  # type: ignore[union-attr]
     step = est.steps[-1]
-    assert isinstance(step, MarkedStep) and len(step.marked) == 6
+    assert len(step.marked) == 6
     assert all(f[:, 1].max() > 0.5 for f in step.marked.values())  # the marked ball is in channel 1
-    assert h.records[0].nmse is not None and h.records[1].params == est.points[0]
+    assert h.iterations[0].nmse is not None and h.iterations[1].params == est.points[0]

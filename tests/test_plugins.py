@@ -13,14 +13,14 @@ import pytest
 
 from physbench import hookspecs
 from physbench.errors import PluginError, UnknownNameError
-from physbench.plugins import KINDS, discover
+from physbench.plugins import KINDS, build_registry
 
 GOOD = """
+from physbench.estimators.base import CorrectionEstimator
 from physbench.hookspecs import hookimpl
 
-class EchoEstimator:
+class EchoEstimator(CorrectionEstimator):
     name = "echo_{tag}"
-    per_object = False
     def start(self, task, *, seed):
         self.initial = task.initial
     def propose(self, step):
@@ -56,7 +56,7 @@ def site(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 
 def test_builtins_register_through_entry_points() -> None:
-    reg = discover(env=False)
+    reg = build_registry(env=False)
     assert not reg.failed, reg.failed
     assert {"pymunk", "box2d"} <= set(reg.names("simulator"))
     assert "raster" in reg.names("renderer")
@@ -80,7 +80,7 @@ def test_third_party_plugin_is_discovered_with_its_package(site: Path) -> None:
         {"good": "pbtest_good"},
         {"pbtest_good": GOOD.format(tag="good")},
     )
-    reg = discover(env=False)
+    reg = build_registry(env=False)
     comp = reg.info("estimator", "echo_good")
     assert (comp.package, comp.version, comp.plugin) == ("pbtest-good", "1.2.3", "good")
     assert comp.obj.__name__ == "EchoEstimator"
@@ -97,7 +97,7 @@ def test_plugin_failing_to_import_is_reported_and_skipped(site: Path) -> None:
     make_dist(
         site, "pbtest-good", "1.0", {"good": "pbtest_good"}, {"pbtest_good": GOOD.format(tag="ok")}
     )
-    reg = discover(env=False)
+    reg = build_registry(env=False)
     failed = {f.plugin: f for f in reg.failed}
     assert "broken" in failed
     assert failed["broken"].package == "pbtest-broken"
@@ -109,7 +109,7 @@ def test_plugin_failing_to_import_is_reported_and_skipped(site: Path) -> None:
 def test_hook_that_matches_no_spec_is_reported(site: Path) -> None:
     src = "from physbench.hookspecs import hookimpl\n@hookimpl\ndef register_simulator():\n    return []\n"
     make_dist(site, "pbtest-typo", "0.1", {"typo": "pbtest_typo"}, {"pbtest_typo": src})
-    reg = discover(env=False)
+    reg = build_registry(env=False)
     err = {f.plugin: f.error for f in reg.failed}["typo"]
     assert "register_simulator" in err
 
@@ -117,15 +117,27 @@ def test_hook_that_matches_no_spec_is_reported(site: Path) -> None:
 def test_hook_that_raises_is_reported(site: Path) -> None:
     src = "from physbench.hookspecs import hookimpl\n@hookimpl\ndef register_estimators():\n    raise ValueError('bad hook')\n"
     make_dist(site, "pbtest-raise", "0.1", {"raiser": "pbtest_raise"}, {"pbtest_raise": src})
-    reg = discover(env=False)
+    reg = build_registry(env=False)
     assert "bad hook" in {f.plugin: f.error for f in reg.failed}["raiser"]
 
 
+def test_a_component_outside_its_contract_is_reported_and_skipped(site: Path) -> None:
+    src = GOOD.format(tag="duck").replace("(CorrectionEstimator)", "")
+    make_dist(site, "pbtest-duck", "0.1", {"duck": "pbtest_duck"}, {"pbtest_duck": src})
+    reg = build_registry(env=False)
+    err = {f.plugin: f.error for f in reg.failed}["duck"]
+    assert "does not subclass physbench.estimators.base.CorrectionEstimator" in err
+    assert "echo_duck" not in reg.names("estimator")
+
+
 def test_duplicate_component_name_fails_loudly(site: Path) -> None:
-    src = "from physbench.hookspecs import hookimpl\nclass S:\n    name = 'pymunk'\n@hookimpl\ndef register_simulators():\n    return [S]\n"
+    src = (
+        "from physbench.hookspecs import hookimpl\nfrom physbench.simulators.base import Simulator\n"
+        "class S(Simulator):\n    name = 'pymunk'\n@hookimpl\ndef register_simulators():\n    return [S]\n"
+    )
     make_dist(site, "pbtest-dup", "0.1", {"dup": "pbtest_dup"}, {"pbtest_dup": src})
     with pytest.raises(PluginError, match=r"duplicate simulator name 'pymunk'.*pbtest-dup"):
-        discover(env=False)
+        build_registry(env=False)
 
 
 def test_explicit_module_fallback_via_environment(
@@ -133,13 +145,13 @@ def test_explicit_module_fallback_via_environment(
 ) -> None:
     (site / "pbtest_env.py").write_text(textwrap.dedent(GOOD.format(tag="env")))
     monkeypatch.setenv("PHYSBENCH_PLUGINS", "pbtest_env, pbtest_missing_module")
-    reg = discover()
+    reg = build_registry()
     assert reg.info("estimator", "echo_env").package == "PHYSBENCH_PLUGINS"
     assert any(f.plugin == "pbtest_missing_module" for f in reg.failed)
 
 
 def test_unknown_name_lists_known_ones() -> None:
-    reg = discover(env=False)
+    reg = build_registry(env=False)
     with pytest.raises(
         UnknownNameError, match="unknown simulator 'bullet'; known simulators: box2d, pymunk"
     ):

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from physbench.errors import SceneError
-from physbench.plugins import discover
+from physbench.plugins import build_registry
 from physbench.scene_toml import dumps_scene, load_scene, loads_scene, save_scene
 
 GOOD = """\
@@ -68,13 +68,13 @@ def test_good_file_loads() -> None:
 
 
 def builtin_scenes() -> list[tuple[str, int]]:
-    names = discover(env=False).names("scene")
+    names = build_registry(env=False).names("scene")
     return [(n, seed) for n in names for seed in (0, 3)]
 
 
 @pytest.mark.parametrize(("name", "seed"), builtin_scenes())
 def test_builtin_scene_round_trip_is_exact(name: str, seed: int, tmp_path: Path) -> None:
-    scene = discover(env=False).get("scene", name)(seed)
+    scene = build_registry(env=False).get("scene", name)(seed)
     text = dumps_scene(scene)
     assert loads_scene(text) == scene
     path = tmp_path / f"{name}.toml"

@@ -238,7 +238,7 @@ def landscape_data(
     out: dict[str, Any] = {}
     for si, seed in enumerate(seeds):
         sc = resolve_scene(scene, seed)
-        units = [u for u in sc.unknowns if u.param == param]
+        units = [u for u in sc.unknowns if u.name == param]
         nominal = {u.key: 0.5 * (u.low + u.high) for u in sc.unknowns}
         obs = ren.render(sc, sim.simulate(sc, nominal))
         for u in units:

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 from physbench.bench.spec import Cell, Spec
 from physbench.bench.store import RESULTS, CellStore, atomic_write
-from physbench.experiment import Case
+from physbench.experiment import RunConfig
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -55,15 +55,15 @@ def versions() -> dict[str, str]:
     return out
 
 
-def run_cell(case: Case) -> dict[str, Any]:
+def run_cell(case: RunConfig) -> dict[str, Any]:
     """Run one cell; called by the executor, in whatever process it chooses. Never raises for a
     failing case: the error is returned, with its traceback for the cell file."""
-    from physbench.experiment import run_case
+    from physbench.experiment import run_config
 
     t0 = time.perf_counter()
     out: dict[str, Any] = {"case": case.to_dict(), "status": "ok", "error": None, "history": None}
     try:
-        out["history"] = run_case(case).to_dict()
+        out["history"] = run_config(case).to_dict()
     except Exception as exc:  # any failure of one cell is data, not the end of the sweep
         out.update(
             status="failed",
@@ -160,7 +160,9 @@ def run_sweep(
         return data is not None and not (retry_failed and data.get("status") != "ok")
 
     todo = [c for c in cells if not finished(c)]
-    by_case = {id(c.case): c for c in todo}  # executors hand back the very objects they were given
+    by_case = {
+        id(c.config): c for c in todo
+    }  # executors hand back the very objects they were given
     t0 = time.perf_counter()
     started = datetime.now(UTC).isoformat(timespec="seconds")
     n_failed = 0
@@ -176,7 +178,7 @@ def run_sweep(
     try:
         if todo:
             with ex:
-                for case, data in ex.map_unordered(run_cell, [c.case for c in todo]):
+                for case, data in ex.map_unordered(run_cell, [c.config for c in todo]):
                     store.save(by_case[id(case)].key, data)
                     if data["status"] != "ok":
                         n_failed += 1

@@ -1,6 +1,6 @@
 """Sweep specs: a TOML file naming the axes of a benchmark, expanded into cells.
 
-A cell is one :class:`~physbench.experiment.Case` (one seed of one configuration). The product is
+A cell is one :class:`~physbench.experiment.RunConfig` (one seed of one configuration). The product is
 ``Σ_scenes (scene's unknown sets) × engine × observe_engine × blur × noise × resolution ×
 render_mode × iterations × estimators × seeds``; each scene lists its own unknown sets because
 the paper's Table 1 is not a full product. Every axis takes one value or a list::
@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from physbench.errors import PhysbenchError, UnknownNameError
-from physbench.experiment import Case
+from physbench.experiment import RunConfig
 
 AXES = ("engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
 TOP_KEYS = ("name", "description", "scenes", "unknowns", "estimators", "seeds", *AXES)
@@ -83,13 +83,13 @@ class Cell:
     ``key`` hashes everything that determines the result, so it names the cell's result file."""
 
     index: int
-    case: Case
+    config: RunConfig
     scene: str
     label: str
 
     @property
     def key(self) -> str:
-        blob = json.dumps(self.case.to_dict(), sort_keys=True, separators=(",", ":"))
+        blob = json.dumps(self.config.to_dict(), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
@@ -113,7 +113,7 @@ class Spec:
                     ax = dict(zip(AXES, values, strict=True))
                     for est in self.estimators:
                         for seed in self.seeds:
-                            case = Case(
+                            case = RunConfig(
                                 scene=sc.path,
                                 params=unknowns,
                                 estimator=est.name,
@@ -331,7 +331,7 @@ def check_unique(cells: list[Cell]) -> None:
             a = seen[c.key]
             raise SpecError(
                 f"cells {a.index} and {c.index} are the same run (scene {c.scene!r}, unknowns "
-                f"{'+'.join(c.case.params)}, estimator {c.label!r}, seed {c.case.seed}); remove the repeated entry"
+                f"{'+'.join(c.config.params)}, estimator {c.label!r}, seed {c.config.seed}); remove the repeated entry"
             )
         seen[c.key] = c
 
@@ -350,8 +350,9 @@ def load_spec(path: str | Path) -> Spec:
 
 
 def _check_names(spec: Spec) -> None:
-    from physbench.experiment import case_space, make_estimator
-    from physbench.plugins import create, get_registry
+    from physbench.experiment import config_space, make_estimator, make_renderer
+    from physbench.plugins import get_registry
+    from physbench.render.base import DEFAULT_RENDERER, ObservationModel
     from physbench.scenes import resolve_scene
 
     reg = get_registry()
@@ -361,15 +362,15 @@ def _check_names(spec: Spec) -> None:
             make_estimator(est.name, est.options)
         for e in {*spec.axes["engine"], *(v for v in spec.axes["observe_engine"] if v is not None)}:
             reg.get("simulator", e)
-        for res, mode, blur, noise in itertools.product(
-            *(spec.axes[a] for a in ("resolution", "render_mode", "blur", "noise"))
-        ):
-            create("renderer", "raster", resolution=res, mode=mode, blur=blur, noise=noise)
+        for res, mode in itertools.product(spec.axes["resolution"], spec.axes["render_mode"]):
+            make_renderer(DEFAULT_RENDERER, {}, resolution=res, mode=mode)
+        for blur, noise in itertools.product(spec.axes["blur"], spec.axes["noise"]):
+            ObservationModel(blur=blur, noise=noise)
         for sc in spec.scenes:
             scene = resolve_scene(sc.path, spec.seeds[0])
             for unknowns in sc.unknowns:
-                case_space(
-                    Case(scene=sc.path, params=unknowns, bodies=sc.bodies, seed=spec.seeds[0]),
+                config_space(
+                    RunConfig(scene=sc.path, params=unknowns, bodies=sc.bodies, seed=spec.seeds[0]),
                     scene,
                 )
     except UnknownNameError as exc:

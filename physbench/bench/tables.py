@@ -172,7 +172,7 @@ def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str
             "t_render": r.get("t_render"),
             "t_estimator": r.get("t_estimator"),
         }
-        for r in hist["records"]
+        for r in hist.get("iterations", hist.get("records", ()))  # "records": written before 0.2
     ]
 
 

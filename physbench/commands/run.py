@@ -9,9 +9,10 @@ image MSE is reported.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from typing import Any
+
+from physbench.commands.arguments import add_renderer_arguments
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -74,19 +75,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="NAME",
         help="simulator that makes the observation (default: --engine); another engine gives a sim-to-sim reality gap",
     )
-    p.add_argument(
-        "--resolution",
-        type=int,
-        default=64,
-        metavar="PX",
-        help="frame width in pixels (default: 64)",
-    )
-    p.add_argument(
-        "--render-mode",
-        default="mark",
-        choices=("mark", "instance", "mask"),
-        help="raster channels (default: mark)",
-    )
+    add_renderer_arguments(p)
     p.add_argument(
         "--blur",
         type=float,
@@ -130,23 +119,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
-def parse_options(items: list[str]) -> dict[str, Any]:
-    """``["startup=5", "sampler=cmaes"]`` -> ``{"startup": 5, "sampler": "cmaes"}``."""
-    from physbench.errors import PhysbenchError
-
-    out: dict[str, Any] = {}
-    for item in items:
-        key, sep, raw = item.partition("=")
-        if not sep or not key.strip():
-            raise PhysbenchError(f"--option {item!r}: expected KEY=VALUE, e.g. startup=5")
-        try:
-            value = json.loads(raw)
-        except ValueError:
-            value = raw
-        out[key.strip()] = value
-    return out
-
-
 def _fmt(v: float | None) -> str:
     return "-" if v is None else f"{v:.3e}"
 
@@ -160,7 +132,7 @@ def print_table(history: Any, out: Any = sys.stdout) -> None:
     )
     head += (["best norm"] if has_truth else []) + ["sim ms", "render ms", "est ms"]
     rows = []
-    for r in history.records:
+    for r in history.iterations:
         row = [str(r.iteration), *(f"{r.params[k]:.4g}" for k in keys), _fmt(r.loss)]
         row += [_fmt(r.nmse)] if has_truth else []
         row += [str(r.best_iteration), _fmt(r.best_loss)] + (
@@ -192,7 +164,8 @@ def main(args: argparse.Namespace) -> int:
     if args.seed < 0:
         raise PhysbenchError(f"--seed {args.seed}: expected a whole number >= 0")
 
-    from physbench.experiment import Case, case_space, make_estimator, run_case
+    from physbench.commands.arguments import parse_key_values, renderer_choice
+    from physbench.experiment import RunConfig, check_config, run_config
 
     params = tuple(q for item in args.params for q in item.split(",") if q)
     bodies = (
@@ -200,15 +173,18 @@ def main(args: argparse.Namespace) -> int:
         if args.bodies is None
         else tuple(b for item in args.bodies for b in item.split(",") if b)
     )
-    case = Case(
+    renderer, renderer_options = renderer_choice(args)
+    config = RunConfig(
         scene=args.scene,
         params=params,
         estimator=args.estimator,
-        options=parse_options(args.option),
+        options=parse_key_values(args.option, "--option"),
         seed=args.seed,
         iterations=args.iterations,
         engine=args.engine,
         observe_engine=args.observe_engine,
+        renderer=renderer,
+        renderer_options=renderer_options,
         blur=args.blur,
         noise=args.noise,
         resolution=args.resolution,
@@ -216,8 +192,7 @@ def main(args: argparse.Namespace) -> int:
         bodies=bodies,
         observation=args.observation,
     )
-    space = case_space(case)  # unknown scene or parameter: fail before the progress bar appears
-    make_estimator(case.estimator, case.options)
+    space = check_config(config)  # a bad name or option: fail before the progress bar appears
 
     from tqdm import tqdm
 
@@ -238,7 +213,7 @@ def main(args: argparse.Namespace) -> int:
         bar.update(1)
 
     try:
-        history = run_case(case, callback=progress, save_observation=args.save_observation)
+        history = run_config(config, callback=progress, save_observation=args.save_observation)
     finally:
         bar.close()
 
@@ -269,9 +244,9 @@ def main(args: argparse.Namespace) -> int:
             f"best (iteration {best.iteration}, by image MSE): "
             + "  ".join(f"{k}={v:.4g}" for k, v in best.params.items())
         )
-    if history.min_nmse is not None:
+    if history.best_nmse is not None:
         print(
-            f"normalized min MSE after {n} iterations: {history.min_nmse:.3e} "
+            f"normalized min MSE after {n} iterations: {history.best_nmse:.3e} "
             f"(initial guess {history.initial_nmse:.3e}; min image MSE {history.min_loss:.3e})"
         )
     else:

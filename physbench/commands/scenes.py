@@ -29,7 +29,7 @@ def main(args: argparse.Namespace) -> int:
         )
         by_param: dict[str, list[str]] = {}
         for u in scene.unknowns:
-            by_param.setdefault(u.param, []).append(f"{u.body} [{u.low:g}, {u.high:g}]")
+            by_param.setdefault(u.name, []).append(f"{u.owner} [{u.low:g}, {u.high:g}]")
         for param, items in by_param.items():
             print(f"    unknown {param}: {', '.join(items)}")
         if not scene.unknowns:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from physbench.commands.arguments import add_renderer_arguments, make_renderer_from
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scene", required=True, help="registered scene name or a scene .toml file")
@@ -18,10 +20,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="BODY.PARAM=VALUE",
         help="override a body parameter, e.g. --set a.mass=3 (repeatable)",
     )
-    p.add_argument("--resolution", type=int, default=64, help="frame width in pixels (default 64)")
-    p.add_argument(
-        "--mode", default="mark", help="renderer mode: mark, instance or mask (default mark)"
-    )
+    add_renderer_arguments(p)
     p.add_argument("--out", metavar="FILE.npz", help="write trajectory and frames here")
     p.add_argument("--preview", metavar="FILE.gif|png", help="write a picture of the run")
 
@@ -56,10 +55,9 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(f"--out {args.out!r}: the output is an .npz file")
     scene = resolve_scene(args.scene, args.seed)
     scene = scene.with_params(parse_overrides(args.set)).validate()
+    renderer = make_renderer_from(args)  # a bad renderer or option fails before simulating
     traj = create("simulator", args.engine).simulate(scene)
-    frames = create("renderer", "raster", resolution=args.resolution, mode=args.mode).render(
-        scene, traj
-    )
+    frames = renderer.render(scene, traj)
     print(
         f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies {', '.join(traj.bodies)}, "
         f"frames {frames.shape}"

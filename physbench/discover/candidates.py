@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 from physbench.errors import UnknownNameError
 
 if TYPE_CHECKING:
-    from physbench.protocols import Effect
+    from physbench.effects.base import Effect
     from physbench.scene import Scene
 
 #: Effects that act on a body's translation like a loss; offered for free bodies only.

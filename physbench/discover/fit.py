@@ -289,13 +289,13 @@ def estimator_fit(
     """Search ``free`` with a registered black-box estimator (``tpe``, ``cmaes``, ``optuna``,
     ``random``, ...), one simulation per iteration, on the mean squared residual of the fit part;
     returns the best values found (the model's values are set to them)."""
+    from physbench.estimators.base import Step, Task
     from physbench.params import ParamSpace
     from physbench.plugins import create
-    from physbench.protocols import Step, Task
-    from physbench.scene import Unknown
+    from physbench.scene import body_unknown
 
     est = create("estimator", estimator, **(options or {}))
-    if getattr(est, "per_object", False):
+    if est.per_object:
         raise DiscoverError(
             f"estimator {estimator!r} corrects marked objects in images; discovery needs a black-box estimator "
             "(tpe, cmaes, optuna, random) or 'lsq'"
@@ -305,7 +305,7 @@ def estimator_fit(
     ps = [model.param(k) for k in free]
     space = ParamSpace(
         tuple(
-            Unknown(k.rpartition(".")[0], k.rpartition(".")[2], p.low, p.high)
+            body_unknown(k.rpartition(".")[0], k.rpartition(".")[2], p.low, p.high)
             for k, p in zip(free, ps, strict=True)
         )
     )
@@ -318,7 +318,8 @@ def estimator_fit(
             space=space,
             observation=np.zeros((0, 1, 1, 1), np.float32),
             initial=current,
-            meta={"iterations": iterations},
+            renderer=None,
+            iterations=iterations,
         ),
         seed=seed,
     )

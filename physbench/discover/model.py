@@ -31,7 +31,9 @@ from physbench.scene import Scene
 from physbench.trajectory import Trajectory
 
 if TYPE_CHECKING:
-    from physbench.protocols import Effect, Renderer, Simulator
+    from physbench.effects.base import Effect
+    from physbench.render.base import Renderer
+    from physbench.simulators.base import Simulator
 
 NUISANCE = ("x0", "y0", "angle0", "vx0", "vy0", "omega0")
 #: Typical size of a change of each nuisance (optimiser scaling and finite-difference unit).
@@ -252,16 +254,16 @@ def body_params(scene: Scene) -> list[Param]:
     """The scene's declared unknowns, starting from the scene's values (clipped into range)."""
     out = []
     for u in scene.unknowns:
-        b = scene.bodies[scene.body_index(u.body)]
-        v = getattr(b, u.param)
+        b = scene.bodies[scene.body_index(u.owner)]
+        v = getattr(b, u.name)
         if v is None:  # moment from the shape
             v = b.inertia()
         out.append(
             Param(
                 u.key,
                 "body",
-                u.body,
-                u.param,
+                u.owner,
+                u.name,
                 float(min(max(v, u.low), u.high)),
                 u.low,
                 u.high,

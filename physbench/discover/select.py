@@ -33,7 +33,9 @@ from physbench.errors import SimulationError
 if TYPE_CHECKING:
     from physbench.discover.diagnostics import Finding
     from physbench.discover.residuals import Breakdown
-    from physbench.protocols import Effect, Renderer, Simulator
+    from physbench.effects.base import Effect
+    from physbench.render.base import Renderer
+    from physbench.simulators.base import Simulator
 
 
 @dataclass(frozen=True)

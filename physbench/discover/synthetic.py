@@ -18,7 +18,7 @@ import numpy as np
 
 from physbench.discover.data import Run
 from physbench.recording import Recording, Track
-from physbench.scene import Body, Box, Circle, Force, Joint, Scene, Segment, Unknown
+from physbench.scene import Body, Box, Circle, Force, Joint, Scene, Segment, body_unknown
 from physbench.trajectory import Trajectory
 
 G = 9.81
@@ -261,7 +261,7 @@ def bouncer(rng: np.random.Generator) -> Scene:
         frames=41,
         substeps=20,
         statics=walls,
-        unknowns=(Unknown("ball", "elasticity", 0.3, 1.0),),
+        unknowns=(body_unknown("ball", "elasticity", 0.3, 1.0),),
     )
 
 
@@ -450,9 +450,9 @@ def _blur(scene: Scene, rng: np.random.Generator) -> Scene:
             }
     scene = apply_initial(scene, state, {})
     for u in scene.unknowns:
-        b = scene.bodies[scene.body_index(u.body)]
+        b = scene.bodies[scene.body_index(u.owner)]
         guess = float(
-            np.clip(getattr(b, u.param) + 0.1 * (u.high - u.low) * _sign(rng), u.low, u.high)
+            np.clip(getattr(b, u.name) + 0.1 * (u.high - u.low) * _sign(rng), u.low, u.high)
         )
         scene = scene.with_params({u.key: guess})
     return scene

@@ -1,8 +1,8 @@
-"""Built-in model extensions (:class:`~physbench.protocols.Effect` plugins).
+"""Built-in model extensions (:class:`~physbench.effects.base.Effect` plugins).
 
 Each adds named parameters and acts through forces and torques that both engines apply the same
 way every substep. Measurement effects (:class:`SensorOffset`, :class:`ClockScale`) apply no forces
-and change the simulated trajectory through ``measure`` instead; :func:`apply_measurements` is what
+and change the simulated trajectory through :meth:`~Effect.measure` instead; :func:`apply_measurements` is what
 the framework calls on every simulated trajectory before comparing it with data.
 """
 
@@ -11,13 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from physbench.effects.base import (
-    EffectBase,
-    EffectError,
-    MeasurementEffect,
-    smooth_sign,
-    smooth_unit,
-)
+from physbench.effects.base import Effect, EffectError, smooth_sign, smooth_unit
 from physbench.effects.contact import VelocityDependentRestitution, restitution_law
 from physbench.effects.drag import LinearDrag, QuadraticDrag
 from physbench.effects.forces import ConstantForce, TableTilt
@@ -32,7 +26,7 @@ from physbench.hookspecs import hookimpl
 from physbench.trajectory import Trajectory
 
 #: Every built-in effect class, in registration order.
-BUILTIN_EFFECTS: tuple[type[EffectBase], ...] = (
+BUILTIN_EFFECTS: tuple[type[Effect], ...] = (
     LinearDrag,
     QuadraticDrag,
     RollingResistance,
@@ -47,11 +41,11 @@ BUILTIN_EFFECTS: tuple[type[EffectBase], ...] = (
 )
 
 
-def apply_measurements(traj: Trajectory, effects: Iterable[Any]) -> Trajectory:
-    """Called after every simulation: ``traj`` passed through the ``measure`` of each effect that
-    has one, in order. Effects without ``measure`` are skipped."""
+def apply_measurements(traj: Trajectory, effects: Iterable[Effect]) -> Trajectory:
+    """Called after every simulation: ``traj`` passed through the :meth:`~Effect.measure` of each
+    effect that :attr:`~Effect.measures`, in order."""
     for eff in effects:
-        if isinstance(eff, MeasurementEffect):
+        if eff.measures:
             traj = eff.measure(traj)
     return traj
 
@@ -65,13 +59,12 @@ __all__ = [
     "BUILTIN_EFFECTS",
     "ClockScale",
     "ConstantForce",
-    "EffectBase",
+    "Effect",
     "EffectError",
     "JointCoulombFriction",
     "JointQuadraticDamping",
     "JointViscousDamping",
     "LinearDrag",
-    "MeasurementEffect",
     "QuadraticDrag",
     "RollingResistance",
     "SensorOffset",

@@ -1,13 +1,26 @@
-"""Shared machinery of the built-in effects: parameter handling, body/joint selection, smoothing.
+"""The Effect contract, and the machinery every effect shares: parameter values, body selection,
+smoothing.
+
+An effect is a model extension (drag, rolling resistance, joint damping, a contact law, a sensor
+bias) that every engine applies the same way. It acts in up to three ways, each declared by a
+class trait so that the framework calls only what an effect uses:
+
+``applies_forces`` (default ``True``)
+    :meth:`Effect.forces` is called every substep and its forces and torques are applied;
+``changes_contacts`` (default ``False``)
+    :meth:`Effect.restitution` is installed as the engine's contact hook;
+``measures`` (default ``False``)
+    :meth:`Effect.measure` is applied to every simulated trajectory before it is compared with
+    data (:func:`physbench.effects.apply_measurements`).
 
 An effect is configured in two ways that combine: keyword values at construction
-(``LinearDrag(c=0.1)``) and :meth:`EffectBase.setup` before each simulation, whose values override
+(``LinearDrag(c=0.1)``) and :meth:`Effect.setup` before each simulation, whose values override
 the constructor's. Values are keyed by the bare parameter name (``"c"``) or the qualified one
 (``"linear_drag.c"``, or ``"<label>.c"`` for an instance built with ``label=...``); every value must
 be finite and inside the parameter's ``[low, high]``.
 
-The simulators call :meth:`EffectBase.setup` themselves before every simulation, with the scene as
-simulated and the values found in ``simulate(params=...)`` under the effect's :attr:`~EffectBase.key`
+The simulators call :meth:`Effect.setup` themselves before every simulation, with the scene as
+simulated and the values found in ``simulate(params=...)`` under the effect's :attr:`Effect.key`
 (``{"linear_drag.c": 0.2}``), so an effect can be fitted like any body parameter. Two instances of
 one effect need distinct labels (``LinearDrag(label="drag_a", bodies=["a"])``): the label is the
 prefix of their parameter keys.
@@ -16,13 +29,13 @@ prefix of their parameter keys.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
-from typing import TYPE_CHECKING, ClassVar, Protocol, runtime_checkable
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
 from physbench.errors import PhysbenchError, UnknownNameError
-from physbench.protocols import EffectParam
+from physbench.parameter import Parameter
 
 if TYPE_CHECKING:
     from physbench.scene import Scene
@@ -31,16 +44,6 @@ if TYPE_CHECKING:
 
 class EffectError(PhysbenchError, ValueError):
     """A bad effect value or configuration; the message names the effect, the key and the value."""
-
-
-@runtime_checkable
-class MeasurementEffect(Protocol):
-    """An effect on what the sensor reports rather than on the dynamics."""
-
-    def measure(self, traj: Trajectory) -> Trajectory:
-        """Called after every simulation, before the trajectory is compared with a recording:
-        returns the trajectory as the sensor would have reported it."""
-        ...
 
 
 def smooth_sign(v: np.ndarray, eps: float | np.ndarray) -> np.ndarray:
@@ -59,15 +62,28 @@ def substep(scene: Scene) -> float:
     return scene.dt / scene.substeps
 
 
-class EffectBase:
-    """Base of the built-in effects. Subclasses set ``name``, ``params``, and implement
-    :meth:`forces` (and :meth:`configure` when they precompute from the scene)."""
+class Effect:
+    """Base class of every effect (plugin contract).
 
+    Subclasses set the class attributes :attr:`name` and :attr:`params` (each
+    :class:`~physbench.params.Parameter` with a ``default`` inside its range) and the traits they
+    need, and override :meth:`forces`, :meth:`restitution` or :meth:`measure` accordingly;
+    :meth:`configure` is the place to precompute from the scene. Constructor keywords:
+    ``bodies`` (names of the bodies it acts on; default all), ``label`` (the key prefix of its
+    parameters; default :attr:`name`) and parameter values.
+    """
+
+    #: Registered name (unique among effects).
     name: ClassVar[str] = ""
-    params: ClassVar[tuple[EffectParam, ...]] = ()
-    #: False for effects whose :meth:`forces` are always zero (measurement and contact laws): the
-    #: stepping loop then does not call them every substep.
+    #: The parameters the effect adds to the model, without owner (instances qualify them).
+    params: ClassVar[tuple[Parameter, ...]] = ()
+    #: Whether :meth:`forces` can be non-zero; ``False`` (contact laws, measurement effects) keeps
+    #: the stepping loop from calling it every substep.
     applies_forces: ClassVar[bool] = True
+    #: Whether :meth:`restitution` replaces the scene's restitution when a contact starts.
+    changes_contacts: ClassVar[bool] = False
+    #: Whether :meth:`measure` changes the reported trajectory.
+    measures: ClassVar[bool] = False
 
     def __init__(
         self, *, bodies: Iterable[str] | None = None, label: str | None = None, **values: float
@@ -83,7 +99,12 @@ class EffectBase:
         self.bodies = None if bodies is None else tuple(bodies)
         #: Prefix of this instance's parameter keys (``"<key>.<param>"``): the label, else the name.
         self.key: str = label or self.name
-        self.values: dict[str, float] = {p.name: p.default for p in self.params}
+        missing = [p.name for p in self.params if p.default is None]
+        if missing:
+            raise EffectError(
+                f"effect {self.name!r} declares parameters {missing} without a default"
+            )
+        self.values: dict[str, float] = {p.name: float(p.default or 0.0) for p in self.params}
         self.values.update(self._checked(values))
         self.scene: Scene | None = None
         self.mask = np.zeros(0, dtype=bool)
@@ -103,8 +124,12 @@ class EffectBase:
 
     # ----------------------------------------------------------------- configuration
 
+    def parameters(self) -> tuple[Parameter, ...]:
+        """This instance's parameters, qualified by its :attr:`key` (``linear_drag.c``)."""
+        return tuple(p.owned_by(self.key) for p in self.params)
+
     @classmethod
-    def param(cls, name: str) -> EffectParam:
+    def param(cls, name: str) -> Parameter:
         for p in cls.params:
             if p.name == name:
                 return p
@@ -121,13 +146,11 @@ class EffectBase:
                 value, int | float | np.floating | np.integer
             ):
                 raise EffectError(
-                    f"{self.key}.{name} = {value!r}: must be a number in [{p.low:g}, {p.high:g}] {p.unit}"
+                    f"{self.key}.{name} = {value!r}: must be a number in {p.describe()}"
                 )
             v = float(value)
             if not math.isfinite(v) or not p.low <= v <= p.high:
-                raise EffectError(
-                    f"{self.key}.{name} = {v!r}: must lie in [{p.low:g}, {p.high:g}] {p.unit}".rstrip()
-                )
+                raise EffectError(f"{self.key}.{name} = {v!r}: must lie in {p.describe()}")
             out[name] = v
         return out
 
@@ -166,69 +189,23 @@ class EffectBase:
     # ----------------------------------------------------------------- forces
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Called every substep with ``(N, 6)`` CoM states; returns ``(N, 2)`` forces and
-        ``(N,)`` torques."""
-        raise NotImplementedError
+        """Called every substep (when :attr:`applies_forces`) with ``states`` ``(N, 6)`` (x, y,
+        angle, vx, vy, omega of the centres of mass). Returns forces ``(N, 2)`` in N and torques
+        ``(N,)`` in N·m. Default: none."""
+        return self.zeros(states.shape[0])
+
+    def restitution(self, normal_speed: float, a: int, b: int | None) -> float | None:
+        """Called by the engine (when :attr:`changes_contacts`) once when a contact starts between
+        bodies ``a`` and ``b`` (indices into ``scene.bodies``, ``b`` ``None`` for static geometry)
+        with the approach speed along the normal (m/s, >= 0). Returns the coefficient of
+        restitution for that contact, or ``None`` to keep the scene's. Default: ``None``."""
+        return None
+
+    def measure(self, traj: Trajectory) -> Trajectory:
+        """Called after every simulation (when :attr:`measures`), before the trajectory is
+        compared with data: the trajectory as the sensor would have reported it. Default: as is."""
+        return traj
 
     @staticmethod
     def zeros(n: int) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros((n, 2)), np.zeros(n)
-
-
-class JointEffectBase(EffectBase):
-    """A torque law on the relative rotation rate of each selected pivot joint.
-
-    A joint to the world gets ``tau = law(omega_a)`` on body ``a``; a joint between two bodies
-    gets ``law(omega_a - omega_b)`` on ``a`` and the opposite on ``b``. ``joints`` selects joints
-    by index into ``scene.joints`` (default: all). ``bodies`` is not used by joint effects.
-    """
-
-    def __init__(self, *, joints: Sequence[int] | None = None, **values: float) -> None:
-        super().__init__(**values)
-        self.joints = None if joints is None else tuple(int(j) for j in joints)
-        self.ia = np.zeros(0, dtype=int)
-        self.ib = np.zeros(0, dtype=int)  # -1: the world
-        self.reduced_inertia = np.zeros(0)
-        self._to_world = False
-
-    def configure(self, scene: Scene) -> None:
-        chosen = range(len(scene.joints)) if self.joints is None else self.joints
-        if not scene.joints:
-            raise EffectError(
-                f"effect {self.name!r} needs a scene with joints; scene {scene.name!r} has none"
-            )
-        for j in chosen:
-            if not 0 <= j < len(scene.joints):
-                raise EffectError(
-                    f"{self.name}: joint index {j} out of range; scene {scene.name!r} has joints 0..{len(scene.joints) - 1}"
-                )
-        sel = [scene.joints[j] for j in chosen]
-        self.ia = np.array([scene.body_index(j.a) for j in sel], dtype=int)
-        self.ib = np.array(
-            [scene.body_index(j.b) if j.b is not None else -1 for j in sel], dtype=int
-        )
-        ia_inv = 1.0 / self.inertias[self.ia]
-        ib_inv = np.where(self.ib >= 0, 1.0 / self.inertias[np.maximum(self.ib, 0)], 0.0)
-        # Smallest inertia the torque acts on: the pivot only adds inertia, so this bounds the
-        # fastest response of the relative rate and sets the regularisation floor.
-        self.reduced_inertia = 1.0 / (ia_inv + ib_inv)
-        self._to_world = bool(np.all(self.ib < 0) and len(set(self.ia.tolist())) == len(self.ia))
-
-    def law(self, rate: np.ndarray) -> np.ndarray:
-        """Torque on body ``a`` for relative rates ``rate`` (one per selected joint)."""
-        raise NotImplementedError
-
-    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        self._require_setup(states)
-        n = states.shape[0]
-        f, tau = self.zeros(n)
-        omega = states[:, 5]
-        if self._to_world:  # every selected joint ties a distinct body to the world
-            tau[self.ia] = self.law(omega[self.ia])
-            return f, tau
-        rate = omega[self.ia] - np.where(self.ib >= 0, omega[np.maximum(self.ib, 0)], 0.0)
-        torque = self.law(rate)
-        np.add.at(tau, self.ia, torque)
-        has_b = self.ib >= 0
-        np.add.at(tau, self.ib[has_b], -torque[has_b])
-        return f, tau

@@ -1,7 +1,7 @@
 """Contact laws that replace the scene's constant restitution.
 
 They act through the simulators' contact hook, not through forces: when a contact starts, the
-stepping loop asks every effect that has a ``restitution`` method for the coefficient to use (see
+stepping loop asks every effect with ``changes_contacts`` set for the coefficient to use (see
 :meth:`VelocityDependentRestitution.restitution`). pymunk applies it for the whole contact;
 Box2D still treats impacts slower than its compiled-in 1 m/s as inelastic.
 """
@@ -12,8 +12,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from physbench.effects.base import EffectBase
-from physbench.protocols import EffectParam
+from physbench.effects.base import Effect
+from physbench.parameter import Parameter
 
 
 def restitution_law(normal_speed: float | np.ndarray, e0: float, k: float) -> float | np.ndarray:
@@ -22,7 +22,7 @@ def restitution_law(normal_speed: float | np.ndarray, e0: float, k: float) -> fl
     return float(e) if np.ndim(e) == 0 else e
 
 
-class VelocityDependentRestitution(EffectBase):
+class VelocityDependentRestitution(Effect):
     """Coefficient of restitution ``e(v) = clip(e0 - k·v, 0, 1)`` for impacts at normal speed ``v``
     (m/s), replacing the product of the two materials' elasticities.
 
@@ -32,17 +32,22 @@ class VelocityDependentRestitution(EffectBase):
 
     name: ClassVar[str] = "velocity_dependent_restitution"
     applies_forces: ClassVar[bool] = False
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("e0", 0.9, 0.0, 1.0, "", "restitution of a very slow impact"),
-        EffectParam("k", 0.0, 0.0, 1.0, "s/m", "restitution lost per m/s of normal impact speed"),
+    changes_contacts: ClassVar[bool] = True
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("e0", 0.0, 1.0, default=0.9, doc="restitution of a very slow impact"),
+        Parameter(
+            "k",
+            0.0,
+            1.0,
+            unit="s/m",
+            default=0.0,
+            doc="restitution lost per m/s of normal impact speed",
+        ),
     )
 
     def __init__(self, *, statics_only: bool = False, **kw: object) -> None:
         super().__init__(**kw)  # type: ignore[arg-type]
         self.statics_only = bool(statics_only)
-
-    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return self.zeros(states.shape[0])
 
     def restitution(self, normal_speed: float, a: int, b: int | None) -> float | None:
         """Called by the engine once when a new contact starts between body ``a`` and body ``b``

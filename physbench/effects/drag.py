@@ -6,16 +6,16 @@ from typing import ClassVar
 
 import numpy as np
 
-from physbench.effects.base import EffectBase
-from physbench.protocols import EffectParam
+from physbench.effects.base import Effect
+from physbench.parameter import Parameter
 
 
-class LinearDrag(EffectBase):
+class LinearDrag(Effect):
     """``F = -c v`` on the centre of mass of each selected body (default: all)."""
 
     name: ClassVar[str] = "linear_drag"
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("c", 0.0, 0.0, 10.0, "N·s/m", "drag force per unit speed"),
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("c", 0.0, 10.0, unit="N·s/m", default=0.0, doc="drag force per unit speed"),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -25,15 +25,15 @@ class LinearDrag(EffectBase):
         return f, tau
 
 
-class QuadraticDrag(EffectBase):
+class QuadraticDrag(Effect):
     """``F = -c |v| v`` on the centre of mass of each selected body (default: all).
 
     ``c = ½ ρ C_d A``; a body of mass ``m`` falling under ``g`` tends to ``sqrt(m g / c)``.
     """
 
     name: ClassVar[str] = "quadratic_drag"
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("c", 0.0, 0.0, 1.0, "kg/m", "drag force per unit squared speed"),
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("c", 0.0, 1.0, unit="kg/m", default=0.0, doc="drag force per unit squared speed"),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

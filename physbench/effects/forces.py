@@ -7,17 +7,17 @@ from typing import ClassVar
 
 import numpy as np
 
-from physbench.effects.base import EffectBase
-from physbench.protocols import EffectParam
+from physbench.effects.base import Effect
+from physbench.parameter import Parameter
 
 
-class ConstantForce(EffectBase):
+class ConstantForce(Effect):
     """``F = (fx, fy)`` on the centre of mass of each selected body (default: all)."""
 
     name: ClassVar[str] = "constant_force"
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("fx", 0.0, -10.0, 10.0, "N", "force along x"),
-        EffectParam("fy", 0.0, -10.0, 10.0, "N", "force along y"),
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("fx", -10.0, 10.0, unit="N", default=0.0, doc="force along x"),
+        Parameter("fy", -10.0, 10.0, unit="N", default=0.0, doc="force along y"),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -27,13 +27,13 @@ class ConstantForce(EffectBase):
         return f, tau
 
 
-class TableTilt(EffectBase):
+class TableTilt(Effect):
     """``F = m (ax, ay)``: the in-plane pull of gravity on a slightly tilted table (``a ≈ g·slope``)."""
 
     name: ClassVar[str] = "table_tilt"
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("ax", 0.0, -1.0, 1.0, "m/s²", "acceleration along x"),
-        EffectParam("ay", 0.0, -1.0, 1.0, "m/s²", "acceleration along y"),
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("ax", -1.0, 1.0, unit="m/s²", default=0.0, doc="acceleration along x"),
+        Parameter("ay", -1.0, 1.0, unit="m/s²", default=0.0, doc="acceleration along y"),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -11,16 +11,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from physbench.effects.base import EffectBase, EffectError
-from physbench.protocols import EffectParam
+from physbench.effects.base import Effect, EffectError
+from physbench.parameter import Parameter
 from physbench.trajectory import Trajectory
 
 
-class _Measurement(EffectBase):
+class _Measurement(Effect):
     applies_forces: ClassVar[bool] = False
-
-    def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return self.zeros(states.shape[0])
+    measures: ClassVar[bool] = True
 
     def _body_mask(self, traj: Trajectory) -> np.ndarray:
         if self.bodies is None:
@@ -38,10 +36,10 @@ class SensorOffset(_Measurement):
     (default: all), e.g. an encoder zero that is not the rest angle."""
 
     name: ClassVar[str] = "sensor_offset"
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("dx", 0.0, -0.5, 0.5, "m", "bias of the tracked x"),
-        EffectParam("dy", 0.0, -0.5, 0.5, "m", "bias of the tracked y"),
-        EffectParam("dangle", 0.0, -0.5, 0.5, "rad", "bias of the tracked angle"),
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("dx", -0.5, 0.5, unit="m", default=0.0, doc="bias of the tracked x"),
+        Parameter("dy", -0.5, 0.5, unit="m", default=0.0, doc="bias of the tracked y"),
+        Parameter("dangle", -0.5, 0.5, unit="rad", default=0.0, doc="bias of the tracked angle"),
     )
 
     def measure(self, traj: Trajectory) -> Trajectory:
@@ -63,8 +61,8 @@ class ClockScale(_Measurement):
     """
 
     name: ClassVar[str] = "clock_scale"
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("scale", 1.0, 0.8, 1.25, "", "true seconds per recorded second"),
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter("scale", 0.8, 1.25, default=1.0, doc="true seconds per recorded second"),
     )
 
     def measure(self, traj: Trajectory) -> Trajectory:

@@ -7,12 +7,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from physbench.effects.base import EffectBase, smooth_unit, substep
-from physbench.protocols import EffectParam
+from physbench.effects.base import Effect, smooth_unit, substep
+from physbench.parameter import Parameter
 from physbench.scene import Scene
 
 
-class RollingResistance(EffectBase):
+class RollingResistance(Effect):
     """A constant deceleration ``mu·g`` against the velocity of each selected body, until it stops.
 
     ``F = -mu m g v / sqrt(|v|² + eps²)``. The regularisation speed ``eps`` keeps the force smooth
@@ -22,8 +22,15 @@ class RollingResistance(EffectBase):
     """
 
     name: ClassVar[str] = "rolling_resistance"
-    params: ClassVar[tuple[EffectParam, ...]] = (
-        EffectParam("mu", 0.0, 0.0, 0.1, "", "rolling resistance coefficient (deceleration / g)"),
+    params: ClassVar[tuple[Parameter, ...]] = (
+        Parameter(
+            "mu",
+            0.0,
+            0.1,
+            unit="",
+            default=0.0,
+            doc="rolling resistance coefficient (deceleration / g)",
+        ),
     )
 
     def __init__(self, *, g: float = 9.81, eps: float = 1e-3, **kw: object) -> None:

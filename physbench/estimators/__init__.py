@@ -1,102 +1,10 @@
-"""Built-in correction estimators and the base class of the gradient-free ones.
-
-Every built-in black-box optimiser works on the unit cube (each unknown's range mapped to [0, 1]
-by :meth:`~physbench.params.ParamSpace.to_unit`) and treats ``propose`` as *tell* (the loss of the
-parameters just simulated) followed by *ask*; the first point told is the initial guess. Importing
-an estimator module is cheap: the optimiser library is imported in :meth:`start`.
-"""
+"""Correction estimators: the contract (:mod:`~physbench.estimators.base`), the ask/tell base of
+the black-box optimisers (:mod:`~physbench.estimators.ask_tell`) and the built-ins, each in its own
+module and registered by name: ``random``, ``tpe``, ``cmaes``, ``optuna`` and the learned
+``resnet3d``."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, ClassVar
+from physbench.estimators.base import CorrectionEstimator, Step, Task
 
-import numpy as np
-
-from physbench.errors import PhysbenchError
-
-if TYPE_CHECKING:
-    from physbench.params import Params, ParamSpace
-    from physbench.protocols import Step, Task
-
-
-class EstimatorOptionError(PhysbenchError, ValueError):
-    """A bad estimator option; names the option, the value and what is accepted."""
-
-
-def int_option(
-    estimator: str, name: str, value: object, *, low: int, allow_none: bool = False
-) -> int | None:
-    """``value`` as an int ``>= low`` (or ``None`` when allowed), else :class:`EstimatorOptionError`."""
-    if value is None and allow_none:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
-        extra = " or None" if allow_none else ""
-        raise EstimatorOptionError(
-            f"{estimator}: {name} = {value!r}: expected a whole number >= {low}{extra}"
-        )
-    return int(value)
-
-
-def float_option(estimator: str, name: str, value: object, *, low: float, high: float) -> float:
-    """``value`` as a float in ``(low, high]``, else :class:`EstimatorOptionError`."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, int | float | np.floating)
-        or not low < value <= high
-    ):
-        raise EstimatorOptionError(
-            f"{estimator}: {name} = {value!r}: expected a number in ({low:g}, {high:g}]"
-        )
-    return float(value)
-
-
-def choice_option(estimator: str, name: str, value: object, choices: tuple[str, ...]) -> str:
-    if value not in choices:
-        raise EstimatorOptionError(
-            f"{estimator}: {name} = {value!r}: expected one of {', '.join(choices)}"
-        )
-    return str(value)
-
-
-class AskTellEstimator:
-    """Base of the gradient-free estimators: ``propose`` = tell the loss, then ask for a new point.
-
-    Subclasses set ``name``, store their options in ``self.options`` (recorded in the history) and
-    implement :meth:`_begin` (set up the optimiser; the first point told will be ``self.x0``),
-    :meth:`_tell` and :meth:`_ask` (a unit-cube vector).
-    """
-
-    name: ClassVar[str] = ""
-    per_object: ClassVar[bool] = False
-
-    def __init__(self) -> None:
-        self.options: dict[str, Any] = {}
-        self.space: ParamSpace | None = None
-        self.x0 = np.zeros(0)
-
-    def __repr__(self) -> str:
-        opts = ", ".join(f"{k}={v!r}" for k, v in self.options.items())
-        return f"{type(self).__name__}({opts})"
-
-    def start(self, task: Task, *, seed: int) -> None:
-        """Called once per run, before the first simulation: set up a fresh optimiser."""
-        self.space = task.space
-        self.x0 = task.space.to_unit(task.initial)
-        self._begin(task, int(seed))
-
-    def propose(self, step: Step) -> Params:
-        """Called after every simulation: tell ``step.loss`` for the point last asked (the initial
-        guess the first time), ask for the next one."""
-        if self.space is None:
-            raise PhysbenchError(f"estimator {self.name!r}: propose() called before start()")
-        self._tell(float(step.loss))
-        return self.space.from_unit(np.clip(np.asarray(self._ask(), dtype=float), 0.0, 1.0))
-
-    def _begin(self, task: Task, seed: int) -> None:
-        raise NotImplementedError
-
-    def _tell(self, loss: float) -> None:
-        raise NotImplementedError
-
-    def _ask(self) -> np.ndarray:
-        raise NotImplementedError
+__all__ = ["CorrectionEstimator", "Step", "Task"]

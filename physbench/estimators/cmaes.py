@@ -12,11 +12,12 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from physbench.estimators import AskTellEstimator, float_option, int_option
+from physbench.estimators.ask_tell import AskTellEstimator
+from physbench.estimators.options import float_option, int_option
 from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
-    from physbench.protocols import Task
+    from physbench.estimators.base import Task
 
 
 class CMAES(AskTellEstimator):
@@ -30,7 +31,7 @@ class CMAES(AskTellEstimator):
     ) -> None:
         super().__init__()
         if not isinstance(elitist, bool):
-            from physbench.estimators import EstimatorOptionError
+            from physbench.estimators.options import EstimatorOptionError
 
             raise EstimatorOptionError(
                 f"{self.name}: elitist = {elitist!r}: expected true or false"

@@ -13,12 +13,13 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from physbench.errors import PhysbenchError
-from physbench.estimators import AskTellEstimator, choice_option, int_option
+from physbench.estimators.ask_tell import AskTellEstimator
+from physbench.estimators.options import choice_option, int_option
 from physbench.estimators.tpe import DEFAULT_STARTUP
 from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
-    from physbench.protocols import Task
+    from physbench.estimators.base import Task
 
 SAMPLERS = ("tpe", "cmaes", "random", "qmc")
 #: Optuna's own TPE default, for comparison runs (``--option startup=10``).

@@ -6,11 +6,11 @@ from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
-from physbench.estimators import AskTellEstimator
+from physbench.estimators.ask_tell import AskTellEstimator
 from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
-    from physbench.protocols import Task
+    from physbench.estimators.base import Task
 
 
 class RandomSearch(AskTellEstimator):

@@ -15,11 +15,12 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from physbench.estimators import AskTellEstimator, float_option, int_option
+from physbench.estimators.ask_tell import AskTellEstimator
+from physbench.estimators.options import float_option, int_option
 from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
-    from physbench.protocols import Task
+    from physbench.estimators.base import Task
 
 DEFAULT_STARTUP = 5
 #: hyperopt's own default, for comparison runs (``--option startup=20``).

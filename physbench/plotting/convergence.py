@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 
 
 def _curves(runs: Sequence[History], field: str) -> np.ndarray | None:
-    vals = [[getattr(r, field) for r in h.records] for h in runs]
+    vals = [[getattr(r, field) for r in h.iterations] for h in runs]
     if any(v is None for row in vals for v in row):
         return None
     n = min(len(row) for row in vals)

@@ -24,50 +24,17 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from physbench.errors import PhysbenchError, UnknownNameError
+from physbench.errors import UnknownNameError
 from physbench.hookspecs import hookimpl
+from physbench.render.base import Renderer, RenderError
 from physbench.scene import Circle
 
 if TYPE_CHECKING:
     from physbench.scene import Scene, Shape
     from physbench.trajectory import Trajectory
 
-MODES = ("mark", "instance", "mask")
 #: Rendered geometries kept per renderer instance (one per distinct scene layout and length).
 _CACHE_SIZE = 8
-
-
-class RenderError(PhysbenchError, ValueError):
-    """Bad renderer options or inputs that do not fit the scene."""
-
-
-def _resolution(resolution: object) -> tuple[int, int] | int:
-    def ok(v: object) -> bool:
-        return isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= 1
-
-    if ok(resolution):
-        return int(resolution)  # type: ignore[arg-type]
-    if (
-        isinstance(resolution, tuple | list)
-        and len(resolution) == 2
-        and all(ok(v) for v in resolution)
-    ):
-        return (int(resolution[0]), int(resolution[1]))
-    raise RenderError(
-        f"resolution = {resolution!r}: expected a whole number >= 1 (image width, square pixels) "
-        "or a pair (height, width) of whole numbers >= 1"
-    )
-
-
-def _nonneg(name: str, value: object) -> float:
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, int | float)
-        or not math.isfinite(value)
-        or value < 0
-    ):
-        raise RenderError(f"{name} = {value!r}: expected a finite number >= 0")
-    return float(value)
 
 
 def image_size(
@@ -196,38 +163,16 @@ class _Layout:
         self.dirty = False
 
 
-class RasterRenderer:
-    """Segmentation-like frames with anti-aliased edges.
-
-    ``mode``: ``"mark"`` (the paper's: channel 0 holds every body but the focus body, channel 1 the
-    focus body, empty without a focus), ``"instance"`` (one channel per body, ``scene.bodies``
-    order) or ``"mask"`` (one channel, all bodies). ``blur`` (Gaussian sigma, pixels) and ``noise``
-    (Gaussian pixel noise sigma) form an optional observation model, applied in that order; the
-    noise is drawn from ``seed`` afresh in every call, so a render is a pure function of its inputs.
-    An instance keeps scratch buffers between calls: use one instance per thread.
+class RasterRenderer(Renderer):
+    """Segmentation-like frames with anti-aliased edges, in any of the :data:`MODES`
+    (``mark``, ``instance``, ``mask``). An instance keeps scratch buffers between calls: use one
+    instance per thread.
     """
 
     name: ClassVar[str] = "raster"
 
-    def __init__(
-        self,
-        resolution: int | tuple[int, int] = 64,
-        mode: str = "mark",
-        blur: float = 0.0,
-        noise: float = 0.0,
-        seed: int = 0,
-    ) -> None:
-        self.resolution = _resolution(resolution)
-        if mode not in MODES:
-            raise RenderError(
-                f"mode = {mode!r}: unknown render mode; known modes: {', '.join(MODES)}"
-            )
-        self.mode = mode
-        self.blur = _nonneg("blur", blur)
-        self.noise = _nonneg("noise", noise)
-        if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
-            raise RenderError(f"seed = {seed!r}: expected a whole number")
-        self.seed = int(seed)
+    def __init__(self, resolution: int | tuple[int, int] = 64, mode: str = "mark") -> None:
+        super().__init__(resolution, mode)
         self._layouts: dict[Any, _Layout] = {}
 
     def __getstate__(self) -> dict[str, Any]:
@@ -235,10 +180,7 @@ class RasterRenderer:
         return {**self.__dict__, "_layouts": {}}
 
     def __repr__(self) -> str:
-        return (
-            f"RasterRenderer(resolution={self.resolution!r}, mode={self.mode!r}, blur={self.blur:g}, "
-            f"noise={self.noise:g}, seed={self.seed})"
-        )
+        return f"RasterRenderer(resolution={self.resolution!r}, mode={self.mode!r})"
 
     # ------------------------------------------------------------------ sizes
 
@@ -311,13 +253,6 @@ class RasterRenderer:
                 win[g.at.reshape(-1)] = 0.0
             lay.dirty = False
 
-        if self.blur > 0 or self.noise > 0:
-            from physbench.render.observe import add_noise, gaussian_blur
-
-            if self.blur > 0:
-                out[...] = gaussian_blur(out, self.blur)
-            if self.noise > 0:
-                out[...] = add_noise(out, self.noise, np.random.default_rng(self.seed))
         return out
 
     def _channel_map(self, scene: Scene, focus: str | None) -> list[int]:

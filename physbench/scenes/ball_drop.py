@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from physbench.scene import Body, Circle, Scene, StaticPolygon, Unknown
-from physbench.scenes import scene_generator
+from physbench.scene import Body, Circle, Scene, StaticPolygon, body_unknown
+from physbench.scenes.generator import scene_generator
 
 OZ = 0.0283495  # kg per ounce
 #: name (as the data's CSV files) -> (weight in oz, circumference in cm), from ``balls.txt``.
@@ -86,7 +86,7 @@ def generate(
         frames=frames,
         substeps=substeps,
         statics=(ground,),
-        unknowns=(Unknown("ball", "mass", 0.5 * mass, 2.0 * mass),),
+        unknowns=(body_unknown("ball", "mass", 0.5 * mass, 2.0 * mass),),
         description=generate.description,
         meta={"seed": seed, "ball": ball},
     )

@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from physbench.scene import Body, Circle, Force, Scene, Segment, Unknown
-from physbench.scenes import scene_generator
+from physbench.scene import Body, Circle, Force, Scene, Segment, body_unknown
+from physbench.scenes.generator import scene_generator
 
 BOUNDS = (0.0, 0.0, 4.0, 4.0)
 RADIUS = 0.2
@@ -74,7 +74,7 @@ def generate(seed: int = 0, n_balls: int | None = None) -> Scene:
         gravity=(0.0, 0.0),
         statics=cushions,
         forces=(push,),
-        unknowns=tuple(Unknown(b.name, "mass", *MASS_RANGE) for b in balls),
+        unknowns=tuple(body_unknown(b.name, "mass", *MASS_RANGE) for b in balls),
         test_body="test",
         description=generate.description,
         meta={"seed": seed, "n_balls": n},

@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physbench.scene import Body, Box, Joint, Scene, Unknown
-from physbench.scenes import scene_generator
+from physbench.scene import Body, Box, Joint, Scene, body_unknown
+from physbench.scenes.generator import scene_generator
 
 
 @dataclass(frozen=True)
@@ -96,7 +96,7 @@ def generate(
         frames=frames,
         substeps=substeps,
         joints=(Joint("arm", pivot),),
-        unknowns=(Unknown("arm", "moment", *p.moment_range),),
+        unknowns=(body_unknown("arm", "moment", *p.moment_range),),
         description=generate.description,
         meta={"seed": seed, "rig": rig},
     )

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from physbench.scene import Body, Box, Circle, Force, Scene, Unknown
-from physbench.scenes import scene_generator
+from physbench.scene import Body, Box, Circle, Force, Scene, body_unknown
 from physbench.scenes.bin import bin_walls
+from physbench.scenes.generator import scene_generator
 
 BOUNDS = (0.0, 0.0, 4.0, 4.0)
 INSET = 0.15  # the floor is at y = 0.15 so that a box resting on it lies inside the bounds
@@ -47,7 +47,7 @@ def generate(seed: int = 0) -> Scene:
         Body("upper", Box(s, s), (xu, y0 + 1.5 * s), mass=m0, elasticity=e, friction=f0),
     )
     unknowns = tuple(
-        Unknown(name, p, lo, hi)
+        body_unknown(name, p, lo, hi)
         for name in ("lower", "upper")
         for p, (lo, hi) in (("mass", MASS_RANGE), ("friction", FRICTION_RANGE))
     )

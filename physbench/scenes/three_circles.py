@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 
-from physbench.scene import Body, Circle, Force, Scene, Unknown
-from physbench.scenes import scene_generator
+from physbench.scene import Body, Circle, Force, Scene, body_unknown
 from physbench.scenes.bin import bin_walls
+from physbench.scenes.generator import scene_generator
 
 BOUNDS = (0.0, 0.0, 4.0, 4.0)
 RADIUS = 0.3
@@ -53,7 +53,7 @@ def generate(seed: int = 0) -> Scene:
         Body("b", Circle(r), (xb, r), mass=m0, elasticity=e0, friction=FRICTION),
     )
     unknowns = tuple(
-        Unknown(name, p, lo, hi)
+        body_unknown(name, p, lo, hi)
         for name in ("a", "b")
         for p, (lo, hi) in (("mass", MASS_RANGE), ("elasticity", ELASTICITY_RANGE))
     )

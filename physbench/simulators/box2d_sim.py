@@ -24,7 +24,7 @@ from typing import Any, ClassVar
 from physbench.errors import SimulationError
 from physbench.hookspecs import hookimpl
 from physbench.scene import Body, Box, Circle, Scene, Segment
-from physbench.simulators.stepping import SteppingSimulator, initial_com_state
+from physbench.simulators.stepping import EngineWorld, SteppingSimulator, initial_com_state
 
 #: Half thickness (m) of the static box that stands in for a segment of radius 0.
 SEGMENT_HALF_THICKNESS = 1e-4
@@ -171,7 +171,9 @@ def _add_body(world: Any, b: Body, v: tuple[float, float], w: float) -> Any:
     return body
 
 
-class Box2DWorld:
+class Box2DWorld(EngineWorld):
+    contact_hook = True
+
     def __init__(self, scene: Scene, velocity_iterations: int, position_iterations: int) -> None:
         import Box2D
 

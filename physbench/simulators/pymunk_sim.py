@@ -17,13 +17,14 @@ from typing import Any, ClassVar
 
 from physbench.hookspecs import hookimpl
 from physbench.scene import Box, Circle, Scene, Segment
-from physbench.simulators.stepping import SteppingSimulator, initial_com_state
+from physbench.simulators.stepping import EngineWorld, SteppingSimulator, initial_com_state
 
 #: Allowed overlap between shapes (m); Box2D's linear slop is the same 5 mm.
 COLLISION_SLOP = 0.005
 
 
-class PymunkWorld:
+class PymunkWorld(EngineWorld):
+    contact_hook = True
     max_speed = math.inf  # Chipmunk never clamps motion
     max_angular_speed = math.inf
 

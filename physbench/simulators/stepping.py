@@ -8,8 +8,8 @@ behave the same by construction.
 Effects: ``simulate(scene, params, effects=[...])`` routes every ``params`` key ``"<key>.<param>"``
 whose prefix is an effect's key (its label, else its name) to that effect, applies the rest to the
 scene's bodies, and calls each effect's ``setup(scene_as_simulated, values)`` before building, so
-every engine prepares effects the same way. Effects with a ``restitution`` method are installed as
-the engine's contact hook (:meth:`EngineWorld.set_restitution_hook`); effects with
+every engine prepares effects the same way. Effects that declare ``changes_contacts`` are installed
+as the engine's contact hook (:meth:`EngineWorld.set_restitution_hook`); effects with
 ``applies_forces = False`` are not called every substep.
 """
 
@@ -17,13 +17,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from typing import ClassVar, Protocol
+from typing import ClassVar
 
 import numpy as np
 
+from physbench.effects.base import Effect
 from physbench.errors import PhysbenchError, SimulationError
-from physbench.protocols import Effect
 from physbench.scene import Scene
+from physbench.simulators.base import Simulator
 from physbench.trajectory import Trajectory
 
 #: A body that leaves the world bounds by more than this many world sizes has exploded.
@@ -32,32 +33,46 @@ ESCAPE_MARGIN = 1.0
 SPEED_LIMIT_FRACTION = 0.99
 
 
-class EngineWorld(Protocol):
-    """One built scene inside a concrete engine. Body order is ``scene.bodies`` order."""
+RestitutionHook = Callable[[float, int, "int | None"], "float | None"]
+
+
+class EngineWorld:
+    """One built scene inside a concrete engine (what :meth:`SteppingSimulator.build` returns).
+    Body order is ``scene.bodies`` order. Subclasses implement the stepping and state methods."""
 
     #: Largest speed (m/s) and angular speed (rad/s) the engine lets a body reach at this step
-    #: size (``math.inf`` when it never clamps; may be left out). A body at the limit has exploded.
-    max_speed: float
-    max_angular_speed: float
+    #: size (``math.inf``: it never clamps). A body at the limit has exploded.
+    max_speed: float = math.inf
+    max_angular_speed: float = math.inf
+    #: Whether :meth:`set_restitution_hook` is implemented (needed by contact effects).
+    contact_hook: ClassVar[bool] = False
 
-    def step(self, h: float) -> None: ...
+    def step(self, h: float) -> None:
+        """Advance the world by ``h`` seconds. Called ``scene.substeps`` times per frame."""
+        raise NotImplementedError
 
     def read(self) -> list[float]:
         """Flat CoM states ``[x, y, angle, vx, vy, omega] * N`` (velocity of the CoM)."""
-        ...
+        raise NotImplementedError
 
-    def apply_force(self, i: int, fx: float, fy: float) -> None: ...
+    def apply_force(self, i: int, fx: float, fy: float) -> None:
+        """Apply a force (N) at body ``i``'s centre of mass for the next step."""
+        raise NotImplementedError
 
-    def apply_torque(self, i: int, tau: float) -> None: ...
+    def apply_torque(self, i: int, tau: float) -> None:
+        """Apply a torque (N·m) to body ``i`` for the next step."""
+        raise NotImplementedError
 
-    def apply_impulse(self, i: int, jx: float, jy: float) -> None: ...
+    def apply_impulse(self, i: int, jx: float, jy: float) -> None:
+        """Change body ``i``'s momentum by ``(jx, jy)`` N·s now."""
+        raise NotImplementedError
 
-    # Optional: ``set_restitution_hook(hook)``, with ``hook(normal_speed, a, b) -> float | None``
-    # called once when a contact starts (a, b body indices, b None for static geometry); the
-    # returned restitution replaces the contact's for its duration. Needed by contact effects.
-
-
-RestitutionHook = Callable[[float, int, "int | None"], "float | None"]
+    def set_restitution_hook(self, hook: RestitutionHook) -> None:
+        """Called once after building, when an effect changes contacts: ``hook(normal_speed, a,
+        b)`` is to be called once when a contact starts (a, b body indices, b None for static
+        geometry); the restitution it returns replaces the contact's for its duration. Engines
+        that set :attr:`contact_hook` implement it."""
+        raise NotImplementedError
 
 
 def split_params(
@@ -73,7 +88,7 @@ def split_params(
         return dict(params or {}), values
     keys: dict[str, int] = {}
     for i, eff in enumerate(effects):
-        k = str(getattr(eff, "key", eff.name))
+        k = eff.key
         if k in keys:
             raise PhysbenchError(
                 f"two effects share the parameter key {k!r} ({effects[keys[k]]!r} and {eff!r}); "
@@ -90,10 +105,10 @@ def split_params(
     return body, values
 
 
-def first_restitution(effects: Sequence[object]) -> RestitutionHook | None:
-    """One hook asking each effect with a ``restitution`` method in turn (the first answer that
-    is not ``None`` wins), or ``None`` when no effect has one."""
-    hooks = [e.restitution for e in effects if callable(getattr(e, "restitution", None))]  # type: ignore[attr-defined]
+def first_restitution(effects: Sequence[Effect]) -> RestitutionHook | None:
+    """One hook asking each effect that ``changes_contacts`` in turn (the first answer that is not
+    ``None`` wins), or ``None`` when no effect does."""
+    hooks = [e.restitution for e in effects if e.changes_contacts]
     if not hooks:
         return None
     if len(hooks) == 1:
@@ -167,8 +182,9 @@ class _EffectFailed(Exception):
     """Carries an effect's own exception through the engine-error handler unchanged."""
 
 
-class SteppingSimulator:
-    """Base of the built-in simulators: subclasses implement :meth:`build`."""
+class SteppingSimulator(Simulator):
+    """A :class:`~physbench.simulators.base.Simulator` for any engine that can step a world:
+    subclasses implement :meth:`build`."""
 
     name: ClassVar[str] = ""
 
@@ -203,21 +219,20 @@ class SteppingSimulator:
         if effects:
             hook = first_restitution(effects)
             if hook is not None:
-                install = getattr(world, "set_restitution_hook", None)
-                if install is None:
-                    names = [e.name for e in effects if callable(getattr(e, "restitution", None))]
+                if not world.contact_hook:
+                    names = [e.name for e in effects if e.changes_contacts]
                     raise SimulationError(
                         f"effects {names} change contacts, but this engine has no contact hook "
                         "(EngineWorld.set_restitution_hook)",
                         engine=self.name,
                         frame=0,
                     )
-                install(hook)
-            effects = [e for e in effects if getattr(e, "applies_forces", True)]
+                world.set_restitution_hook(hook)
+            effects = [e for e in effects if e.applies_forces]
         T, n_sub = scene.frames, scene.substeps
         h = scene.dt / n_sub
         sched = _schedule(scene, h, (T - 1) * n_sub)
-        vmax = getattr(world, "max_speed", math.inf)  # optional for third-party worlds
+        vmax = world.max_speed
         if math.isfinite(vmax):
             self._check_actions(scene, sched, vmax, h, n_sub)
         busy = {k // n_sub for k in sched}  # frames (0-based intervals) with forces or impulses
@@ -314,10 +329,7 @@ class SteppingSimulator:
         nan = ~np.isfinite(states).all(axis=2)
         out = (x < xmin - mx) | (x > xmax + mx) | (y < ymin - my) | (y > ymax + my)
         fast = np.zeros_like(out)
-        vmax, wmax = (
-            getattr(world, "max_speed", math.inf),
-            getattr(world, "max_angular_speed", math.inf),
-        )
+        vmax, wmax = world.max_speed, world.max_angular_speed
         if math.isfinite(vmax):
             with np.errstate(invalid="ignore", over="ignore"):
                 fast |= np.hypot(states[:, :, 3], states[:, :, 4]) >= SPEED_LIMIT_FRACTION * vmax

@@ -35,7 +35,7 @@ from physbench.discover.report import write_report
 from physbench.discover.verdict import text, to_dict
 from physbench.plugins import create
 from physbench.recording import Recording, Track
-from physbench.scene import Body, Circle, Unknown
+from physbench.scene import Body, Circle, body_unknown
 
 OUT = Path(__file__).resolve().parent
 
@@ -305,7 +305,7 @@ def rolling_segments(
                 statics=cushions(1.0),
                 forces=(),
                 frames=2,
-                unknowns=(Unknown("ball", "elasticity", 0.4, 1.0),),
+                unknowns=(body_unknown("ball", "elasticity", 0.4, 1.0),),
                 description=f"{case.name}: {name} after its last ball contact",
             )
             run_rec = Recording(
@@ -450,7 +450,8 @@ def pendulum_kaheman() -> None:
     for c in cases:
         arm = c.scene.bodies[0]
         scene = replace(
-            c.scene, unknowns=(Unknown("arm1", "moment", 0.5 * arm.inertia(), 1.5 * arm.inertia()),)
+            c.scene,
+            unknowns=(body_unknown("arm1", "moment", 0.5 * arm.inertia(), 1.5 * arm.inertia()),),
         )
         runs.append(Run(c.name, scene, recording=c.recording, source=c.recording.source))
     sim = create("simulator", "pymunk")
@@ -466,7 +467,8 @@ def pendulum_benard() -> None:
     for c in cases:  # the rod's inertia is uncertain (the author added 0.08 kg to match the period)
         rod = c.scene.bodies[0]
         scene = replace(
-            c.scene, unknowns=(Unknown("rod", "moment", 0.5 * rod.inertia(), 4.0 * rod.inertia()),)
+            c.scene,
+            unknowns=(body_unknown("rod", "moment", 0.5 * rod.inertia(), 4.0 * rod.inertia()),),
         )
         runs.append(Run(c.name, scene, recording=c.recording, source=c.recording.source))
     sim = create("simulator", "pymunk")

@@ -17,8 +17,9 @@ from physbench.bench.spec import parse_spec
 from physbench.bench.tables import SCHEMA, TIMINGS, bootstrap_ci, without_timings
 from physbench.cli import main
 from physbench.errors import PhysbenchError
+from physbench.estimators.base import CorrectionEstimator
 from physbench.hookspecs import hookimpl
-from physbench.plugins import discover, get_registry, reset_registry
+from physbench.plugins import build_registry, get_registry, reset_registry
 
 TINY = {
     "name": "tiny",
@@ -30,11 +31,10 @@ TINY = {
 }
 
 
-class Flaky:
+class Flaky(CorrectionEstimator):
     """Random search that fails in ``start`` when told to: a cell that raises."""
 
     name: ClassVar[str] = "flaky"
-    per_object: ClassVar[bool] = False
 
     def __init__(self, fail: bool = False) -> None:
         self.options = {"fail": fail}
@@ -57,7 +57,7 @@ class _Plugin:
 
 @pytest.fixture
 def flaky_registry() -> Iterator[None]:
-    reset_registry(discover(extra=[("test-flaky", _Plugin())]))
+    reset_registry(build_registry(extra=[("test-flaky", _Plugin())]))
     yield
     reset_registry(None)
 

@@ -30,7 +30,7 @@ def test_product_order_and_seeds() -> None:
     # (2 + 1 unknown sets) x 2 iteration budgets x 2 estimators x 3 seeds
     assert len(cells) == 3 * 2 * 2 * 3
     assert [c.index for c in cells] == list(range(len(cells)))
-    first = cells[0].case
+    first = cells[0].config
     assert (first.scene, first.params, first.iterations, first.estimator, first.seed) == (
         "three_circles",
         ("mass",),
@@ -38,10 +38,10 @@ def test_product_order_and_seeds() -> None:
         "random",
         0,
     )
-    assert [c.case.seed for c in cells[:3]] == [0, 1, 2]  # the run seed is the seed value
-    assert cells[3].label == "optuna-rs" and cells[3].case.options == {"sampler": "random"}
+    assert [c.config.seed for c in cells[:3]] == [0, 1, 2]  # the run seed is the seed value
+    assert cells[3].label == "optuna-rs" and cells[3].config.options == {"sampler": "random"}
     assert (
-        cells[-1].case.params == ("mass",) and cells[-1].scene == "second_order"
+        cells[-1].config.params == ("mass",) and cells[-1].scene == "second_order"
     )  # the default unknowns
     assert len({c.key for c in cells}) == len(cells)
     assert parse_spec(GOOD).cells()[5].key == cells[5].key  # keys are stable
@@ -149,7 +149,7 @@ def test_shipped_specs_load() -> None:
     }
     assert len(load_spec(root / "smoke.toml").seeds) >= 5  # the compare test needs >= 5 seeds
     gap = load_spec(root / "reality_gap.toml")
-    assert any(c.case.engine != c.case.observe_engine for c in gap.cells())
+    assert any(c.config.engine != c.config.observe_engine for c in gap.cells())
 
 
 def test_argument_parsing_imports_nothing_heavy() -> None:

@@ -21,6 +21,7 @@ import pandas as pd
 import pytest
 
 from physbench.bench.tables import without_timings
+from physbench.estimators.base import CorrectionEstimator
 from physbench.hookspecs import hookimpl
 
 SPEC = """
@@ -37,9 +38,8 @@ unknowns = ["mass", "elasticity"]
 CELLS = 2 * 2 * 4
 
 
-class SlowRandom:
+class SlowRandom(CorrectionEstimator):
     name: ClassVar[str] = "slow_random"
-    per_object: ClassVar[bool] = False
 
     def __init__(self) -> None:
         self.options: dict[str, Any] = {}

@@ -64,12 +64,13 @@ def test_json_history_is_reproducible(capsys: pytest.CaptureFixture[str]) -> Non
     _, out2, _ = run(capsys, *argv)
     a, b = json.loads(out1), json.loads(out2)
     assert (
-        a["keys"] == ["a.mass", "a.elasticity", "b.mass", "b.elasticity"] and len(a["records"]) == 4
+        a["keys"] == ["a.mass", "a.elasticity", "b.mass", "b.elasticity"]
+        and len(a["iterations"]) == 4
     )
-    assert a["min_nmse"] == a["records"][-1]["best_nmse"] and a["truth"] is not None
+    assert a["best_nmse"] == a["iterations"][-1]["best_nmse"] and a["truth"] is not None
     for d in (a, b):
         d.pop("timings"), d["meta"].pop("t_start")
-        for r in d["records"]:
+        for r in d["iterations"]:
             for k in ("t_simulate", "t_render", "t_estimator"):
                 r.pop(k)
     assert a == b

@@ -25,9 +25,9 @@ from physbench.effects import (
     apply_measurements,
     restitution_law,
 )
+from physbench.effects.base import Effect
 from physbench.errors import UnknownNameError
-from physbench.plugins import discover
-from physbench.protocols import Effect
+from physbench.plugins import build_registry
 from physbench.scene import Body, Box, Circle, Joint, Scene
 from physbench.simulators.box2d_sim import Box2DSimulator
 from physbench.simulators.pymunk_sim import PymunkSimulator
@@ -93,7 +93,7 @@ def ball_scene(
 
 
 def test_every_builtin_effect_is_registered_and_follows_the_protocol():
-    names = discover().names("effect")
+    names = build_registry().names("effect")
     for cls in BUILTIN_EFFECTS:
         assert cls.name in names
         assert isinstance(cls(), Effect)

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from physbench.errors import PhysbenchError
-from physbench.estimators import EstimatorOptionError
 from physbench.estimators.cmaes import CMAES
+from physbench.estimators.options import EstimatorOptionError
 from physbench.estimators.optuna_sampler import Optuna
 from physbench.estimators.random_search import RandomSearch
 from physbench.estimators.tpe import DEFAULT_STARTUP, TPE
@@ -63,7 +63,7 @@ def test_builtins_are_registered_through_entry_points() -> None:
 def test_reduces_the_normalized_error_on_three_circles_mass(name: str) -> None:
     runs = [_three_circles(name, seed, ["mass"]) for seed in range(5)]
     initial = np.mean([h.initial_nmse for h in runs])
-    final = np.mean([h.min_nmse for h in runs])
+    final = np.mean([h.best_nmse for h in runs])
     # 11 iterations, best by image MSE; measured ratios are 0.08 (random) to 0.3 (cmaes).
     assert final < 0.5 * initial, (name, final, initial)
     assert all(len(h) == 11 for h in runs)
@@ -109,18 +109,20 @@ def test_startup_is_a_setting_with_a_small_budget_default() -> None:
     # default the proposals after the start-up phase differ from those random draws.
     lib = run_toy(TPE, {"startup": 20}, seed=1, iterations=11)
     ours = run_toy(TPE, {"startup": DEFAULT_STARTUP}, seed=1, iterations=11)
-    assert [r.params for r in lib.records[:DEFAULT_STARTUP]] == [
-        r.params for r in ours.records[:DEFAULT_STARTUP]
+    assert [r.params for r in lib.iterations[:DEFAULT_STARTUP]] == [
+        r.params for r in ours.iterations[:DEFAULT_STARTUP]
     ]
-    assert lib.records[-1].params != ours.records[-1].params
+    assert lib.iterations[-1].params != ours.iterations[-1].params
     assert ours.options == {"startup": DEFAULT_STARTUP, "candidates": 24, "gamma": 0.25}
 
 
 def test_first_point_told_is_the_initial_guess() -> None:
     for cls in (TPE, CMAES, Optuna):
         h = run_toy(cls, {}, seed=2, iterations=3)
-        assert h.records[0].params == h.initial
-        assert h.records[1].params != h.initial  # a new point is asked, not the initial one again
+        assert h.iterations[0].params == h.initial
+        assert (
+            h.iterations[1].params != h.initial
+        )  # a new point is asked, not the initial one again
 
 
 @pytest.mark.parametrize(
@@ -158,10 +160,10 @@ def test_optuna_samplers() -> None:
 
 def test_cmaes_handles_a_single_unknown() -> None:
     h = run_toy(CMAES, {}, seed=0, iterations=6, bodies=("a",))
-    assert h.keys == ("a.mass",) and len({r.params["a.mass"] for r in h.records}) == 6
+    assert h.keys == ("a.mass",) and len({r.params["a.mass"] for r in h.iterations}) == 6
 
 
 def test_random_search_is_uniform_and_ignores_the_loss() -> None:
     h = run_toy(RandomSearch, {}, seed=0, iterations=40)
-    xs = np.array([r.params["a.mass"] for r in h.records[1:]])
+    xs = np.array([r.params["a.mass"] for r in h.iterations[1:]])
     assert xs.min() < 3 and xs.max() > 8

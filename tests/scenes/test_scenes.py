@@ -104,10 +104,10 @@ def observability(cid: str, engine: str) -> dict[str, Any]:
                 (seed, float(np.linalg.norm(xy - xy[0], axis=1).max()))
             )
         for u in space.unknowns:
-            ref = renderer.render(scene, base, focus=u.body)
+            ref = renderer.render(scene, base, focus=u.owner)
             changes = []
             for v in perturbed(u.key, p[u.key]):
-                frames = renderer.render(scene, sim.simulate(scene, {**p, u.key: v}), focus=u.body)
+                frames = renderer.render(scene, sim.simulate(scene, {**p, u.key: v}), focus=u.owner)
                 changes.append(float(np.abs(frames - ref).sum()))
             pix.setdefault(u.key, []).append((seed, min(changes)))
     return {"disp": disp, "pix": pix}
@@ -141,10 +141,10 @@ def test_valid_roundtrip_seeded(cid: str) -> None:
         scene.validate()
         assert loads_scene(dumps_scene(scene)) == scene
         assert make(cid, seed) == scene  # same seed, same scene
-        assert scene.unknowns and not any(u.body == scene.test_body for u in scene.unknowns)
+        assert scene.unknowns and not any(u.owner == scene.test_body for u in scene.unknowns)
         for u in scene.unknowns:  # nominal values lie inside the declared ranges
-            b = scene.bodies[scene.body_index(u.body)]
-            value = b.inertia() if u.param == "moment" else getattr(b, u.param)
+            b = scene.bodies[scene.body_index(u.owner)]
+            value = b.inertia() if u.name == "moment" else getattr(b, u.name)
             assert u.low <= value <= u.high, u.key
     assert len({dumps_scene(s) for s in scenes}) == len(scenes)  # different seeds, different scenes
 

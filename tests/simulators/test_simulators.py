@@ -19,8 +19,9 @@ from typing import ClassVar
 import numpy as np
 import pytest
 
+from physbench.effects.base import Effect
 from physbench.errors import SimulationError
-from physbench.protocols import EffectParam
+from physbench.parameter import Parameter
 from physbench.scene import (
     Body,
     Box,
@@ -392,11 +393,11 @@ def _overlap(a0: float, a1: float, b0: float, b1: float) -> float:
     return max(0.0, min(a1, b1) - max(a0, b0))
 
 
-class _ConstantPush:
+class _ConstantPush(Effect):
     """A test effect: a constant force and torque on body 0."""
 
     name: ClassVar[str] = "push"
-    params: ClassVar[tuple[EffectParam, ...]] = ()
+    params: ClassVar[tuple[Parameter, ...]] = ()
 
     def setup(self, scene: Scene, values: object) -> None:
         pass

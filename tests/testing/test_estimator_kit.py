@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from physbench.errors import PhysbenchError
+from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.estimators.random_search import RandomSearch
 from physbench.params import Params
-from physbench.protocols import Step, Task
 from physbench.testing import (
     ConformanceError,
     EstimatorConformance,
@@ -25,11 +25,10 @@ from physbench.testing import (
 )
 
 
-class Base:
+class Base(CorrectionEstimator):
     """A correct minimal estimator (uniform draws); the broken ones below change one thing."""
 
     name: ClassVar[str] = "base"
-    per_object: ClassVar[bool] = False
 
     def __init__(self, width: float = 1.0) -> None:
         if not 0 < width <= 1:

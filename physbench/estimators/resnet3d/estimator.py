@@ -7,11 +7,11 @@ from typing import Any, ClassVar
 import numpy as np
 
 from physbench.errors import PhysbenchError
+from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.params import Params
-from physbench.protocols import Step, Task
 
 
-class ResNet3DEstimator:
+class ResNet3DEstimator(CorrectionEstimator):
     """3D-ResNet correction estimator (paper). Marks one unknown body at a time and batches all
     marked bodies into one forward pass (the loop renders each marked view).
 
@@ -38,7 +38,7 @@ class ResNet3DEstimator:
         from physbench.estimators.resnet3d import weights
         from physbench.estimators.resnet3d.model import NetConfig, build_net
 
-        params = tuple(dict.fromkeys(u.param for u in task.space.unknowns))
+        params = tuple(dict.fromkeys(u.name for u in task.space.unknowns))
         if self.weights_path:
             state, meta = weights.load(self.weights_path)
             trained_for = tuple(sorted(meta["data"]["params"]))
@@ -59,7 +59,7 @@ class ResNet3DEstimator:
         self.net.load_state_dict({k: v.float() for k, v in state.items()})
         self.net.eval()
         self.space = task.space
-        self.observed: dict[str, np.ndarray] = dict(task.meta.get("marked_observation") or {})
+        self.observed: dict[str, np.ndarray] = dict(task.marked_observation)
         # Per unknown body: its unknown keys in the network's output order and their range widths.
         self.targets: list[tuple[str, list[str], np.ndarray]] = []
         for body in task.space.bodies:
@@ -83,7 +83,7 @@ class ResNet3DEstimator:
 
         from physbench.estimators.resnet3d.inputs import make_input
 
-        marked = getattr(step, "marked", None)
+        marked = step.marked
         if not marked:
             raise PhysbenchError(
                 "resnet3d corrects one marked object at a time: the loop must pass marked frames"

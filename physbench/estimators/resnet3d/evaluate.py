@@ -56,6 +56,10 @@ def evaluate_weights(
             initial=initial,
         )
         rows.append(
-            {r.iteration + 1: float(r.best_nmse) for r in hist.records if r.best_nmse is not None}
+            {
+                r.iteration + 1: float(r.best_nmse)
+                for r in hist.iterations
+                if r.best_nmse is not None
+            }
         )
     return rows

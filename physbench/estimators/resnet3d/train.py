@@ -70,7 +70,7 @@ def _ranges(spec: DataSpec) -> dict[str, list[float]]:
 
     scene = get_registry().get("scene", spec.scene)(0, **spec.scene_options)
     space = ParamSpace.from_scene(scene, spec.params)
-    return {u.param: [u.low, u.high] for u in space.unknowns}
+    return {u.name: [u.low, u.high] for u in space.unknowns}
 
 
 def _optimizer_tensors(opt: Any) -> tuple[dict[str, Any], dict[str, Any]]:

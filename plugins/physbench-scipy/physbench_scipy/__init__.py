@@ -7,11 +7,12 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from physbench.errors import PhysbenchError
+from physbench.estimators.base import CorrectionEstimator
 from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
+    from physbench.estimators.base import Step, Task
     from physbench.params import Params, ParamSpace
-    from physbench.protocols import Step, Task
 
 METHODS = ("nelder-mead", "powell")
 
@@ -23,13 +24,12 @@ class _Unseen(Exception):
         self.x = x
 
 
-class ScipyMinimize:
+class ScipyMinimize(CorrectionEstimator):
     """A deterministic scipy minimiser over the unit cube, turned ask/tell by replaying it
     against the losses recorded so far (see README). Restarts from a seeded random point when it
     converges before the budget is spent."""
 
     name: ClassVar[str] = "scipy"
-    per_object: ClassVar[bool] = False
 
     def __init__(self, method: str = "nelder-mead", step: float = 0.2, xatol: float = 1e-3) -> None:
         if method not in METHODS:

@@ -11,7 +11,7 @@ import pytest
 from physbench_scipy import ScipyMinimize
 
 from physbench.cli import main
-from physbench.plugins import discover
+from physbench.plugins import build_registry
 from physbench.testing import EstimatorConformance, run_toy
 
 
@@ -31,7 +31,7 @@ class TestPowellConformance(EstimatorConformance):
 
 
 def test_found_through_the_entry_point() -> None:
-    info = discover(env=False).info("estimator", "scipy")
+    info = build_registry(env=False).info("estimator", "scipy")
     assert info.obj is ScipyMinimize
     assert info.package == "physbench-scipy"
 
@@ -44,13 +44,13 @@ def test_improves_on_the_initial_guess(method: str) -> None:
         )
         for s in range(6)
     ]
-    assert all(h.min_loss < h.records[0].loss for h in runs)
-    assert np.mean([h.min_nmse for h in runs]) < 0.5 * np.mean([h.initial_nmse for h in runs])
+    assert all(h.min_loss < h.iterations[0].loss for h in runs)
+    assert np.mean([h.best_nmse for h in runs]) < 0.5 * np.mean([h.initial_nmse for h in runs])
 
 
 def test_restarts_after_converging() -> None:
     h = run_toy(ScipyMinimize, {"method": "nelder-mead", "xatol": 0.2}, iterations=30, seed=1)
-    xs = np.array([[r.params[k] for k in h.keys] for r in h.records])
+    xs = np.array([[r.params[k] for k in h.keys] for r in h.iterations])
     assert len(np.unique(xs, axis=0)) > 10  # kept exploring instead of repeating one point
 
 

@@ -166,7 +166,7 @@ def test_shipped_weights_beat_the_random_estimator(info: weights.WeightsInfo) ->
             h = refine(
                 obs, scene, space, sim, renderer, est, iterations=3, seed=seed, initial=initial
             )
-            out.append(h.min_nmse)
+            out.append(h.best_nmse)
     assert np.mean(learned) < np.mean(baseline), (learned, baseline)
 
 
@@ -250,7 +250,7 @@ def test_symmetric_option_makes_the_truth_an_exact_fixed_point(symmetric: bool) 
         seed=3,
         initial=truth,
     )
-    moved = max(abs(h.records[1].params[k] - truth[k]) for k in truth)
+    moved = max(abs(h.iterations[1].params[k] - truth[k]) for k in truth)
     if symmetric:
         assert moved < 1e-9  # f(o, s) - f(s, o) vanishes when o == s
     else:

@@ -1,0 +1,81 @@
+"""Command-line arguments that several commands share, so that one flag means one thing
+everywhere: ``KEY=VALUE`` options and the renderer choice (``--renderer``, ``--renderer-option``,
+``--resolution``, ``--render-mode``)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+#: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
+RENDER_MODES = ("mark", "instance", "mask")
+
+
+def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
+    """``["startup=5", "sampler=cmaes"]`` -> ``{"startup": 5, "sampler": "cmaes"}``: values parse
+    as JSON, else stay text. ``flag`` names the option in errors."""
+    from physbench.errors import PhysbenchError
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        if not sep or not key.strip():
+            raise PhysbenchError(f"{flag} {item!r}: expected KEY=VALUE, e.g. {flag} startup=5")
+        try:
+            value = json.loads(raw)
+        except ValueError:
+            value = raw
+        out[key.strip()] = value
+    return out
+
+
+def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) -> None:
+    """``--renderer NAME``, ``--renderer-option KEY=VALUE`` (repeatable), ``--resolution PX`` and
+    ``--render-mode MODE``."""
+    p.add_argument(
+        "--renderer",
+        default=None,
+        metavar="NAME",
+        help="renderer of the frames (default: raster; see `physbench plugins`)",
+    )
+    p.add_argument(
+        "-R",
+        "--renderer-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="renderer option, repeatable (values parse as JSON, else text)",
+    )
+    p.add_argument(
+        "--resolution",
+        type=int,
+        default=resolution,
+        metavar="PX",
+        help=f"frame width in pixels (default: {resolution})",
+    )
+    p.add_argument(
+        "--render-mode",
+        "--mode",
+        dest="render_mode",
+        default="mark",
+        choices=RENDER_MODES,
+        help="channel layout of the frames (default: mark)",
+    )
+
+
+def renderer_choice(args: argparse.Namespace) -> tuple[str, dict[str, Any]]:
+    """The renderer name (the default when not given) and its options from the parsed ``args``."""
+    from physbench.render.base import DEFAULT_RENDERER
+
+    return args.renderer or DEFAULT_RENDERER, parse_key_values(
+        args.renderer_option, "--renderer-option"
+    )
+
+
+def make_renderer_from(args: argparse.Namespace) -> Any:
+    """The renderer the parsed ``args`` choose, built with their resolution and render mode."""
+    from physbench.experiment import make_renderer
+
+    name, options = renderer_choice(args)
+    return make_renderer(name, options, resolution=args.resolution, mode=args.render_mode)
