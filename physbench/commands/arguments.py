@@ -30,9 +30,8 @@ def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
     return out
 
 
-def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) -> None:
-    """``--renderer NAME``, ``--renderer-option KEY=VALUE`` (repeatable), ``--resolution PX`` and
-    ``--render-mode MODE``."""
+def add_renderer_choice(p: argparse.ArgumentParser) -> None:
+    """``--renderer NAME`` and ``--renderer-option KEY=VALUE`` (repeatable)."""
     p.add_argument(
         "--renderer",
         default=None,
@@ -47,6 +46,11 @@ def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) 
         metavar="KEY=VALUE",
         help="renderer option, repeatable (values parse as JSON, else text)",
     )
+
+
+def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) -> None:
+    """:func:`add_renderer_choice` plus ``--resolution PX`` and ``--render-mode MODE``."""
+    add_renderer_choice(p)
     p.add_argument(
         "--resolution",
         type=int,

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from physbench.commands.arguments import add_renderer_choice
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scene", required=True, help="registered scene name")
@@ -50,6 +52,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="fine-tune: start from these weights (.safetensors) instead of a fresh network",
     )
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
+    add_renderer_choice(p)
     p.add_argument("--workers", type=int, default=1, help="data-generating processes (default 1)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (default: torch's choice)")
     p.add_argument(
@@ -73,16 +76,20 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from physbench.commands.arguments import renderer_choice
     from physbench.errors import PhysbenchError
     from physbench.estimators.resnet3d.data import DataSpec
     from physbench.estimators.resnet3d.model import NetConfig
     from physbench.estimators.resnet3d.train import TrainConfig, train, weights_name
+    from physbench.experiment import make_renderer
     from physbench.params import ParamSpace
     from physbench.plugins import get_registry
 
     params = tuple(p.strip() for p in args.params.split(",") if p.strip())
     scene = get_registry().get("scene", args.scene)(0)
     ParamSpace.from_scene(scene, params)  # unknown parameter names fail here, listing the known
+    renderer, renderer_options = renderer_choice(args)
+    make_renderer(renderer, renderer_options, resolution=64, mode="mark")  # fail before training
     try:
         widths = tuple(int(w) for w in args.widths.split(","))
         assert len(widths) == 4 and all(w > 0 for w in widths)
@@ -109,6 +116,8 @@ def main(args: argparse.Namespace) -> int:
         args.scene,
         params,
         engine=args.engine,
+        renderer=renderer,
+        renderer_options=renderer_options,
         resolution=args.resolution,
         frames=args.frames,
         blur_max=args.blur_max,

@@ -174,3 +174,32 @@ def test_argument_parsing_imports_nothing_heavy() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_a_third_party_renderer_is_chosen_by_name(
+    capsys: pytest.CaptureFixture[str], squares_renderer
+) -> None:
+    code, out, _ = run(capsys, "--renderer", "squares", "-R", "size=3", *FAST, "--json", "-q")
+    history = json.loads(out)
+    assert code == 0 and history["meta"]["renderer"] == "squares"
+    assert history["meta"]["renderer_options"] == {"size": 3}
+    # the observation, the shape check (a one-frame still: Squares has no shape()) and 4 model
+    # renders, all by the plugin
+    assert squares_renderer.CALLS.count(None) == 6
+    code, raster, _ = run(capsys, *FAST, "--json", "-q")
+    assert code == 0 and json.loads(raster)["meta"]["renderer"] == "raster"
+    losses = [r["loss"] for r in history["iterations"]]
+    assert losses != [r["loss"] for r in json.loads(raster)["iterations"]]
+
+
+def test_bad_renderer_choices_are_named(
+    capsys: pytest.CaptureFixture[str], squares_renderer
+) -> None:
+    code, _, err = run(capsys, "--renderer", "nope", *FAST)
+    assert code == 2 and "unknown renderer 'nope'" in err and "raster" in err and "squares" in err
+    code, _, err = run(capsys, "--renderer", "squares", "-R", "colour=red", *FAST)
+    assert code == 2 and "does not take options {'colour': 'red'}" in err and "size" in err
+    code, _, err = run(capsys, "--renderer", "squares", "--render-mode", "instance", *FAST)
+    assert code == 2 and "supports modes mark, mask" in err
+    code, _, err = run(capsys, "-R", "resolution=8", *FAST)
+    assert code == 2 and "--resolution" in err

@@ -16,6 +16,8 @@ from typing import Any
 import numpy as np
 
 from physbench.estimators.resnet3d.inputs import make_input
+from physbench.render.base import DEFAULT_RENDERER
+from physbench.simulators.base import DEFAULT_SIMULATOR
 
 TRAIN_SEED0 = 1 << 24
 VAL_SEED0 = 1 << 30
@@ -27,7 +29,9 @@ class DataSpec:
 
     scene: str
     params: tuple[str, ...]
-    engine: str = "pymunk"
+    engine: str = DEFAULT_SIMULATOR
+    renderer: str = DEFAULT_RENDERER
+    renderer_options: dict[str, Any] = field(default_factory=dict)
     render_resolution: int = 64
     resolution: int = 32
     frames: int = 15
@@ -35,7 +39,7 @@ class DataSpec:
     scene_options: dict[str, Any] = field(default_factory=dict)
     # Camera-blur augmentation of the *observed* sequence only (the simulated one stays sharp, as
     # at inference): with probability ``blur_prob`` a Gaussian of sigma ~ U(0, blur_max) pixels at
-    # the render resolution, the renderer's own blur.
+    # the render resolution, the blur of the loop's observation model.
     blur_max: float = 0.0
     blur_prob: float = 0.5
 
@@ -46,6 +50,8 @@ class DataSpec:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> DataSpec:
+        """The spec stored in a sidecar; sidecars written before the renderer was a choice lack
+        ``renderer`` and ``renderer_options`` and get the defaults, what they were trained on."""
         return cls(**{**d, "params": tuple(d["params"])})
 
 
@@ -53,12 +59,15 @@ class PairMaker:
     """Builds sample groups for one :class:`DataSpec` (one per worker process)."""
 
     def __init__(self, spec: DataSpec) -> None:
+        from physbench.experiment import make_renderer
         from physbench.plugins import create, get_registry
 
         self.spec = spec
         self.generator = get_registry().get("scene", spec.scene)
         self.sim = create("simulator", spec.engine)
-        self.renderer = create("renderer", "raster", resolution=spec.render_resolution, mode="mark")
+        self.renderer = make_renderer(
+            spec.renderer, spec.renderer_options, resolution=spec.render_resolution, mode="mark"
+        )
 
     def group(self, seed: int) -> tuple[np.ndarray, np.ndarray]:
         """Samples ``x (S, 2, 2F, R, R)`` and targets ``y (S, P)`` from the instance ``seed``."""

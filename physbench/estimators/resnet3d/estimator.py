@@ -36,6 +36,7 @@ class ResNet3DEstimator(CorrectionEstimator):
         import torch
 
         from physbench.estimators.resnet3d import weights
+        from physbench.estimators.resnet3d.data import DataSpec
         from physbench.estimators.resnet3d.model import NetConfig, build_net
 
         params = tuple(dict.fromkeys(u.name for u in task.space.unknowns))
@@ -51,6 +52,13 @@ class ResNet3DEstimator(CorrectionEstimator):
             info = weights.find(task.scene.name, params)
             state, meta = weights.load(info.path)
         self.params = tuple(meta["data"]["params"])
+        trained_on = DataSpec.from_dict(meta["data"]).renderer
+        if task.renderer is not None and type(task.renderer).name != trained_on:
+            raise PhysbenchError(
+                f"resnet3d weights for {task.scene.name} were trained on frames of renderer "
+                f"{trained_on!r}; this run renders with {type(task.renderer).name!r} (choose "
+                f"--renderer {trained_on}, or train weights for it with physbench train --renderer)"
+            )
         if self.threads:
             torch.set_num_threads(self.threads)
         torch.manual_seed(seed)

@@ -27,23 +27,31 @@ def evaluate_weights(
     from physbench.estimators.resnet3d import weights
     from physbench.estimators.resnet3d.data import DataSpec
     from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
+    from physbench.experiment import make_renderer
     from physbench.loop import draw_problem, refine
     from physbench.observation import simulate_observation
     from physbench.params import ParamSpace
     from physbench.plugins import create, get_registry
+    from physbench.render.base import ObservationModel
 
     _, meta = weights.load(path)
     spec = DataSpec.from_dict(meta["data"])
     generator = get_registry().get("scene", spec.scene)
     sim = create("simulator", engine)
-    model = create("renderer", "raster", resolution=resolution, mode="mark")
-    observer = create("renderer", "raster", resolution=resolution, mode="mark", blur=blur)
+
+    def renderer():  # the renderer the weights were trained on
+        return make_renderer(
+            spec.renderer, spec.renderer_options, resolution=resolution, mode="mark"
+        )
+
+    model, observer = renderer(), renderer()
+    camera = ObservationModel(blur=blur)
     rows = []
     for seed in seeds:
         scene = generator(seed, **{**spec.scene_options, **(scene_options or {})})
         space = ParamSpace.from_scene(scene, spec.params, bodies)
         truth, initial = draw_problem(space, seed)
-        obs = simulate_observation(scene, truth, sim, observer, marked=space.bodies)
+        obs = simulate_observation(scene, truth, sim, observer, marked=space.bodies, camera=camera)
         hist = refine(
             obs,
             scene,
