@@ -102,11 +102,15 @@ def make_estimator(name: str, options: Mapping[str, Any]) -> CorrectionEstimator
     cls = get_registry().get("estimator", name)
     try:
         return cls(**dict(options))
+    except PhysbenchError:
+        raise
     except TypeError as exc:
         raise PhysbenchError(
             f"estimator {name!r} does not take options {dict(options)}: {exc}; "
             f"its options: {_accepted(cls)}"
         ) from None
+    except ValueError as exc:  # a plugin's own check, not phrased as a PhysbenchError
+        raise PhysbenchError(f"estimator {name!r} refused options {dict(options)}: {exc}") from None
 
 
 def make_renderer(
@@ -126,11 +130,15 @@ def make_renderer(
         )
     try:
         return cls(resolution=resolution, mode=mode, **dict(options))
+    except PhysbenchError:
+        raise
     except TypeError as exc:
         raise PhysbenchError(
             f"renderer {name!r} does not take options {dict(options)}: {exc}; "
             f"its options: {_accepted(cls)}"
         ) from None
+    except ValueError as exc:  # a plugin's own check, not phrased as a PhysbenchError
+        raise PhysbenchError(f"renderer {name!r} refused options {dict(options)}: {exc}") from None
 
 
 def _check_observation(config: RunConfig) -> None:

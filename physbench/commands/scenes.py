@@ -22,7 +22,7 @@ def main(args: argparse.Namespace) -> int:
         gen = reg.get("scene", name)
         scene = gen(args.seed)
         print(f"{name}  ({reg.info('scene', name).package})")
-        print(f"    {getattr(gen, 'description', '')}")
+        print(f"    {gen.description}")
         bodies = ", ".join(scene.body_names)
         print(
             f"    bodies: {bodies}" + (f"; test body: {scene.test_body}" if scene.test_body else "")

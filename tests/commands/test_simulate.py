@@ -1,0 +1,88 @@
+"""``physbench simulate``: one scene instance to trajectory + frames and a preview; clear errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from physbench.cli import main
+
+
+def test_unknown_scene_lists_known_ones(capsys) -> None:
+    assert main(["simulate", "--scene", "no_such_scene"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        "unknown scene 'no_such_scene'" in err
+        and "three_circles" in err
+        and "bouncing_balls" in err
+    )
+
+
+def test_unknown_engine_lists_known_ones(capsys) -> None:
+    assert main(["simulate", "--scene", "three_circles", "--engine", "bullet"]) == 2
+    assert "known simulators: box2d, pymunk" in capsys.readouterr().err
+
+
+def test_bad_override_is_explained(capsys) -> None:
+    assert main(["simulate", "--scene", "three_circles", "--set", "a.mass"]) == 2
+    assert "expected BODY.PARAM=NUMBER" in capsys.readouterr().err
+    assert main(["simulate", "--scene", "three_circles", "--set", "a.mass=-1"]) == 2
+    err = capsys.readouterr().err
+    assert "a.mass" in err or "bodies[1].mass = -1.0" in err
+    assert "mass must be > 0" in err
+
+
+def test_simulate_writes_npz_and_previews(tmp_path: Path, capsys) -> None:
+    out, gif, png = tmp_path / "run.npz", tmp_path / "p.gif", tmp_path / "p.png"
+    for engine in ("pymunk", "box2d"):
+        assert (
+            main(
+                [
+                    "simulate",
+                    "--scene",
+                    "three_circles",
+                    "--engine",
+                    engine,
+                    "--seed",
+                    "2",
+                    "--out",
+                    str(out),
+                    "--preview",
+                    str(gif),
+                    "--resolution",
+                    "32",
+                ]
+            )
+            == 0
+        )
+        data = np.load(out)
+        assert data["states"].shape[1:] == (3, 6)
+        assert data["frames"].shape[0] == data["states"].shape[0] and data["frames"].shape[2:] == (
+            32,
+            32,
+        )
+        assert str(data["engine"]) == engine
+    assert gif.stat().st_size > 0
+    assert main(["simulate", "--scene", "three_circles", "--preview", str(png)]) == 0
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_simulate_a_toml_scene(tmp_path: Path, capsys) -> None:
+    assert main(["scenes", "--toml", "three_circles"]) == 0
+    path = tmp_path / "tc.toml"
+    path.write_text(capsys.readouterr().out)
+    assert main(["simulate", "--scene", str(path)]) == 0
+    assert "three_circles" in capsys.readouterr().out
+
+
+def test_the_renderer_is_a_choice(tmp_path: Path, capsys, squares_renderer) -> None:  # type: ignore[no-untyped-def]
+    out = tmp_path / "sq.npz"
+    argv = ["simulate", "--scene", "three_circles", "--renderer", "squares", "--out", str(out)]
+    assert main([*argv, "--render-mode", "mask", "--resolution", "20"]) == 0
+    frames = np.load(out)["frames"]
+    assert frames.shape[1:] == (1, 20, 20) and set(np.unique(frames)) <= {0.0, 1.0}
+    assert main([*argv, "-R", "size=0.5.1"]) == 2  # not a number: the plugin's own ValueError
+    assert "renderer 'squares' refused options {'size': '0.5.1'}" in capsys.readouterr().err
+    assert main(["simulate", "--scene", "three_circles", "--renderer", "nope"]) == 2
+    assert "unknown renderer 'nope'" in capsys.readouterr().err
