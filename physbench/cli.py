@@ -34,7 +34,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="physbench",
-        description="Identify physical object properties from video or trajectories, and benchmark the methods.",
+        description="Identify physical object properties from video or trajectories, and benchmark "
+        "the methods.",
     )
     parser.add_argument("--version", action="store_true", help="print the version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

@@ -41,7 +41,8 @@ def register_estimators() -> list[type[Any]]:
 @hookspec
 def register_scenes() -> list[Any]:
     """Return scene generators: callables ``(seed: int) -> Scene`` with a ``name`` attribute
-    (see :func:`physbench.scenes.generator.scene_generator`). Called once when the registry is first built."""
+    (see :func:`physbench.scenes.generator.scene_generator`). Called once when the registry is
+    first built."""
 
 
 @hookspec

@@ -38,7 +38,8 @@ if TYPE_CHECKING:
     from physbench.simulators.base import Simulator
     from physbench.trajectory import Trajectory
 
-#: Loss given to the estimator when a simulation fails: the largest image MSE frames in [0, 1] allow.
+#: Loss given to the estimator when a simulation fails: the largest image MSE that frames in [0, 1]
+#: allow.
 FAILED_LOSS = 1.0
 
 
@@ -134,7 +135,8 @@ class History:
         }
 
     def to_dict(self, *, timings: bool = True) -> dict[str, Any]:
-        """JSON-ready dict; ``timings=False`` drops everything that varies between identical runs."""
+        """JSON-ready dict; ``timings=False`` drops everything that varies between identical
+        runs."""
         recs = []
         for r in self.iterations:
             d = asdict(r)
@@ -191,14 +193,16 @@ class History:
 def _check_proposal(name: str, space: ParamSpace, proposal: object, iteration: int) -> Params:
     if not isinstance(proposal, Mapping):
         raise EstimatorError(
-            f"estimator {name!r} returned {type(proposal).__name__} from propose() in iteration {iteration}; "
+            f"estimator {name!r} returned {type(proposal).__name__} from propose() in iteration "
+            f"{iteration}; "
             f"expected a dict with keys {list(space.keys)}"
         )
     keys = set(space.keys)
     missing, extra = sorted(keys - set(proposal)), sorted(set(proposal) - keys)
     if missing or extra:
         raise EstimatorError(
-            f"estimator {name!r} proposed keys {sorted(proposal)} in iteration {iteration}; expected exactly "
+            f"estimator {name!r} proposed keys {sorted(proposal)} in iteration {iteration}; "
+            "expected exactly "
             f"{list(space.keys)}"
             + (f" (missing {missing})" if missing else "")
             + (f" (extra {extra})" if extra else "")
@@ -214,7 +218,8 @@ def _check_proposal(name: str, space: ParamSpace, proposal: object, iteration: i
         tol = 1e-9 * (u.high - u.low)
         if not (math.isfinite(x) and u.low - tol <= x <= u.high + tol):
             raise EstimatorError(
-                f"estimator {name!r} proposed {u.key} = {shown} in iteration {iteration}; expected a finite "
+                f"estimator {name!r} proposed {u.key} = {shown} in iteration {iteration}; "
+                "expected a finite "
                 f"number in [{u.low:g}, {u.high:g}]"
             )
         out[u.key] = min(max(x, u.low), u.high)

@@ -54,7 +54,8 @@ def mean_std(values: Iterable[float]) -> tuple[float, float]:
 
 
 def format_mean_std(mean: float, std: float) -> str:
-    """``(1.1 ± 0.3)e-02``: mean and std sharing the mean's power of ten, as in the paper's Table 1."""
+    """``(1.1 ± 0.3)e-02``: mean and std sharing the mean's power of ten, as in the paper's Table
+    1."""
     if not math.isfinite(mean) or mean == 0:
         return f"{mean:.2g} ± {std:.2g}"
     exp = math.floor(math.log10(abs(mean)))

@@ -60,7 +60,8 @@ def expected_shape(renderer: Renderer, scene: Scene) -> tuple[int, int, int, int
 def check_frames(
     frames: object, expected: Sequence[int], *, what: str = "observation"
 ) -> np.ndarray:
-    """``frames`` as float32 ``(T, C, H, W)``, or :class:`ObservationError` naming expected vs got."""
+    """``frames`` as float32 ``(T, C, H, W)``, or :class:`ObservationError` naming expected vs
+    got."""
     arr = np.asarray(frames)
     if arr.dtype.kind not in "fiub":
         raise ObservationError(f"{what}: expected numeric frames, got dtype {arr.dtype}")
@@ -74,8 +75,10 @@ def check_frames(
             ]
             detail = " (" + ", ".join(diffs) + ")"
         raise ObservationError(
-            f"{what}: frames have shape {arr.shape}, expected {names} = {exp}{detail}; T is the scene's "
-            "frame count, C, H, W the renderer's channels and image size (check --resolution and the render mode)"
+            f"{what}: frames have shape {arr.shape}, expected {names} = {exp}{detail}; T is the "
+            "scene's "
+            "frame count, C, H, W the renderer's channels and image size (check --resolution and "
+            "the render mode)"
         )
     arr = arr.astype(np.float32, copy=False)
     if not np.isfinite(arr).all():
@@ -91,7 +94,8 @@ def check_frames(
 def validate(
     obs: Observation, expected: Sequence[int], *, bodies: Iterable[str] = ()
 ) -> Observation:
-    """Check ``obs`` against the model's frame shape; ``bodies`` lists the marked frames required."""
+    """Check ``obs`` against the model's frame shape; ``bodies`` lists the marked frames
+    required."""
     what = obs.source or "observation"
     frames = check_frames(obs.frames, expected, what=what)
     marked = {
@@ -103,7 +107,8 @@ def validate(
         have = ", ".join(sorted(marked)) or "none"
         raise ObservationError(
             f"{what}: no marked frames for {', '.join(missing)} (have: {have}); an estimator that "
-            f"corrects one marked object at a time needs '{MARK_PREFIX}<body>' arrays for every unknown body"
+            f"corrects one marked object at a time needs '{MARK_PREFIX}<body>' arrays for every "
+            "unknown body"
         )
     return Observation(frames, obs.truth, marked, obs.source)
 
@@ -148,7 +153,8 @@ def load_observation(path: str | Path) -> Observation:
         raise ObservationError(f"{p}: cannot read as .npz ({type(exc).__name__}: {exc})") from None
     if "frames" not in arrays:
         raise ObservationError(
-            f"{p}: no 'frames' array (found: {', '.join(sorted(arrays)) or 'none'}); expected key 'frames' "
+            f"{p}: no 'frames' array (found: {', '.join(sorted(arrays)) or 'none'}); expected key "
+            "'frames' "
             "holding (T, C, H, W) floats in [0, 1]"
         )
     frames = arrays.pop("frames")

@@ -114,7 +114,8 @@ class ParamSpace:
         return self.from_unit(rng.random(len(self)))
 
     def normalized_mse(self, estimate: Mapping[str, float], truth: Mapping[str, float]) -> float:
-        """The paper's metric: each parameter divided by the maximum of its range, MSE over unknowns."""
+        """The paper's metric: each parameter divided by the maximum of its range, MSE over
+        unknowns."""
         d = (self.to_vector(estimate) - self.to_vector(truth)) / self.high
         return float(np.mean(d * d))
 

@@ -3,8 +3,9 @@
 Built-ins are declared in physbench's own ``[project.entry-points.physbench]``, the same path a
 third party uses. A plugin that fails to import (or whose hooks fail, or that returns a class that
 does not subclass its kind's base class) is recorded in :attr:`Registry.failed` and skipped; two
-components of one kind with the same name raise :class:`~physbench.errors.PluginError`. ``PHYSBENCH_PLUGINS="pkg.mod,other.mod"`` registers
-modules explicitly, without packaging (Gymnasium's ``module:Name`` idea, as a fallback).
+components of one kind with the same name raise :class:`~physbench.errors.PluginError`.
+``PHYSBENCH_PLUGINS="pkg.mod,other.mod"`` registers modules explicitly, without packaging
+(Gymnasium's ``module:Name`` idea, as a fallback).
 """
 
 from __future__ import annotations
@@ -61,7 +62,8 @@ class Registry:
         return sorted(self.components[kind])
 
     def get(self, kind: str, name: str) -> Any:
-        """The registered class (or scene generator) ``name`` of ``kind``; unknown names list the known."""
+        """The registered class (or scene generator) ``name`` of ``kind``; unknown names list the
+        known."""
         try:
             return self.components[kind][name].obj
         except KeyError:
@@ -80,7 +82,8 @@ class Registry:
             old = known[comp.name]
             raise PluginError(
                 f"duplicate {comp.kind} name {comp.name!r}: provided by plugin {old.plugin!r} "
-                f"({old.package} {old.version}) and by plugin {comp.plugin!r} ({comp.package} {comp.version}); "
+                f"({old.package} {old.version}) and by plugin {comp.plugin!r} ({comp.package} "
+                f"{comp.version}); "
                 "rename one of them or uninstall one package"
             )
         known[comp.name] = comp

@@ -1,9 +1,9 @@
 """Recordings: tracked trajectories of real (or simulated) bodies, and their CSV format.
 
 A recording file is CSV with a header naming the columns ``t, body, x, y`` and optionally
-``angle`` and ``run``, in any order (SI units: s, m, rad; ``x, y`` is the centre of the body's shape,
-as in a :class:`~physbench.trajectory.Trajectory`). Rows may come in any order and each body may be
-sampled at its own, irregular times. Rules:
+``angle`` and ``run``, in any order (SI units: s, m, rad; ``x, y`` is the centre of the body's
+shape, as in a :class:`~physbench.trajectory.Trajectory`). Rows may come in any order and each body
+may be sampled at its own, irregular times. Rules:
 
 - ``t >= 0``: recording time ``t`` is simulation time ``t`` (a scene starts at 0);
 - within one run, a body has at most one sample per time (a repeated time is an error, as is a
@@ -99,7 +99,8 @@ class Track:
         if bad.size:
             i = int(bad[0]) + 1
             raise RecordingError(
-                f"track times must increase strictly; t[{i}] = {self.t[i]!r} follows {self.t[i - 1]!r}"
+                f"track times must increase strictly; t[{i}] = {self.t[i]!r} follows "
+                f"{self.t[i - 1]!r}"
             )
         if self.t[0] < 0:
             raise RecordingError(
@@ -176,7 +177,7 @@ class Recording:
                 raise RecordingError(f"no track of recording {self.run!r} has field {f!r}")
         return tuple(fields)
 
-    # ------------------------------------------------------------------ comparison with a simulation
+    # ----------------------------------------------------------------- comparison with a simulation
 
     def sample(self, traj: Trajectory, *, method: str = "hermite") -> Recording:
         """The simulated poses at this recording's sample times, as a recording of the same
@@ -189,16 +190,18 @@ class Recording:
         for body, tr in self.tracks.items():
             if body not in traj.bodies:
                 raise RecordingError(
-                    f"recorded body {body!r} is not simulated; simulated bodies: {', '.join(traj.bodies)}",
+                    f"recorded body {body!r} is not simulated; simulated bodies: "
+                    f"{', '.join(traj.bodies)}",
                     source=self.source,
                 )
             lo, hi = times[0], times[-1]
             tol = 1e-9 * max(1.0, abs(hi))
             if tr.t[0] < lo - tol or tr.t[-1] > hi + tol:
+                need = self.frames_for(1.0 / (times[1] - times[0])) if times.size > 1 else "more"
                 raise RecordingError(
-                    f"run {self.run!r}, body {body!r}: samples span t = {tr.t[0]:g}..{tr.t[-1]:g} s but the "
-                    f"simulation covers {lo:g}..{hi:g} s; simulate more frames "
-                    f"(at least {self.frames_for(1.0 / (times[1] - times[0])) if times.size > 1 else 'more'})",
+                    f"run {self.run!r}, body {body!r}: samples span t = {tr.t[0]:g}..{tr.t[-1]:g} "
+                    f"s but the simulation covers {lo:g}..{hi:g} s; simulate more frames "
+                    f"(at least {need})",
                     source=self.source,
                 )
             state = traj.body(body)
@@ -324,7 +327,8 @@ def parse_recordings(
     header: list[str] | None = None
     header_line = 0
     row_no = 0
-    # (run, body) -> {"t": [...], "x": [...], "y": [...], "angle": [...], "lines": [...], "angle_line": int}
+    # (run, body) -> {"t": [...], "x": [...], "y": [...], "angle": [...], "lines": [...],
+    #                 "angle_line": int}
     groups: dict[tuple[str, str], dict[str, list]] = {}
     seen_times: dict[tuple[str, str], dict[float, int]] = {}
     angle_state: dict[tuple[str, str], tuple[bool, int]] = {}
@@ -343,7 +347,8 @@ def parse_recordings(
             for i, name in enumerate(header):
                 if name not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS:
                     raise err(
-                        f"unknown column name {name!r}; columns are {', '.join(REQUIRED_COLUMNS)} and optionally "
+                        f"unknown column name {name!r}; columns are {', '.join(REQUIRED_COLUMNS)} "
+                        "and optionally "
                         f"{', '.join(OPTIONAL_COLUMNS)}",
                         name or f"#{i + 1}",
                         line,
@@ -355,7 +360,8 @@ def parse_recordings(
             for name in REQUIRED_COLUMNS:
                 if name not in col:
                     raise err(
-                        f"missing required column; the header has {', '.join(header)} but needs {', '.join(REQUIRED_COLUMNS)}",
+                        f"missing required column; the header has {', '.join(header)} but needs "
+                        f"{', '.join(REQUIRED_COLUMNS)}",
                         name,
                         line,
                         None,
@@ -408,8 +414,10 @@ def parse_recordings(
         if key in angle_state and angle_state[key][0] != has_angle:
             first_with, first_line = angle_state[key]
             raise err(
-                f"angle is {'given' if first_with else 'empty'} for body {body!r} in run {run!r} at line {first_line} "
-                f"but {'given' if has_angle else 'empty'} here; give it in all of the body's rows or in none",
+                f"angle is {'given' if first_with else 'empty'} for body {body!r} in run {run!r} "
+                f"at line {first_line} "
+                f"but {'given' if has_angle else 'empty'} here; give it in all of the body's rows "
+                "or in none",
                 "angle",
                 line,
                 row_no,
@@ -418,7 +426,8 @@ def parse_recordings(
         times = seen_times.setdefault(key, {})
         if t in times:
             raise err(
-                f"t = {t!r} repeats for body {body!r} in run {run!r} (also at line {times[t]}); a body has one sample per time in a run",
+                f"t = {t!r} repeats for body {body!r} in run {run!r} (also at line {times[t]}); a "
+                "body has one sample per time in a run",
                 "t",
                 line,
                 row_no,
@@ -432,7 +441,8 @@ def parse_recordings(
 
     if header is None:
         raise err(
-            f"empty file; expected a header with columns {','.join(REQUIRED_COLUMNS)} (optionally angle, run)",
+            f"empty file; expected a header with columns {','.join(REQUIRED_COLUMNS)} (optionally "
+            "angle, run)",
             "t",
             1,
             None,

@@ -348,7 +348,8 @@ def validate_scene(scene: Scene) -> None:
             xmin + hx - eps <= x <= xmax - hx + eps and ymin + hy - eps <= y <= ymax - hy + eps
         ):
             raise SceneError(
-                f"body (half size {hx:g} x {hy:g} m) must lie inside the world bounds {tuple(scene.bounds)}",
+                f"body (half size {hx:g} x {hy:g} m) must lie inside the world bounds "
+                f"{tuple(scene.bounds)}",
                 key=f"{k}.position",
                 value=b.position,
             )

@@ -12,9 +12,9 @@ STATE_FIELDS = ("x", "y", "angle", "vx", "vy", "omega")
 
 @dataclass(frozen=True, eq=False)
 class Trajectory:
-    """Per frame, per body: ``x, y`` (shape centre, m), ``angle`` (rad, CCW), ``vx, vy`` (velocity of
-    the shape centre, m/s), ``omega`` (rad/s). ``states`` has shape ``(T, N, 6)``; frame 0 is the
-    initial state and frame ``k`` is at ``times[k] = k / fps``."""
+    """Per frame, per body: ``x, y`` (shape centre, m), ``angle`` (rad, CCW), ``vx, vy``
+    (velocity of the shape centre, m/s), ``omega`` (rad/s). ``states`` has shape ``(T, N, 6)``;
+    frame 0 is the initial state and frame ``k`` is at ``times[k] = k / fps``."""
 
     bodies: tuple[str, ...]
     times: np.ndarray  # (T,)
@@ -25,7 +25,8 @@ class Trajectory:
         t, n, c = self.states.shape
         if n != len(self.bodies) or c != len(STATE_FIELDS) or self.times.shape != (t,):
             raise ValueError(
-                f"states {self.states.shape} do not match {len(self.bodies)} bodies and {len(self.times)} times"
+                f"states {self.states.shape} do not match {len(self.bodies)} bodies and "
+                f"{len(self.times)} times"
             )
 
     @property

@@ -21,10 +21,12 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
 
 def test_help_is_fast_and_imports_nothing_heavy() -> None:
     code = (
-        "import contextlib, io, sys, time; t = time.perf_counter(); from physbench.cli import main\n"
+        "import contextlib, io, sys, time; t = time.perf_counter(); from physbench.cli import "
+        "main\n"
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         "    try:\n        main(['--help'])\n    except SystemExit:\n        pass\n"
-        "heavy = [m for m in ('numpy', 'torch', 'optuna', 'hyperopt', 'dask', 'pandas', 'matplotlib', 'pymunk', 'Box2D') if m in sys.modules]\n"
+        "heavy = [m for m in ('numpy', 'torch', 'optuna', 'hyperopt', 'dask', 'pandas', "
+        "'matplotlib', 'pymunk', 'Box2D') if m in sys.modules]\n"
         "print(time.perf_counter() - t, heavy)"
     )
     best = min(

@@ -107,7 +107,10 @@ def test_plugin_failing_to_import_is_reported_and_skipped(site: Path) -> None:
 
 
 def test_hook_that_matches_no_spec_is_reported(site: Path) -> None:
-    src = "from physbench.hookspecs import hookimpl\n@hookimpl\ndef register_simulator():\n    return []\n"
+    src = (
+        "from physbench.hookspecs import hookimpl\n"
+        "@hookimpl\ndef register_simulator():\n    return []\n"
+    )
     make_dist(site, "pbtest-typo", "0.1", {"typo": "pbtest_typo"}, {"pbtest_typo": src})
     reg = build_registry(env=False)
     err = {f.plugin: f.error for f in reg.failed}["typo"]
@@ -115,7 +118,10 @@ def test_hook_that_matches_no_spec_is_reported(site: Path) -> None:
 
 
 def test_hook_that_raises_is_reported(site: Path) -> None:
-    src = "from physbench.hookspecs import hookimpl\n@hookimpl\ndef register_estimators():\n    raise ValueError('bad hook')\n"
+    src = (
+        "from physbench.hookspecs import hookimpl\n"
+        "@hookimpl\ndef register_estimators():\n    raise ValueError('bad hook')\n"
+    )
     make_dist(site, "pbtest-raise", "0.1", {"raiser": "pbtest_raise"}, {"pbtest_raise": src})
     reg = build_registry(env=False)
     assert "bad hook" in {f.plugin: f.error for f in reg.failed}["raiser"]
@@ -132,8 +138,10 @@ def test_a_component_outside_its_contract_is_reported_and_skipped(site: Path) ->
 
 def test_duplicate_component_name_fails_loudly(site: Path) -> None:
     src = (
-        "from physbench.hookspecs import hookimpl\nfrom physbench.simulators.base import Simulator\n"
-        "class S(Simulator):\n    name = 'pymunk'\n@hookimpl\ndef register_simulators():\n    return [S]\n"
+        "from physbench.hookspecs import hookimpl\nfrom physbench.simulators.base import "
+        "Simulator\n"
+        "class S(Simulator):\n    name = 'pymunk'\n@hookimpl\ndef register_simulators():\n    "
+        "return [S]\n"
     )
     make_dist(site, "pbtest-dup", "0.1", {"dup": "pbtest_dup"}, {"pbtest_dup": src})
     with pytest.raises(PluginError, match=r"duplicate simulator name 'pymunk'.*pbtest-dup"):

@@ -28,7 +28,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help="estimator option, repeatable, e.g. -o startup=5 or -o sampler=cmaes (values parse as JSON, else text)",
+        help="estimator option, repeatable, e.g. -o startup=5 or -o sampler=cmaes (values parse as "
+        "JSON, else text)",
     )
     p.add_argument(
         "--scene",
@@ -41,7 +42,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         nargs="+",
         default=["mass"],
         metavar="PARAM",
-        help="unknown parameters to identify, e.g. mass or mass elasticity (commas work too; default: mass)",
+        help="unknown parameters to identify, e.g. mass or mass elasticity (commas work too; "
+        "default: mass)",
     )
     p.add_argument(
         "--bodies",
@@ -73,7 +75,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--observe-engine",
         default=None,
         metavar="NAME",
-        help="simulator that makes the observation (default: --engine); another engine gives a sim-to-sim reality gap",
+        help="simulator that makes the observation (default: --engine); another engine gives a "
+        "sim-to-sim reality gap",
     )
     add_renderer_arguments(p)
     p.add_argument(
@@ -123,8 +126,9 @@ def _fmt(v: float | None) -> str:
     return "-" if v is None else f"{v:.3e}"
 
 
-def print_table(history: Any, out: Any = sys.stdout) -> None:
+def print_table(history: Any, out: Any = None) -> None:
     """The per-iteration table: parameters, image MSE, normalized MSE, best-so-far, timings (ms)."""
+    out = sys.stdout if out is None else out  # looked up now: sys.stdout may be replaced
     keys = list(history.keys)
     has_truth = history.truth is not None
     head = (
@@ -234,7 +238,8 @@ def main(args: argparse.Namespace) -> int:
         print_table(history)
         t = history.timings()
         print(
-            f"per iteration: simulate {1e3 * t['simulate']:.2f} ms, render {1e3 * t['render']:.2f} ms, "
+            f"per iteration: simulate {1e3 * t['simulate']:.2f} ms, render "
+            f"{1e3 * t['render']:.2f} ms, "
             f"estimator {1e3 * t['estimator']:.2f} ms"
         )
         best = history.best
@@ -251,6 +256,7 @@ def main(args: argparse.Namespace) -> int:
         )
     else:
         print(
-            f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation from {args.observation})"
+            f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation "
+            f"from {args.observation})"
         )
     return 0

@@ -59,7 +59,8 @@ def main(args: argparse.Namespace) -> int:
     traj = create("simulator", args.engine).simulate(scene)
     frames = renderer.render(scene, traj)
     print(
-        f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies {', '.join(traj.bodies)}, "
+        f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies "
+        f"{', '.join(traj.bodies)}, "
         f"frames {frames.shape}"
     )
     for i, name in enumerate(traj.bodies):

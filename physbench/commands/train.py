@@ -35,7 +35,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--minutes",
         type=float,
         default=0.0,
-        help="wall-clock budget; training ends at this or --samples, whichever comes first (default: none)",
+        help="wall-clock budget; training ends at this or --samples, whichever comes first "
+        "(default: none)",
     )
     p.add_argument(
         "--device", default="cpu", help="torch device to train on, e.g. cuda (default cpu)"
@@ -44,7 +45,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--blur-max",
         type=float,
         default=0.0,
-        help="augment: blur half the observed sequences by sigma ~ U(0, this) pixels (default 0: off)",
+        help="augment: blur half the observed sequences by sigma ~ U(0, this) pixels (default 0: "
+        "off)",
     )
     p.add_argument(
         "--init",
@@ -110,7 +112,8 @@ def main(args: argparse.Namespace) -> int:
             torch.empty(1, device=args.device)
         except (RuntimeError, AssertionError) as exc:
             raise PhysbenchError(
-                f"--device {args.device!r} is not usable here ({exc}); use cpu or an available GPU, e.g. cuda"
+                f"--device {args.device!r} is not usable here ({exc}); use cpu or an available "
+                "GPU, e.g. cuda"
             ) from None
     spec = DataSpec(
         args.scene,
@@ -139,7 +142,8 @@ def main(args: argparse.Namespace) -> int:
     out = Path(args.out or f"runs/train/{weights_name(spec)}")
     path, meta = train(spec, net, cfg, out, resume=not args.no_resume, progress=not args.quiet)
     print(
-        f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: {meta['val_mse']:.3g}; "
+        f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: "
+        f"{meta['val_mse']:.3g}; "
         f"{meta['training']['samples_seen']} samples in {meta['training']['wall_s']:.0f} s"
     )
     if args.eval_seeds:
@@ -149,7 +153,8 @@ def main(args: argparse.Namespace) -> int:
         for it in (1, 2, 11):
             vals = [r[it] for r in rows]
             print(
-                f"held-out seeds 0..{args.eval_seeds - 1}: normalized min MSE after {it:2d} iterations: "
+                f"held-out seeds 0..{args.eval_seeds - 1}: normalized min MSE after {it:2d} "
+                "iterations: "
                 f"{sum(vals) / len(vals):.3g}"
             )
     return 0

@@ -2,8 +2,9 @@
 
 Each adds named parameters and acts through forces and torques that both engines apply the same
 way every substep. Measurement effects (:class:`SensorOffset`, :class:`ClockScale`) apply no forces
-and change the simulated trajectory through :meth:`~Effect.measure` instead; :func:`apply_measurements` is what
-the framework calls on every simulated trajectory before comparing it with data.
+and change the simulated trajectory through :meth:`~Effect.measure` instead;
+:func:`apply_measurements` is what the framework calls on every simulated trajectory before
+comparing it with data.
 """
 
 from __future__ import annotations

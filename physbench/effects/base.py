@@ -119,7 +119,8 @@ class Effect:
         return f"{type(self).__name__}({vals}{sel}{lab})"
 
     def qualified(self) -> dict[str, float]:
-        """The current values keyed ``"<key>.<param>"``, as :meth:`setup` and ``simulate`` take them."""
+        """The current values keyed ``"<key>.<param>"``, as :meth:`setup` and ``simulate`` take
+        them."""
         return {f"{self.key}.{k}": v for k, v in self.values.items()}
 
     # ----------------------------------------------------------------- configuration

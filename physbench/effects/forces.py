@@ -28,7 +28,8 @@ class ConstantForce(Effect):
 
 
 class TableTilt(Effect):
-    """``F = m (ax, ay)``: the in-plane pull of gravity on a slightly tilted table (``a ≈ g·slope``)."""
+    """``F = m (ax, ay)``: the in-plane pull of gravity on a slightly tilted table (``a ≈
+    g·slope``)."""
 
     name: ClassVar[str] = "table_tilt"
     params: ClassVar[tuple[Parameter, ...]] = (

@@ -38,7 +38,8 @@ class JointEffect(Effect):
         for j in chosen:
             if not 0 <= j < len(scene.joints):
                 raise EffectError(
-                    f"{self.name}: joint index {j} out of range; scene {scene.name!r} has joints 0..{len(scene.joints) - 1}"
+                    f"{self.name}: joint index {j} out of range; scene {scene.name!r} has joints "
+                    f"0..{len(scene.joints) - 1}"
                 )
         sel = [scene.joints[j] for j in chosen]
         self.ia = np.array([scene.body_index(j.a) for j in sel], dtype=int)

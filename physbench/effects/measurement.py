@@ -26,7 +26,8 @@ class _Measurement(Effect):
         missing = [b for b in self.bodies if b not in traj.bodies]
         if missing:
             raise EffectError(
-                f"{self.name}: bodies {missing} are not in the trajectory (bodies: {list(traj.bodies)})"
+                f"{self.name}: bodies {missing} are not in the trajectory (bodies: "
+                f"{list(traj.bodies)})"
             )
         return np.array([b in self.bodies for b in traj.bodies], dtype=bool)
 

@@ -15,7 +15,8 @@ class EstimatorOptionError(PhysbenchError, ValueError):
 def int_option(
     estimator: str, name: str, value: object, *, low: int, allow_none: bool = False
 ) -> int | None:
-    """``value`` as an int ``>= low`` (or ``None`` when allowed), else :class:`EstimatorOptionError`."""
+    """``value`` as an int ``>= low`` (or ``None`` when allowed), else
+    :class:`EstimatorOptionError`."""
     if value is None and allow_none:
         return None
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:

@@ -32,7 +32,8 @@ def plot_convergence(
 ) -> Path:
     """Write a figure of best-so-far normalized MSE (top, when the truth is known) and image MSE
     (bottom) against the iteration count; one line per label: the median over its runs, with the
-    interquartile range shaded (on a log axis a mean ± std band runs below zero). Returns the path."""
+    interquartile range shaded (on a log axis a mean ± std band runs below zero). Returns the
+    path."""
     from physbench.loop import History
 
     if isinstance(histories, History):

@@ -217,7 +217,8 @@ class RasterRenderer(Renderer):
         frames, n = states.shape[0], len(scene.bodies)
         if states.shape[1] != n or (traj.bodies and tuple(traj.bodies) != scene.body_names):
             raise RenderError(
-                f"trajectory bodies {list(traj.bodies)} do not match the scene's bodies {list(scene.body_names)}"
+                f"trajectory bodies {list(traj.bodies)} do not match the scene's bodies "
+                f"{list(scene.body_names)}"
             )
         if not np.isfinite(states[:, :, :3]).all():
             t, i = np.argwhere(~np.isfinite(states[:, :, :3]).all(axis=2))[0]

@@ -1,7 +1,8 @@
 """Built-in scene generators, one per module, each a seeded ``(seed) -> Scene`` callable.
 
-A generator carries ``name`` and ``description`` attributes (set by :func:`~physbench.scenes.generator.scene_generator`) and is
-registered through the ``register_scenes`` hook like any third-party scene.
+A generator carries ``name`` and ``description`` attributes (set by
+:func:`~physbench.scenes.generator.scene_generator`) and is registered through the
+``register_scenes`` hook like any third-party scene.
 """
 
 from __future__ import annotations

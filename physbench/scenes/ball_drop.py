@@ -1,4 +1,5 @@
-"""ball_drop: a ball dropped from ≈47 m, matching de Silva et al.'s ball drops (``ball_drops_desilva``).
+"""ball_drop: a ball dropped from ≈47 m, matching de Silva et al.'s ball drops
+(``ball_drops_desilva``).
 
 Geometry and units follow the data's PROVENANCE.md: heights in m, 15 frames per second, drops from
 45.5-49.5 m recorded for 2.8-3.9 s. Each ball's mass and radius come from the authors'
@@ -60,8 +61,8 @@ def generate(
     fps: float = FPS,
     substeps: int = 10,
 ) -> Scene:
-    """``ball`` released at ``height`` m (None: 45.5-49.5 m from the seed) moving at ``velocity`` m/s
-    (up positive)."""
+    """``ball`` released at ``height`` m (None: 45.5-49.5 m from the seed) moving at ``velocity``
+    m/s (up positive)."""
     mass, radius = ball_properties(ball)
     rng = np.random.default_rng([seed, 6])
     y0 = rng.uniform(45.5, 49.5) if height is None else float(height)

@@ -38,7 +38,8 @@ SLOTS = ((0, 0.0), (1, 0.5), (1, -0.5), (2, 0.0), (2, 1.0), (2, -1.0))
     "bouncing_balls", "top-down pool table: a test ball shot into a rack of 2-6 unknown balls"
 )
 def generate(seed: int = 0, n_balls: int | None = None) -> Scene:
-    """A pool table with ``n_balls`` unknown-mass balls ``b0..`` (None: 2-6, drawn from the seed)."""
+    """A pool table with ``n_balls`` unknown-mass balls ``b0..`` (None: 2-6, drawn from the
+    seed)."""
     rng = np.random.default_rng([seed, 4])
     n = int(rng.integers(2, MAX_BALLS + 1)) if n_balls is None else n_balls
     if isinstance(n, bool) or not 1 <= n <= MAX_BALLS:

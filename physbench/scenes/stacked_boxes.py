@@ -5,8 +5,9 @@ the left and strikes ``lower`` at its centre height, so ``lower`` slides out fro
 Contacts multiply the two surfaces' friction (the floor's is 1), so ``lower`` slides on the floor
 with its own friction and ``upper`` is dragged by ``lower.friction * upper.friction``: the drag can
 never match the floor's grip, so ``upper`` always slips on ``lower``, lags behind and tips off the
-back onto the floor or onto the test circle, which follows ``lower``. Friction is therefore seen through sliding distances for
-every value in the range; boxes never stick or topple forward (that would need friction > 1).
+back onto the floor or onto the test circle, which follows ``lower``. Friction is therefore seen
+through sliding distances for every value in the range; boxes never stick or topple forward (that
+would need friction > 1).
 """
 
 from __future__ import annotations

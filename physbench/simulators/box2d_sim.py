@@ -82,7 +82,8 @@ def _polygon(points: Any) -> Any:
 
 
 def _inset(points: tuple[tuple[float, float], ...], r: float) -> list[tuple[float, float]] | None:
-    """The convex CCW polygon whose edges lie ``r`` inside ``points``' edges, or None if too small."""
+    """The convex CCW polygon whose edges lie ``r`` inside ``points``' edges, or None if too
+    small."""
     n = len(points)
     lines = []
     for i in range(n):

@@ -125,7 +125,8 @@ def first_restitution(effects: Sequence[Effect]) -> RestitutionHook | None:
 
 
 def com_offsets_world(scene: Scene, angles: np.ndarray) -> np.ndarray:
-    """``(..., N, 2)`` vectors from shape centre to centre of mass, rotated by ``angles (..., N)``."""
+    """``(..., N, 2)`` vectors from shape centre to centre of mass, rotated by ``angles (...,
+    N)``."""
     off = np.array([b.com_offset for b in scene.bodies], dtype=float)
     c, s = np.cos(angles), np.sin(angles)
     return np.stack([c * off[:, 0] - s * off[:, 1], s * off[:, 0] + c * off[:, 1]], axis=-1)
@@ -292,7 +293,8 @@ class SteppingSimulator(Simulator):
                 dv = math.hypot(x, y) / body.mass * (1.0 if impulse else h)
                 if dv >= SPEED_LIMIT_FRACTION * vmax:
                     raise SimulationError(
-                        f"{'impulse' if impulse else 'force'} changes the speed by {dv:.3g} m/s in one step; "
+                        f"{'impulse' if impulse else 'force'} changes the speed by {dv:.3g} m/s "
+                        "in one step; "
                         f"the engine clamps speeds above {vmax:.3g} m/s at this step size",
                         engine=self.name,
                         frame=k // n_sub + 1,
@@ -346,8 +348,10 @@ class SteppingSimulator(Simulator):
             why = f"body left the world {tuple(scene.bounds)} (at x={x[t, i]:.3g}, y={y[t, i]:.3g})"
         else:
             why = (
-                f"speed reached the engine's limit ({vmax:.3g} m/s, {wmax:.3g} rad/s at this step size; "
-                f"v={math.hypot(states[t, i, 3], states[t, i, 4]):.3g} m/s, ω={states[t, i, 5]:.3g} rad/s): "
+                f"speed reached the engine's limit ({vmax:.3g} m/s, {wmax:.3g} rad/s at this step "
+                "size; "
+                f"v={math.hypot(states[t, i, 3], states[t, i, 4]):.3g} m/s, "
+                f"ω={states[t, i, 5]:.3g} rad/s): "
                 "the engine clamped it; more substeps raise the limit"
             )
         raise SimulationError(why, engine=self.name, frame=int(t), body=scene.bodies[i].name)

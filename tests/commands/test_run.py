@@ -169,7 +169,8 @@ def test_clear_errors(capsys: pytest.CaptureFixture[str], argv: list[str], messa
 
 def test_argument_parsing_imports_nothing_heavy() -> None:
     code = (
-        "import sys\nfrom physbench.cli import build_parser\nbuild_parser('run').parse_args(['run', '--estimator', 'tpe'])\n"
+        "import sys\nfrom physbench.cli import "
+        "build_parser\nbuild_parser('run').parse_args(['run', '--estimator', 'tpe'])\n"
         "print([m for m in ('numpy', 'physbench.loop', 'tqdm', 'pandas') if m in sys.modules])"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -312,7 +312,7 @@ def test_joint_between_bodies_gets_equal_and_opposite_torques():
     assert tau.tolist() == pytest.approx([-0.15, 0.15])
 
 
-# --------------------------------------------------------------------------- measurement and contact
+# -------------------------------------------------------------------------- measurement and contact
 
 
 def test_sensor_offset_and_clock_scale_change_only_the_measurement():

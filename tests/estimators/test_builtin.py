@@ -95,9 +95,11 @@ def test_builtins_pass_the_conformance_suite(name: str) -> None:
 def test_importing_estimator_modules_does_not_import_the_optimisers() -> None:
     code = (
         "import sys\n"
-        "import physbench.estimators.tpe, physbench.estimators.cmaes, physbench.estimators.optuna_sampler\n"
+        "import physbench.estimators.tpe, physbench.estimators.cmaes, "
+        "physbench.estimators.optuna_sampler\n"
         "import physbench.estimators.random_search, physbench.loop, physbench.testing\n"
-        "print([m for m in ('hyperopt', 'nevergrad', 'optuna', 'pandas', 'matplotlib', 'scipy') if m in sys.modules])"
+        "print([m for m in ('hyperopt', 'nevergrad', 'optuna', 'pandas', 'matplotlib', 'scipy') "
+        "if m in sys.modules])"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"

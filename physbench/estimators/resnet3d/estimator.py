@@ -78,7 +78,8 @@ class ResNet3DEstimator(CorrectionEstimator):
                 raise PhysbenchError(f"body {body!r} lacks unknowns {missing} the weights predict")
             if body not in self.observed:
                 raise PhysbenchError(
-                    f"resnet3d needs the observation with {body!r} marked (frames rendered with focus={body!r}); "
+                    f"resnet3d needs the observation with {body!r} marked (frames rendered with "
+                    f"focus={body!r}); "
                     "give marked_<body> arrays in the observation file"
                 )
             by_key = {u.key: u for u in sub.unknowns}

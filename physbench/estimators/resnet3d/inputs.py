@@ -19,7 +19,8 @@ def time_indices(total: int, frames: int) -> np.ndarray:
 
 
 def resize(frames: np.ndarray, size: int) -> np.ndarray:
-    """Area-average ``(..., H, W)`` so that H becomes ``size`` (integer factors take a fast path)."""
+    """Area-average ``(..., H, W)`` so that H becomes ``size`` (integer factors take a fast
+    path)."""
     h, w = frames.shape[-2:]
     if h == size:
         return frames

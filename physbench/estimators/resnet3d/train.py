@@ -230,7 +230,8 @@ def train(
         "data": spec.to_dict(),
         "net": net_cfg.to_dict(),
         "ranges": _ranges(spec),
-        "normalization": "target = (p_observed - p_simulated) / (high - low), per parameter of the marked body",
+        "normalization": "target = (p_observed - p_simulated) / (high - low), per parameter of "
+        "the marked body",
         "training": {
             **asdict(cfg),
             "samples_seen": seen,

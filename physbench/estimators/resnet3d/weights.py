@@ -53,7 +53,8 @@ def save(path: str | Path, state: dict[str, Any], meta: dict[str, Any]) -> Path:
 
 
 def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(tensors, meta) from a .safetensors file and its sidecar; int8 storage comes back as float32."""
+    """(tensors, meta) from a .safetensors file and its sidecar; int8 storage comes back as
+    float32."""
     from safetensors.torch import load_file
 
     path = Path(path).with_suffix(".safetensors")
@@ -123,7 +124,8 @@ def find(scene: str, params: tuple[str, ...]) -> WeightsInfo:
             return w
     have = ", ".join(f"{w.scene}[{'+'.join(w.params)}]" for w in found) or "none"
     raise PhysbenchError(
-        f"no resnet3d weights for scene {scene!r} with parameters {'+'.join(want)}; available: {have}. "
+        f"no resnet3d weights for scene {scene!r} with parameters {'+'.join(want)}; available: "
+        f"{have}. "
         f"Train them with `physbench train --scene {scene} --params {','.join(want)}` "
         "and put the output folder on PHYSBENCH_WEIGHTS."
     )

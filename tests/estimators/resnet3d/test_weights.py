@@ -26,7 +26,8 @@ def test_missing_weights_error_says_how_to_train(
     monkeypatch.setattr(weights, "SHIPPED", tmp_path)
     with pytest.raises(
         PhysbenchError,
-        match=r"no resnet3d weights for scene 'three_circles'.*physbench train --scene three_circles --params mass",
+        match=r"no resnet3d weights for scene 'three_circles'.*physbench train --scene "
+        r"three_circles --params mass",
     ):
         weights.find("three_circles", ("mass",))
 
