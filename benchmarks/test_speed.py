@@ -37,7 +37,8 @@ CASES = [f"{s}-{e}" for s in SCENES for e in ENGINES]
 
 
 def _stand_in_balls(seed: int, n: int) -> Scene:
-    """Used only without ``physbench.scenes.bouncing_balls``: a test ball and n balls, no gravity."""
+    """Used only without ``physbench.scenes.bouncing_balls``: a test ball and n balls, no
+    gravity."""
     rng = np.random.default_rng(seed)
     bounds = (0.0, 0.0, 4.0, 4.0)
     bodies = tuple(
@@ -102,14 +103,17 @@ def push_schedule(scene: Scene) -> list[list[tuple[bool, int, float, float]]]:
 
 
 @dataclass
-class Case:
+class Workload:
+    """One scene on one engine, with everything each timed job needs."""
+
     scene: Scene
     sim: Any
     renderer: RasterRenderer
 
     @classmethod
-    def named(cls, case: str) -> Case:
-        scene_name, engine = case.rsplit("-", 1)
+    def named(cls, name: str) -> Workload:
+        """``"<scene>-<engine>"`` -> its workload."""
+        scene_name, engine = name.rsplit("-", 1)
         return cls(load_scene(scene_name), make_simulator(engine), RasterRenderer())
 
     def __post_init__(self) -> None:
@@ -138,7 +142,7 @@ class Case:
 def measure(case: str, repeats: int = REPEATS) -> dict[str, float]:
     """Median seconds of build, raw, simulate, render and full, timed interleaved, plus
     ``ratio`` (of the medians) and ``ratio_min`` (of the fastest runs)."""
-    c = Case.named(case)
+    c = Workload.named(case)
     traj = c.simulate()
     jobs: dict[str, Callable[[], object]] = {
         "build": c.build,
@@ -172,11 +176,13 @@ def table(results: dict[str, dict[str, float]]) -> str:
     for case, m in results.items():
         ms = {k: v * 1e3 for k, v in m.items()}
         lines.append(
-            f"{case:<24}{ms['build']:8.3f}{ms['raw'] - ms['build']:8.3f}{ms['simulate'] - ms['raw']:10.3f}"
-            f"{ms['render']:8.3f}{ms['raw']:8.3f}{ms['full']:8.3f}{m['ratio']:10.2f}{m['ratio_min']:7.2f}"
+            f"{case:<24}{ms['build']:8.3f}{ms['raw'] - ms['build']:8.3f}"
+            f"{ms['simulate'] - ms['raw']:10.3f}{ms['render']:8.3f}{ms['raw']:8.3f}"
+            f"{ms['full']:8.3f}{m['ratio']:10.2f}{m['ratio_min']:7.2f}"
         )
     lines.append(
-        f"target: full/raw <= {TARGET:g}, checked on the fastest runs (median of {REPEATS} interleaved repeats; ms)"
+        f"target: full/raw <= {TARGET:g}, checked on the fastest runs (median of {REPEATS} "
+        "interleaved repeats; ms)"
     )
     return "\n".join(lines)
 
@@ -186,14 +192,14 @@ def table(results: dict[str, dict[str, float]]) -> str:
 
 @pytest.mark.parametrize("case", CASES)
 def test_raw_stepping(benchmark: Any, case: str) -> None:
-    c = Case.named(case)
+    c = Workload.named(case)
     benchmark.group = case
     benchmark(c.raw)
 
 
 @pytest.mark.parametrize("case", CASES)
 def test_simulate_and_render(benchmark: Any, case: str) -> None:
-    c = Case.named(case)
+    c = Workload.named(case)
     benchmark.group = case
     frames = benchmark(c.full)
     assert frames.shape == c.renderer.shape(c.scene)
