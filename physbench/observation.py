@@ -4,8 +4,9 @@ File format (``.npz``, written by :func:`save_observation`, read by :func:`load_
 
 ``frames``
     required, ``(T, C, H, W)`` floats in [0, 1]; ``T`` must equal the scene's frame count and
-    ``C, H, W`` the model renderer's output (e.g. ``raster`` in ``mark`` mode: ``C = 2``, channel
-    0 every body, channel 1 empty; at ``--resolution 64`` on a square world ``H = W = 64``).
+    ``C, H, W`` the model renderer's output (e.g. the default renderer in ``mark`` mode:
+    ``C = 2``, channel 0 every body, channel 1 empty; at ``--resolution 64`` on a square world
+    ``H = W = 64``).
 ``marked_<body>``
     optional, same shape: the frames with ``<body>`` marked (rendered with ``focus=<body>``),
     needed only by estimators that correct one marked object at a time.

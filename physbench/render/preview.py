@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.render.raster import RasterRenderer, RenderError
+from physbench.render.base import DEFAULT_RENDERER, RenderError
 from physbench.scene import Segment
 
 if TYPE_CHECKING:
@@ -72,7 +72,10 @@ def save_preview(
     xmin, ymin, xmax, ymax = scene.bounds
     mx, my = MARGIN * (xmax - xmin), MARGIN * (ymax - ymin)
     view = dataclasses.replace(scene, bounds=(xmin - mx, ymin - my, xmax + mx, ymax + my))
-    renderer = RasterRenderer(resolution=size, mode="instance")
+    from physbench.plugins import create
+
+    # the default renderer draws each body's coverage, one channel per body, for the colours
+    renderer = create("renderer", DEFAULT_RENDERER, resolution=size, mode="instance")
     cover = renderer.render(view, traj)  # (T, N, H, W)
     h, w = cover.shape[2:]
     vx0, vy0, vx1, vy1 = view.bounds
