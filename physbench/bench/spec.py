@@ -95,7 +95,8 @@ class SceneSpec:
 @dataclass(frozen=True)
 class Cell:
     """One run of a sweep. ``index`` is its position in the spec's product (the table's order);
-    ``key`` hashes everything that determines the result, so it names the cell's result file."""
+    ``key`` hashes its settings, so it names the cell's result file (the code behind the
+    settings is recorded apart, in the cell's stamp: :mod:`physbench.bench.stamp`)."""
 
     index: int
     config: RunConfig
