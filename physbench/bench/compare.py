@@ -1,15 +1,18 @@
 """Regression check of a sweep against a baseline sweep.
 
-Cells are matched on their full configuration and seed (:data:`~physbench.bench.tables.MATCH`).
-Seeds fix the scene instance, the truth, the initial guess and the estimator's randomness, so a
-matched pair differs only through code or library changes, and the test is paired over seeds:
+Cells are matched on their full configuration and seed (:data:`~physbench.bench.tables.MATCH`);
+a table written before the renderer columns existed counts as the default renderer without
+options. Seeds fix the scene instance, the truth, the initial guess and the estimator's
+randomness, so a matched pair differs only through code or library changes, and the test is
+paired over seeds:
 
-For every estimator × scene × unknown set (× any other setting), with ``d_i = ln(new_i / base_i)``
-the per-seed log ratio of normalized min MSE after N iterations, the configuration is **worse** when
+For every estimator × scene × unknown set (× any other setting), with ``d_i = ln(new_i /
+base_i)`` the per-seed log ratio of normalized min MSE after N iterations, the configuration is
+**worse** when
 
-1. a one-sided Wilcoxon signed-rank test (zero differences dropped) rejects "no shift towards larger
-   errors" at family-wise level ``alpha`` (default 0.05) after Holm's correction over all compared
-   configurations, **and**
+1. a one-sided Wilcoxon signed-rank test (zero differences dropped) rejects "no shift towards
+   larger errors" at family-wise level ``alpha`` (default 0.05) after Holm's correction over all
+   compared configurations, **and**
 2. the geometric-mean ratio ``exp(mean d_i)`` over all matched seeds is at least ``min_ratio``
    (default 1.25, i.e. errors 25 % larger), so that tiny but consistent shifts are not flagged;
 
@@ -30,7 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.bench.tables import CONFIG, MATCH, final_rows
+from physbench.bench.tables import CONFIG, MATCH, final_rows, upgrade
 from physbench.errors import PhysbenchError
 
 if TYPE_CHECKING:
@@ -86,8 +89,9 @@ def compare(
     if not min_ratio >= 1:
         raise PhysbenchError(f"min_ratio = {min_ratio!r}: expected a ratio >= 1, e.g. 1.25")
     cols = list(MATCH)
-    a = final_rows(new)[[*cols, "status", "best_nmse"]]
-    b = final_rows(base)[[*cols, "status", "best_nmse"]]
+    # tables written before the renderer columns existed ran the default renderer
+    a = final_rows(upgrade(new))[[*cols, "status", "best_nmse"]]
+    b = final_rows(upgrade(base))[[*cols, "status", "best_nmse"]]
     m = a.merge(b, on=cols, how="outer", suffixes=("_new", "_base"), indicator=True)
     only_new, only_base = (
         int((m["_merge"] == "left_only").sum()),
@@ -96,8 +100,9 @@ def compare(
     m = m[m["_merge"] == "both"]
     if m.empty:
         raise PhysbenchError(
-            "no cell of the new sweep matches a baseline cell (same scene, unknowns, estimator, options, engines, "
-            "blur, noise, resolution, render mode, iterations and seed); compare sweeps of the same spec"
+            "no cell of the new sweep matches a baseline cell (same scene, unknowns, estimator, "
+            "options, engines, renderer and its options, blur, noise, resolution, render mode, "
+            "iterations and seed); compare sweeps of the same spec"
         )
     rows = []
     for key, g in m.groupby(list(CONFIG), sort=False, dropna=False):

@@ -92,8 +92,9 @@ class ProcessExecutor:
                 yield futures[fut], fut.result()
         except BrokenProcessPool as exc:
             raise PhysbenchError(
-                f"a worker process died ({exc}); finished cells are saved: re-run the same command to "
-                "resume, or use --executor serial to see which cell crashes the interpreter"
+                f"a worker process died ({exc}); finished cells are saved: re-run the same "
+                "command to resume, or use --executor serial to see which cell crashes the "
+                "interpreter"
             ) from None
         finally:
             for fut in futures:
@@ -145,7 +146,8 @@ class DaskExecutor:
                 self._client = Client(self._cluster)
         except OSError as exc:
             raise PhysbenchError(
-                f"--address {self.address!r}: cannot reach a Dask scheduler ({exc}); expected e.g. tcp://host:8786"
+                f"--address {self.address!r}: cannot reach a Dask scheduler ({exc}); expected "
+                "e.g. tcp://host:8786"
             ) from None
         return self
 
@@ -165,10 +167,11 @@ class DaskExecutor:
             for fut in as_completed(futures):
                 try:
                     result = fut.result()
-                except Exception as exc:  # the cell itself never raises: this is the cluster (a killed worker, ...)
+                # the cell itself never raises: this is the cluster (a killed worker, ...)
+                except Exception as exc:
                     raise PhysbenchError(
-                        f"the Dask cluster lost a cell ({type(exc).__name__}: {exc}); finished cells are saved: "
-                        "re-run the same command to resume"
+                        f"the Dask cluster lost a cell ({type(exc).__name__}: {exc}); finished "
+                        "cells are saved: re-run the same command to resume"
                     ) from None
                 yield index[fut.key], result
         finally:

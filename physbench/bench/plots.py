@@ -1,11 +1,12 @@
-"""Figures of a sweep, from its long table (matplotlib, Agg backend, imported inside each function).
+"""Figures of a sweep, from its long table (matplotlib, Agg backend, imported inside each
+function).
 
 - :func:`convergence`: best-so-far normalized MSE per iteration, mean over seeds and the spread
   (interquartile band) for every estimator, one panel per unknown set (the paper's Fig. 3).
 - :func:`trajectories`: the iterates of the first seeds in the plane of two unknowns, as arrows,
   with the truth as a filled circle (Fig. 5).
 - :func:`landscape`: image MSE against the deviation of one parameter from its nominal value,
-  per body (Fig. 4); this one simulates.
+  per body (Fig. 4), with the sweep's engine and renderer; this one simulates.
 - :func:`win_rate`: how often each estimator ends closer to the truth than each other one.
 """
 
@@ -13,7 +14,7 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -25,8 +26,11 @@ from physbench.bench.tables import (
     param_frame,
     scene_label,
     unknowns_label,
+    upgrade,
     win_rate_table,
 )
+from physbench.render.base import DEFAULT_RENDERER
+from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -38,6 +42,7 @@ SETTINGS = (
     "bodies",
     "engine",
     "observe_engine",
+    "renderer",
     "blur",
     "noise",
     "resolution",
@@ -87,7 +92,8 @@ def _title(cfg: dict[str, Any], varying: Sequence[str]) -> str:
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    """PNG with a 128-colour palette: line plots lose nothing visible and shrink 2-4x (committed files)."""
+    """PNG with a 128-colour palette: line plots lose nothing visible and shrink 2-4x (committed
+    files)."""
     import io
 
     from PIL import Image
@@ -206,8 +212,9 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
             ax.set_title(str(est["estimator"]), fontsize="medium")
             ax.set_xlabel(kx)
         axes[0, 0].set_ylabel(ky)
+        seeds_text = ", ".join(map(str, chosen))
         fig.suptitle(
-            f"{_title(cfg, varying)}, {unknowns_label(str(cfg['unknowns']))}: seeds {', '.join(map(str, chosen))} "
+            f"{_title(cfg, varying)}, {unknowns_label(str(cfg['unknowns']))}: seeds {seeds_text} "
             "(hollow: start, star: best by image MSE, filled: truth)",
             fontsize="small",
         )
@@ -220,21 +227,25 @@ def landscape_data(
     scene: str,
     param: str,
     *,
-    engine: str = "pymunk",
+    engine: str = DEFAULT_SIMULATOR,
+    renderer: str = DEFAULT_RENDERER,
+    renderer_options: Mapping[str, Any] | None = None,
     resolution: int = 64,
     render_mode: str = "mark",
     seeds: Sequence[int] = (0, 1, 2),
     points: int = 21,
 ) -> dict[str, np.ndarray]:
     """Image MSE between the scene at nominal parameters and the scene with one unknown
-    ``body.param`` moved across its range, per key: ``{"x": Δp grid (points,), key: (seeds, points)}``,
-    Δp relative to the nominal value (the range's middle)."""
+    ``body.param`` moved across its range, per key: ``{"x": Δp grid (points,), key: (seeds,
+    points)}``, Δp relative to the nominal value (the range's middle); frames from ``renderer``
+    with ``renderer_options``."""
+    from physbench.experiment import make_renderer
     from physbench.metrics import image_mse
     from physbench.plugins import create
     from physbench.scenes import resolve_scene
 
     sim = create("simulator", engine)
-    ren = create("renderer", "raster", resolution=resolution, mode=render_mode)
+    ren = make_renderer(renderer, renderer_options or {}, resolution=resolution, mode=render_mode)
     out: dict[str, Any] = {}
     for si, seed in enumerate(seeds):
         sc = resolve_scene(scene, seed)
@@ -258,23 +269,32 @@ def landscape_data(
 
 
 def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) -> list[Path]:
-    """Per scene: a panel per parameter among the sweep's unknowns, a line per body (mean over
-    ``seeds`` scene instances, band: min to max), with the model settings of the sweep's first cell."""
+    """Per scene (and renderer, when the sweep has several): a panel per parameter among the
+    sweep's unknowns, a line per body (mean over ``seeds`` scene instances, band: min to max),
+    with the engine, renderer, resolution and render mode of the first such cell."""
     plt = _plt()
-    first = df.sort_values("cell_index").iloc[0]
-    engine, res, mode = str(first["engine"]), int(first["resolution"]), str(first["render_mode"])
+    df = upgrade(df)
+    several = df["renderer"].nunique() > 1
     paths = []
-    for scene in dict.fromkeys(df.sort_values("cell_index")["scene"]):
-        params = list(
-            dict.fromkeys(p for u in df.loc[df["scene"] == scene, "unknowns"] for p in u.split("+"))
+    for cfg, rows in _groups(df, ["scene", "renderer"]):
+        scene = str(cfg["scene"])
+        first = rows.sort_values("cell_index").iloc[0]
+        engine, res, mode = (
+            str(first["engine"]),
+            int(first["resolution"]),
+            str(first["render_mode"]),
         )
+        renderer, options = str(first["renderer_name"]), json.loads(first["renderer_options"])
+        params = list(dict.fromkeys(p for u in rows["unknowns"] for p in u.split("+")))
         fig, axes = plt.subplots(1, len(params), figsize=(4 * len(params), 3.2), squeeze=False)
         try:
             for ax, param in zip(axes[0], params, strict=True):
                 data = landscape_data(
-                    str(scene),
+                    scene,
                     param,
                     engine=engine,
+                    renderer=renderer,
+                    renderer_options=options,
                     resolution=res,
                     render_mode=mode,
                     seeds=range(seeds),
@@ -297,18 +317,18 @@ def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) 
                 ax.set_title(param, fontsize="medium")
                 ax.legend(fontsize="x-small")
                 ax.grid(True, alpha=0.25)
-        except Exception:  # e.g. a scene file that moved since the sweep
+        except Exception:  # e.g. a scene file that moved since the sweep, a renderer now missing
             plt.close(fig)
             continue
         axes[0, 0].set_ylabel("image MSE vs nominal")
+        shown = f"{engine}, {cfg['renderer']}, {res} px" if several else f"{engine}, {res} px"
         fig.suptitle(
-            f"{scene_label(str(scene))}: image-MSE landscape ({engine}, {res} px, mean of {seeds} scene instances)",
+            f"{scene_label(scene)}: image-MSE landscape ({shown}, mean of {seeds} scene instances)",
             fontsize="medium",
         )
         fig.tight_layout()
-        paths.append(
-            _save(fig, out / f"landscape_{re.sub(r'[^A-Za-z0-9_.-]+', '-', str(scene))}.png")
-        )
+        name = f"landscape_{scene}" + (f"_renderer{cfg['renderer']}" if several else "")
+        paths.append(_save(fig, out / f"{re.sub(r'[^A-Za-z0-9_.-]+', '-', name)}.png"))
     return paths
 
 
@@ -347,6 +367,7 @@ def plot_all(
 ) -> dict[str, list[Path]]:
     """Every figure into ``out`` (created); ``landscape_seeds=0`` skips the simulating one."""
     out.mkdir(parents=True, exist_ok=True)
+    df = upgrade(df)
     figs = {
         "convergence": convergence(df, out),
         "trajectories": trajectories(df, out, seeds=seeds),

@@ -43,7 +43,8 @@ def build(
     title: str,
     run_log: Mapping[str, Any] | None = None,
 ) -> Path:
-    """Write ``out/report.html`` from the long table ``df`` and the figure files; returns its path."""
+    """Write ``out/report.html`` from the long table ``df`` and the figure files; returns its
+    path."""
     from physbench.bench.store import atomic_write
     from physbench.bench.tables import (
         detail,
@@ -51,9 +52,11 @@ def build(
         paper_layout,
         side_by_side,
         stats,
+        upgrade,
         win_rate_table,
     )
 
+    df = upgrade(df)
     st = stats(df)
     parts = [
         f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>",
@@ -62,34 +65,36 @@ def build(
     fin = final_rows(df)
     cells, failed = len(fin), int((fin["status"] != "ok").sum())
     iters = ", ".join(str(i) for i in dict.fromkeys(st["iterations"]))
+    renderers = ", ".join(html.escape(str(r)) for r in dict.fromkeys(df["renderer"]))
     parts.append(
-        f"<p>{cells} cells ({failed} failed), {fin['seed'].nunique()} seeds, {iters} iterations. "
-        "Score: normalized min MSE of the best-by-image-MSE iterate (the paper's Table 1 metric).</p>"
+        f"<p>{cells} cells ({failed} failed), {fin['seed'].nunique()} seeds, {iters} iterations, "
+        f"rendered by {renderers}. Score: normalized min MSE of the best-by-image-MSE iterate "
+        "(the paper's Table 1 metric).</p>"
     )
     if run_log:
         runs = run_log.get("runs", [])
         rows = "".join(
-            f"<tr><td>{html.escape(str(r.get('started')))}</td><td>{html.escape(str(r.get('executor')))}</td>"
+            f"<tr><td>{html.escape(str(r.get('started')))}</td>"
+            f"<td>{html.escape(str(r.get('executor')))}</td>"
             f"<td>{r.get('ran')}</td><td>{r.get('skipped')}</td><td>{r.get('wall_s')}</td></tr>"
             for r in runs
         )
         parts.append(
-            "<h2>Runs</h2><table><tr><th>started</th><th>executor</th><th>cells run</th><th>skipped</th>"
-            f"<th>wall s</th></tr>{rows}</table>"
+            "<h2>Runs</h2><table><tr><th>started</th><th>executor</th><th>cells run</th>"
+            f"<th>skipped</th><th>wall s</th></tr>{rows}</table>"
         )
         if run_log.get("versions"):
-            parts.append(
-                f"<p class='note'>versions: <code>{html.escape(json.dumps(run_log['versions']))}</code></p>"
-            )
+            versions = html.escape(json.dumps(run_log["versions"]))
+            parts.append(f"<p class='note'>versions: <code>{versions}</code></p>")
     parts += [
-        "<h2>Table 1 layout</h2><p class='note'>mean ± sample std over seeds; paper rows: Link, Schwarz, "
-        "Behnke (IJCNN 2022), Table 1, 11 iterations, 10 seeds.</p>",
+        "<h2>Table 1 layout</h2><p class='note'>mean ± sample std over seeds; paper rows: Link, "
+        "Schwarz, Behnke (IJCNN 2022), Table 1, 11 iterations, 10 seeds.</p>",
         _table(paper_layout(st)),
     ]
     parts += ["<h2>Next to the paper</h2>", _table(side_by_side(st))]
     parts += [
-        "<h2>Per configuration</h2><p class='note'>median and 95 % percentile-bootstrap interval of the "
-        "mean over seeds.</p>",
+        "<h2>Per configuration</h2><p class='note'>median and 95 % percentile-bootstrap interval "
+        "of the mean over seeds.</p>",
         _table(detail(st)),
     ]
     bad = st[st["failed"] > 0]
@@ -103,8 +108,9 @@ def build(
         shown = wr.map(lambda v: "-" if v != v else f"{100 * v:.0f}%")
         shown.insert(0, "estimator", wr.index)
         parts += [
-            "<h2>Win rate</h2><p class='note'>share of matched cells (same configuration and seed) where "
-            "the row estimator ends with a lower normalized min MSE than the column (ties: half).</p>",
+            "<h2>Win rate</h2><p class='note'>share of matched cells (same configuration and "
+            "seed) where the row estimator ends with a lower normalized min MSE than the column "
+            "(ties: half).</p>",
             _table(shown),
         ]
     for name, paths in figures.items():

@@ -4,7 +4,8 @@ A cell that raises (an exploding simulation that the loop does not absorb, an es
 weights, ...) is stored as failed with its error and the sweep goes on. Re-running on the same
 output folder runs only the cells without a stored result, and the long table is rebuilt from the
 stored cells in spec order, so an interrupted-and-resumed sweep ends with exactly the rows of an
-uninterrupted one.
+uninterrupted one. Every stored cell carries a stamp of what produced it
+(:mod:`physbench.bench.stamp`); a resume refuses finished cells whose stamp differs from now.
 """
 
 from __future__ import annotations
@@ -55,15 +56,20 @@ def versions() -> dict[str, str]:
     return out
 
 
-def run_cell(case: RunConfig) -> dict[str, Any]:
+def run_cell(config: RunConfig) -> dict[str, Any]:
     """Run one cell; called by the executor, in whatever process it chooses. Never raises for a
-    failing case: the error is returned, with its traceback for the cell file."""
+    failing cell: the error is returned, with its traceback for the cell file."""
     from physbench.experiment import run_config
 
     t0 = time.perf_counter()
-    out: dict[str, Any] = {"case": case.to_dict(), "status": "ok", "error": None, "history": None}
+    out: dict[str, Any] = {
+        "config": config.to_dict(),
+        "status": "ok",
+        "error": None,
+        "history": None,
+    }
     try:
-        out["history"] = run_config(case).to_dict()
+        out["history"] = run_config(config).to_dict()
     except Exception as exc:  # any failure of one cell is data, not the end of the sweep
         out.update(
             status="failed",
@@ -91,16 +97,22 @@ class SweepResult:
 
 
 def assemble(cells: list[Cell], store: CellStore) -> pd.DataFrame:
-    """The long table from the stored cells, in cell order (cells without a result are left out)."""
+    """The long table from the stored cells, in cell order (cells without a result are left
+    out)."""
     from physbench.bench.tables import cell_rows, to_frame
 
     rows: list[dict[str, Any]] = []
     for c in cells:
         data = store.load(c.key)
         if data is not None:
-            rows += cell_rows(
-                {"key": c.key, "index": c.index, "scene": c.scene, "label": c.label}, data
-            )
+            identity = {
+                "key": c.key,
+                "index": c.index,
+                "scene": c.scene,
+                "label": c.label,
+                "renderer_label": c.renderer_label,
+            }
+            rows += cell_rows(identity, data)
     return to_frame(rows)
 
 
@@ -114,18 +126,21 @@ def write_table(df: pd.DataFrame, out: Path) -> Path:
 
 
 def read_table(path: str | Path) -> pd.DataFrame:
-    """A sweep's long table from its folder or its ``results.parquet``."""
+    """A sweep's long table from its folder or its ``results.parquet``; a table written before
+    some columns existed gets them with the values it implies (:func:`~.tables.upgrade`)."""
     import pandas as pd
 
+    from physbench.bench.tables import upgrade
     from physbench.errors import PhysbenchError
 
     p = Path(path)
     f = p / RESULTS if p.is_dir() else p
     if not f.is_file():
         raise PhysbenchError(
-            f"{str(p)!r}: no {RESULTS} there; expected the --out folder of a finished `physbench bench` run"
+            f"{str(p)!r}: no {RESULTS} there; expected the --out folder of a finished "
+            "`physbench bench` run"
         )
-    return pd.read_parquet(f)
+    return upgrade(pd.read_parquet(f))
 
 
 def run_sweep(
@@ -137,14 +152,18 @@ def run_sweep(
     address: str | None = None,
     fresh: bool = False,
     retry_failed: bool = False,
+    allow_stale: bool = False,
     progress: bool = True,
     command: str = "",
 ) -> SweepResult:
     """Run the cells of ``spec`` that ``out`` lacks, then write ``results.parquet``, the summary
-    tables and ``run.json`` (one entry per invocation: executor, workers, cells run, wall time)."""
+    tables and ``run.json`` (one entry per invocation: executor, workers, cells run, wall time).
+    Before anything runs, refuses (:class:`~physbench.bench.stamp.StaleCellsError`) to keep
+    finished cells whose stamp differs from now, unless ``allow_stale``."""
     from tqdm import tqdm
 
     from physbench.bench.executors import make_executor
+    from physbench.bench.stamp import StaleCellsError, Stamper, describe, find_stale
     from physbench.bench.tables import write_summary
 
     out = Path(out)
@@ -152,17 +171,25 @@ def run_sweep(
     cells = spec.cells()
     store = CellStore(out)
     store.prepare(fresh=fresh)
+
+    stored = {c.key: data for c in cells if (data := store.load(c.key)) is not None}
+    kept = [
+        c
+        for c in cells
+        if c.key in stored and not (retry_failed and stored[c.key].get("status") != "ok")
+    ]
+    stamper = Stamper()
+    stamps = {c.key: stamper.stamp(c.config) for c in cells}
+    stale = find_stale(kept, stored, stamps)
+    if stale and not allow_stale:
+        raise StaleCellsError(describe(stale, len(kept), str(out)))
     if spec.source:
         atomic_write(out / "spec.toml", spec.source.encode())
 
-    def finished(c: Cell) -> bool:
-        data = store.load(c.key)
-        return data is not None and not (retry_failed and data.get("status") != "ok")
-
-    todo = [c for c in cells if not finished(c)]
-    by_case = {
-        id(c.config): c for c in todo
-    }  # executors hand back the very objects they were given
+    done = {c.key for c in kept}
+    todo = [c for c in cells if c.key not in done]
+    # executors hand back the very objects they were given
+    by_config = {id(c.config): c for c in todo}
     t0 = time.perf_counter()
     started = datetime.now(UTC).isoformat(timespec="seconds")
     n_failed = 0
@@ -178,8 +205,9 @@ def run_sweep(
     try:
         if todo:
             with ex:
-                for case, data in ex.map_unordered(run_cell, [c.config for c in todo]):
-                    store.save(by_case[id(case)].key, data)
+                for config, data in ex.map_unordered(run_cell, [c.config for c in todo]):
+                    key = by_config[id(config)].key
+                    store.save(key, {**data, "stamp": stamps[key]})
                     if data["status"] != "ok":
                         n_failed += 1
                         bar.set_postfix(failed=n_failed, refresh=False)
@@ -208,6 +236,7 @@ def run_sweep(
             "ran": len(todo),
             "skipped": len(cells) - len(todo),
             "failed_now": n_failed,
+            "kept_stale": len(stale),
             "wall_s": round(wall, 2),
             "command": command,
         }

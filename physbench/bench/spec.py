@@ -1,9 +1,9 @@
 """Sweep specs: a TOML file naming the axes of a benchmark, expanded into cells.
 
-A cell is one :class:`~physbench.experiment.RunConfig` (one seed of one configuration). The product is
-``Σ_scenes (scene's unknown sets) × engine × observe_engine × blur × noise × resolution ×
-render_mode × iterations × estimators × seeds``; each scene lists its own unknown sets because
-the paper's Table 1 is not a full product. Every axis takes one value or a list::
+A cell is one :class:`~physbench.experiment.RunConfig` (one seed of one configuration). The
+product is ``Σ_scenes (scene's unknown sets) × renderer × engine × observe_engine × blur × noise ×
+resolution × render_mode × iterations × estimators × seeds``; each scene lists its own unknown
+sets because the paper's Table 1 is not a full product. Every axis takes one value or a list::
 
     name = "example"
     estimators = ["tpe", "random", {name = "tpe", label = "tpe-20", options = {startup = 20}}]
@@ -15,6 +15,8 @@ the paper's Table 1 is not a full product. Every axis takes one value or a list:
     noise = 0.0
     resolution = 64
     render_mode = "mark"
+    renderer = {name = "mycam", label = "cam-wide", options = {fov = 60}}
+                                     # or a name, or a list (default: DEFAULT_RENDERER, no options)
     unknowns = ["mass"]              # default for scenes that list none; each item is one set
 
     [[scenes]]
@@ -22,32 +24,36 @@ the paper's Table 1 is not a full product. Every axis takes one value or a list:
     unknowns = ["mass", "elasticity", "mass+elasticity"]
     bodies = ["a"]                   # optional: only these bodies' unknowns
 
-Seeds: a cell's run seed *is* the seed value, so every configuration sees the same scene instances,
-truths and initial guesses (paired comparisons), and ``physbench run ... --seed S`` reproduces a
-cell exactly.
+Seeds: a cell's run seed *is* the seed value, so every configuration sees the same scene
+instances, truths and initial guesses (paired comparisons), and ``physbench run ... --seed S``
+reproduces a cell exactly.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import json
 import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
+from physbench.render.base import DEFAULT_RENDERER
+from physbench.simulators.base import DEFAULT_SIMULATOR
 
 AXES = ("engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
-TOP_KEYS = ("name", "description", "scenes", "unknowns", "estimators", "seeds", *AXES)
+TOP_KEYS = ("name", "description", "scenes", "unknowns", "estimators", "renderer", "seeds", *AXES)
 SCENE_KEYS = ("name", "unknowns", "bodies")
-ESTIMATOR_KEYS = ("name", "label", "options")
+#: Keys of an estimator or renderer table: ``{name = "...", label = "...", options = {...}}``.
+COMPONENT_KEYS = ("name", "label", "options")
 DEFAULTS: dict[str, Any] = {
-    "engine": "pymunk",
+    "engine": DEFAULT_SIMULATOR,
     "observe_engine": None,
     "blur": 0.0,
     "noise": 0.0,
@@ -63,10 +69,19 @@ class SpecError(PhysbenchError, ValueError):
 
 
 @dataclass(frozen=True)
-class EstimatorSpec:
+class ComponentSpec:
+    """An estimator or a renderer of a spec: its registered name, its label in the tables
+    (unique within the axis) and its options."""
+
     name: str
     label: str
     options: Mapping[str, Any] = field(default_factory=dict)
+
+
+EstimatorSpec = ComponentSpec
+RendererSpec = ComponentSpec
+#: The renderer axis of a spec that names none.
+DEFAULT_RENDERERS = (RendererSpec(DEFAULT_RENDERER, DEFAULT_RENDERER),)
 
 
 @dataclass(frozen=True)
@@ -80,17 +95,24 @@ class SceneSpec:
 @dataclass(frozen=True)
 class Cell:
     """One run of a sweep. ``index`` is its position in the spec's product (the table's order);
-    ``key`` hashes everything that determines the result, so it names the cell's result file."""
+    ``key`` hashes its settings, so it names the cell's result file (the code behind the
+    settings is recorded apart, in the cell's stamp: :mod:`physbench.bench.stamp`)."""
 
     index: int
     config: RunConfig
     scene: str
-    label: str
+    label: str  # the estimator's label
+    renderer_label: str = DEFAULT_RENDERER
 
-    @property
+    @functools.cached_property
     def key(self) -> str:
-        blob = json.dumps(self.config.to_dict(), sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(blob.encode()).hexdigest()[:20]
+        return config_key(self.config)
+
+
+def config_key(config: RunConfig) -> str:
+    """The hash of everything in ``config``: the file name of its cell."""
+    blob = json.dumps(config.to_dict(), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
 @dataclass(frozen=True)
@@ -101,28 +123,33 @@ class Spec:
     estimators: tuple[EstimatorSpec, ...]
     seeds: tuple[int, ...]
     axes: Mapping[str, tuple[Any, ...]]
+    renderers: tuple[RendererSpec, ...] = DEFAULT_RENDERERS
     source: str = ""  # the TOML text
     path: str = ""
 
     def cells(self) -> list[Cell]:
-        """Every cell in product order: scene, unknowns, axes, estimator, seed (seed innermost)."""
+        """Every cell in product order: scene, unknowns, renderer, axes, estimator, seed (seed
+        innermost)."""
         out: list[Cell] = []
         for sc in self.scenes:
             for unknowns in sc.unknowns:
-                for values in itertools.product(*(self.axes[a] for a in AXES)):
-                    ax = dict(zip(AXES, values, strict=True))
-                    for est in self.estimators:
-                        for seed in self.seeds:
-                            case = RunConfig(
-                                scene=sc.path,
-                                params=unknowns,
-                                estimator=est.name,
-                                options=dict(est.options),
-                                seed=seed,
-                                bodies=sc.bodies,
-                                **ax,
-                            )
-                            out.append(Cell(len(out), case, sc.name, est.label))
+                for ren in self.renderers:
+                    for values in itertools.product(*(self.axes[a] for a in AXES)):
+                        ax = dict(zip(AXES, values, strict=True))
+                        for est in self.estimators:
+                            for seed in self.seeds:
+                                config = RunConfig(
+                                    scene=sc.path,
+                                    params=unknowns,
+                                    estimator=est.name,
+                                    options=dict(est.options),
+                                    seed=seed,
+                                    bodies=sc.bodies,
+                                    renderer=ren.name,
+                                    renderer_options=dict(ren.options),
+                                    **ax,
+                                )
+                                out.append(Cell(len(out), config, sc.name, est.label, ren.label))
         return out
 
 
@@ -143,8 +170,8 @@ def _unknown_set(value: Any, where: str) -> tuple[str, ...]:
         parts = []
     if not parts or len(set(parts)) != len(parts):
         raise SpecError(
-            f'{where} = {value!r}: expected an unknown-parameter set such as "mass", "mass+elasticity" '
-            'or ["mass", "elasticity"] (no repeats)'
+            f'{where} = {value!r}: expected an unknown-parameter set such as "mass", '
+            '"mass+elasticity" or ["mass", "elasticity"] (no repeats)'
         )
     return tuple(parts)
 
@@ -166,8 +193,8 @@ def _seeds(value: Any, where: str) -> tuple[int, ...]:
         seeds = list(range(value.get("start", 0), value.get("start", 0) + value["count"]))
     else:
         raise SpecError(
-            f"{where} = {value!r}: expected a count (50 -> seeds 0..49), a list of whole numbers >= 0, "
-            "or {start = S, count = N}"
+            f"{where} = {value!r}: expected a count (50 -> seeds 0..49), a list of whole numbers "
+            ">= 0, or {start = S, count = N}"
         )
     if len(set(seeds)) != len(seeds):
         raise SpecError(f"{where} = {value!r}: seeds repeat")
@@ -202,7 +229,9 @@ def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
     return tuple(out)
 
 
-def _estimators(value: Any, where: str) -> tuple[EstimatorSpec, ...]:
+def _components(value: Any, where: str, kind: str) -> tuple[ComponentSpec, ...]:
+    """The estimators or renderers (``kind``) of a spec: names or tables with a name, an optional
+    label and options; labels default to ``name(option=value, ...)`` and must be unique."""
     out = []
     for i, item in enumerate(_as_list(value)):
         at = f"{where}[{i}]"
@@ -210,31 +239,40 @@ def _estimators(value: Any, where: str) -> tuple[EstimatorSpec, ...]:
             item = {"name": item}
         if not isinstance(item, dict) or not isinstance(item.get("name"), str):
             raise SpecError(
-                f'{at} = {item!r}: expected an estimator name or {{name = "tpe", label = "...", options = {{...}}}}'
+                f"{at} = {item!r}: expected a registered {kind} name or "
+                '{name = "...", label = "...", options = {...}}'
             )
-        extra = sorted(set(item) - set(ESTIMATOR_KEYS))
+        extra = sorted(set(item) - set(COMPONENT_KEYS))
         if extra:
             raise SpecError(
-                f"{at}: unknown key {extra[0]!r}; known keys: {', '.join(ESTIMATOR_KEYS)}"
+                f"{at}: unknown key {extra[0]!r}; known keys: {', '.join(COMPONENT_KEYS)}"
             )
         options = item.get("options", {})
         if not isinstance(options, dict):
-            raise SpecError(f"{at}.options = {options!r}: expected a table of estimator options")
-        label = item.get("label") or item["name"] + (
-            "(" + ", ".join(f"{k}={v}" for k, v in sorted(options.items())) + ")" if options else ""
-        )
-        out.append(EstimatorSpec(item["name"], str(label), options))
-    labels = [e.label for e in out]
+            raise SpecError(f"{at}.options = {options!r}: expected a table of {kind} options")
+        out.append(ComponentSpec(item["name"], str(item.get("label") or ""), options))
+    out = [
+        ComponentSpec(c.name, c.label or default_label(c.name, c.options), c.options) for c in out
+    ]
+    labels = [c.label for c in out]
     dup = next((x for x in labels if labels.count(x) > 1), None)
     if dup is not None:
-        raise SpecError(f"{where}: two estimators are labelled {dup!r}; give each a distinct label")
-    same = [(e.name, json.dumps(dict(e.options), sort_keys=True)) for e in out]
+        raise SpecError(f"{where}: two {kind}s are labelled {dup!r}; give each a distinct label")
+    same = [(c.name, json.dumps(dict(c.options), sort_keys=True)) for c in out]
     dup2 = next((x for x in same if same.count(x) > 1), None)
     if dup2 is not None:
         raise SpecError(
-            f"{where}: estimator {dup2[0]!r} with options {dup2[1]} appears twice (it would run the same cells)"
+            f"{where}: {kind} {dup2[0]!r} with options {dup2[1]} appears twice "
+            "(it would run the same cells)"
         )
     return tuple(out)
+
+
+def default_label(name: str, options: Mapping[str, Any]) -> str:
+    """``tpe(startup=20)``: a component's label in the tables when the spec gives none."""
+    if not options:
+        return name
+    return name + "(" + ", ".join(f"{k}={v}" for k, v in sorted(options.items())) + ")"
 
 
 def _scenes(value: Any, default_unknowns: Any, base: Path, where: str) -> tuple[SceneSpec, ...]:
@@ -245,7 +283,8 @@ def _scenes(value: Any, default_unknowns: Any, base: Path, where: str) -> tuple[
             item = {"name": item}
         if not isinstance(item, dict) or not isinstance(item.get("name"), str):
             raise SpecError(
-                f"{at} = {item!r}: expected a scene name or a [[scenes]] table with name and unknowns"
+                f"{at} = {item!r}: expected a scene name or a [[scenes]] table with name and "
+                "unknowns"
             )
         extra = sorted(set(item) - set(SCENE_KEYS))
         if extra:
@@ -300,7 +339,10 @@ def parse_spec(
     scenes = _scenes(
         data["scenes"], data.get("unknowns", DEFAULTS["unknowns"]), base, _where(path, "scenes")
     )
-    estimators = _estimators(data["estimators"], _where(path, "estimators"))
+    estimators = _components(data["estimators"], _where(path, "estimators"), "estimator")
+    renderers = _components(
+        data.get("renderer", DEFAULT_RENDERER), _where(path, "renderer"), "renderer"
+    )
     seeds = _seeds(data["seeds"], _where(path, "seeds"))
     axes = {a: _check_axis(a, _as_list(data.get(a, DEFAULTS[a])), _where(path, a)) for a in AXES}
     empty = [
@@ -308,6 +350,7 @@ def parse_spec(
         for k, v in (
             ("scenes", scenes),
             ("estimators", estimators),
+            ("renderer", renderers),
             ("seeds", seeds),
             *axes.items(),
         )
@@ -317,10 +360,28 @@ def parse_spec(
         raise SpecError(
             f"{_where(path, empty[0])}: empty product: the axis {empty[0]!r} has no values"
         )
-    spec = Spec(name, description, scenes, estimators, seeds, axes, source, path)
+    spec = Spec(name, description, scenes, estimators, seeds, axes, renderers, source, path)
     _check_names(spec)
     check_unique(spec.cells())
     return spec
+
+
+def with_renderer(spec: Spec, name: str | None, options: Mapping[str, Any]) -> Spec:
+    """``spec`` with its renderer axis replaced (``physbench bench --renderer NAME -R K=V``):
+    ``name`` alone, with ``options``; without ``name``, the spec's single renderer with its
+    options updated by ``options``. Checked like a spec's own renderer."""
+    if name is None:
+        if len(spec.renderers) != 1:
+            labels = ", ".join(r.label for r in spec.renderers)
+            raise SpecError(
+                f"--renderer-option without --renderer: the spec has {len(spec.renderers)} "
+                f"renderers ({labels}); name the one to run with --renderer NAME"
+            )
+        name, options = spec.renderers[0].name, {**spec.renderers[0].options, **options}
+    ren = RendererSpec(name, default_label(name, options), dict(options))
+    out = replace(spec, renderers=(ren,))
+    _check_names(out, renderer_where="--renderer")
+    return out
 
 
 def check_unique(cells: list[Cell]) -> None:
@@ -331,7 +392,8 @@ def check_unique(cells: list[Cell]) -> None:
             a = seen[c.key]
             raise SpecError(
                 f"cells {a.index} and {c.index} are the same run (scene {c.scene!r}, unknowns "
-                f"{'+'.join(c.config.params)}, estimator {c.label!r}, seed {c.config.seed}); remove the repeated entry"
+                f"{'+'.join(c.config.params)}, estimator {c.label!r}, seed {c.config.seed}); "
+                "remove the repeated entry"
             )
         seen[c.key] = c
 
@@ -349,10 +411,12 @@ def load_spec(path: str | Path) -> Spec:
     return parse_spec(data, path=str(p), source=text)
 
 
-def _check_names(spec: Spec) -> None:
+def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
+    """Build every estimator and renderer once and look up every name, so a bad spec fails
+    before anything runs; errors name the spec file and the key."""
     from physbench.experiment import config_space, make_estimator, make_renderer
     from physbench.plugins import get_registry
-    from physbench.render.base import DEFAULT_RENDERER, ObservationModel
+    from physbench.render.base import ObservationModel
     from physbench.scenes import resolve_scene
 
     reg = get_registry()
@@ -362,8 +426,15 @@ def _check_names(spec: Spec) -> None:
             make_estimator(est.name, est.options)
         for e in {*spec.axes["engine"], *(v for v in spec.axes["observe_engine"] if v is not None)}:
             reg.get("simulator", e)
-        for res, mode in itertools.product(spec.axes["resolution"], spec.axes["render_mode"]):
-            make_renderer(DEFAULT_RENDERER, {}, resolution=res, mode=mode)
+        for i, ren in enumerate(spec.renderers):
+            at = renderer_where or (f"renderer[{i}]" if len(spec.renderers) > 1 else "renderer")
+            try:
+                for res, mode in itertools.product(
+                    spec.axes["resolution"], spec.axes["render_mode"]
+                ):
+                    make_renderer(ren.name, ren.options, resolution=res, mode=mode)
+            except PhysbenchError as exc:
+                raise SpecError(f"{where}: {at} = {ren.name!r}: {exc}") from None
         for blur, noise in itertools.product(spec.axes["blur"], spec.axes["noise"]):
             ObservationModel(blur=blur, noise=noise)
         for sc in spec.scenes:

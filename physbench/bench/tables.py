@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from physbench.metrics import format_mean_std
+from physbench.render.base import DEFAULT_RENDERER
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -38,6 +39,9 @@ SCHEMA: dict[str, str] = {
     "options": "string",
     "engine": "string",
     "observe_engine": "string",
+    "renderer": "string",
+    "renderer_name": "string",
+    "renderer_options": "string",
     "blur": "float64",
     "noise": "float64",
     "resolution": "int64",
@@ -71,6 +75,8 @@ CONFIG = (
     "bodies",
     "engine",
     "observe_engine",
+    "renderer",
+    "renderer_options",
     "blur",
     "noise",
     "resolution",
@@ -81,11 +87,18 @@ CONFIG = (
 #: What identifies a cell across two sweeps (``compare`` matches on these).
 MATCH = (*CONFIG, "options", "seed")
 ALL_BODIES = "all"
+#: Columns that tables written before they existed lack, and the value such a table implies.
+ADDED: dict[str, str] = {
+    "renderer": DEFAULT_RENDERER,
+    "renderer_name": DEFAULT_RENDERER,
+    "renderer_options": "{}",
+}
 #: Configuration columns shown only when they vary within a sweep.
 SETTINGS = (
     "bodies",
     "engine",
     "observe_engine",
+    "renderer",
     "blur",
     "noise",
     "resolution",
@@ -123,9 +136,13 @@ def dumps(obj: Any) -> str:
 
 
 def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str, Any]]:
-    """Long-table rows of one cell: ``cell`` holds its identity (key, index, scene, label, case
-    settings); ``data`` is what :func:`physbench.bench.runner.run_cell` returned."""
-    case = data["case"]
+    """Long-table rows of one cell: ``cell`` holds its identity in the spec (key, index, scene,
+    estimator ``label``, ``renderer_label``); ``data`` is the stored cell
+    (:func:`physbench.bench.runner.run_cell`)."""
+    from physbench.experiment import RunConfig
+
+    # "case": cells written before the key was renamed; from_dict fills settings added since.
+    case = RunConfig.from_dict(data["config"] if "config" in data else data["case"]).to_dict()
     base = {
         "cell": cell["key"],
         "cell_index": cell["index"],
@@ -137,6 +154,9 @@ def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str
         "options": dumps(case["options"]),
         "engine": case["engine"],
         "observe_engine": case["observe_engine"] or case["engine"],
+        "renderer": cell["renderer_label"],
+        "renderer_name": case["renderer"],
+        "renderer_options": dumps(case["renderer_options"]),
         "blur": case["blur"],
         "noise": case["noise"],
         "resolution": case["resolution"],
@@ -189,8 +209,24 @@ def to_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     return df.reset_index(drop=True)
 
 
+def upgrade(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` with the columns of :data:`ADDED` that it lacks (a table written before they
+    existed), filled with what such a table implies, in :data:`SCHEMA` order; a table that has
+    them is returned as it is."""
+    missing = [c for c in ADDED if c not in df.columns]
+    if not missing:
+        return df
+    df = df.copy()
+    for c in missing:
+        df[c] = ADDED[c]
+        df[c] = df[c].astype("string")
+    known = [c for c in SCHEMA if c in df.columns]
+    return df[[*known, *(c for c in df.columns if c not in SCHEMA)]]
+
+
 def without_timings(df: pd.DataFrame) -> pd.DataFrame:
-    """``df`` minus the wall-clock columns: what must agree between executors, workers and resumes."""
+    """``df`` minus the wall-clock columns: what must agree between executors, workers and
+    resumes."""
     return df.drop(columns=[c for c in TIMINGS if c in df.columns])
 
 
@@ -269,6 +305,7 @@ def stats(df: pd.DataFrame) -> pd.DataFrame:
     iterations, plus the initial guess's mean error and the paper's values where it has the cell."""
     import pandas as pd
 
+    df = upgrade(df)
     fin = final_rows(df)
     init = df[df["iteration"] == 0]
     rows = []
@@ -425,6 +462,7 @@ def win_rate_table(fin: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     column's (ties count half), and the number of matched cells."""
     import pandas as pd
 
+    fin = upgrade(fin)
     ok = fin[fin["status"] == "ok"]
     ests = list(dict.fromkeys(ok.sort_values("cell_index")["estimator"]))
     idx = [c for c in MATCH if c not in ("estimator", "options")]
@@ -454,7 +492,8 @@ def markdown(df: pd.DataFrame) -> str:
 
 
 def _latex_cell(text: str) -> str:
-    # "(2.6 ± 0.9)e-03 [1 failed]" -> "$(2.6 \pm 0.9) \times 10^{-3}$ [1 failed]", as the paper prints it
+    # As the paper prints it:
+    # "(2.6 ± 0.9)e-03 [1 failed]" -> "$(2.6 \pm 0.9) \times 10^{-3}$ [1 failed]"
     head, sep, tail = text.partition(")e")
     if sep and head.startswith("("):
         exp, _, rest = tail.partition(" ")
@@ -518,8 +557,9 @@ def write_summary(df: pd.DataFrame, out: Path, *, title: str) -> pd.DataFrame:
         "The same means ± std, a row per scene and unknown set.\n",
         markdown(side_by_side(st)),
         "\n## Per configuration\n",
-        "Normalized min MSE after N iterations over seeds: mean ± sample std, median, 95 % percentile-bootstrap "
-        f"interval of the mean ({BOOTSTRAP} resamples), cells that ran (n) and failed.\n",
+        "Normalized min MSE after N iterations over seeds: mean ± sample std, median, "
+        f"95 % percentile-bootstrap interval of the mean ({BOOTSTRAP} resamples), cells that ran "
+        "(n) and failed.\n",
         markdown(detail(st)),
     ]
     failed = st[st["failed"] > 0]

@@ -30,14 +30,14 @@ def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
     return out
 
 
-def add_renderer_choice(p: argparse.ArgumentParser) -> None:
-    """``--renderer NAME`` and ``--renderer-option KEY=VALUE`` (repeatable)."""
-    p.add_argument(
-        "--renderer",
-        default=None,
-        metavar="NAME",
-        help="renderer of the frames (default: raster; see `physbench plugins`)",
-    )
+def add_renderer_choice(
+    p: argparse.ArgumentParser,
+    *,
+    renderer_help: str = "renderer of the frames (default: raster; see `physbench plugins`)",
+) -> None:
+    """``--renderer NAME`` and ``--renderer-option KEY=VALUE`` (repeatable); read them with
+    :func:`renderer_choice`."""
+    p.add_argument("--renderer", default=None, metavar="NAME", help=renderer_help)
     p.add_argument(
         "-R",
         "--renderer-option",
@@ -49,7 +49,8 @@ def add_renderer_choice(p: argparse.ArgumentParser) -> None:
 
 
 def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) -> None:
-    """:func:`add_renderer_choice` plus ``--resolution PX`` and ``--render-mode MODE``."""
+    """``--renderer NAME``, ``--renderer-option KEY=VALUE`` (repeatable), ``--resolution PX`` and
+    ``--render-mode MODE``."""
     add_renderer_choice(p)
     p.add_argument(
         "--resolution",

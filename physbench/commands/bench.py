@@ -11,12 +11,19 @@ import argparse
 import shlex
 import sys
 
+from physbench.commands.arguments import add_renderer_choice
+
 EPILOG = """\
 A spec is TOML: scenes (each with its unknown sets), estimators, seeds, iterations, and the axes
-engine, observe_engine, blur, noise, resolution, render_mode (one value or a list each); see
-benchmarks/README.md. A cell's run seed is its seed value: `physbench run --seed S` with the same
-settings reproduces it. Failed cells are recorded with their error and do not stop the sweep.
-Re-running the same command on the same DIR resumes: finished cells are skipped."""
+renderer, engine, observe_engine, blur, noise, resolution, render_mode (one value or a list each);
+see benchmarks/README.md. A cell's run seed is its seed value: `physbench run --seed S` with the
+same settings reproduces it. Failed cells are recorded with their error and do not stop the sweep.
+
+Re-running the same command on the same DIR resumes: finished cells are skipped. Every cell records
+what produced it (a hash of its scene as generated for its seed, the estimator's resolved options,
+the physbench version); a resume refuses, before running anything, when that changed for any
+finished cell (or a cell predates these records): --allow-stale keeps such cells, --fresh starts
+over."""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -46,7 +53,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--address",
         default=None,
         metavar="tcp://HOST:PORT",
-        help="Dask scheduler address (with --executor dask; default: start a LocalCluster of --workers processes)",
+        help="Dask scheduler address (with --executor dask; default: start a LocalCluster of "
+        "--workers processes)",
+    )
+    add_renderer_choice(
+        p,
+        renderer_help="run every cell with this renderer instead of the spec's renderer axis "
+        "(with the -R options only); -R alone updates the options of the spec's single renderer",
     )
     p.add_argument(
         "--fresh", action="store_true", help="discard the cells already in DIR and run everything"
@@ -55,15 +68,28 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--retry-failed", action="store_true", help="run the cells recorded as failed again"
     )
     p.add_argument(
+        "--allow-stale",
+        action="store_true",
+        help="resume even when finished cells were produced by other code or settings (a changed "
+        "scene generator, estimator default or physbench version); they are kept as they are",
+    )
+    p.add_argument(
         "-q", "--quiet", action="store_true", help="no progress bar or table: only the final line"
     )
 
 
 def main(args: argparse.Namespace) -> int:
     from physbench.bench.runner import run_sweep
-    from physbench.bench.spec import load_spec
+    from physbench.bench.spec import load_spec, with_renderer
+    from physbench.commands.arguments import parse_key_values
 
     spec = load_spec(args.spec)
+    if args.renderer is not None or args.renderer_option:
+        options = parse_key_values(args.renderer_option, "--renderer-option")
+        spec = with_renderer(spec, args.renderer, options)
+    command = ""
+    if sys.argv[1:2] == ["bench"]:
+        command = "physbench bench " + " ".join(shlex.quote(a) for a in sys.argv[2:])
     try:
         res = run_sweep(
             spec,
@@ -73,14 +99,14 @@ def main(args: argparse.Namespace) -> int:
             address=args.address,
             fresh=args.fresh,
             retry_failed=args.retry_failed,
+            allow_stale=args.allow_stale,
             progress=not args.quiet,
-            command="physbench bench " + " ".join(shlex.quote(a) for a in sys.argv[2:])
-            if sys.argv[1:2] == ["bench"]
-            else "",
+            command=command,
         )
     except KeyboardInterrupt:
         print(
-            f"physbench bench: interrupted; finished cells are saved in {args.out}: re-run the same command to resume",
+            f"physbench bench: interrupted; finished cells are saved in {args.out}: re-run the "
+            "same command to resume",
             file=sys.stderr,
         )
         return 130
@@ -89,7 +115,8 @@ def main(args: argparse.Namespace) -> int:
 
         print(markdown(paper_layout(res.stats)))
     print(
-        f"{spec.name}: {res.cells} cells ({res.ran} run, {res.skipped} already done, {res.failed} failed) in "
-        f"{res.wall_s:.1f} s with {res.executor}; table {res.out / 'results.parquet'}"
+        f"{spec.name}: {res.cells} cells ({res.ran} run, {res.skipped} already done, "
+        f"{res.failed} failed) in {res.wall_s:.1f} s with {res.executor}; "
+        f"table {res.out / 'results.parquet'}"
     )
     return 0

@@ -12,8 +12,10 @@ ALPHA, MIN_RATIO = 0.05, 1.25
 
 EPILOG = """\
 NEW and BASELINE are `physbench bench` output folders (or their results.parquet). Cells are matched
-on scene, unknowns, estimator and options, engines, blur, noise, resolution, render mode, iterations
-and seed. Seeds fix truth, initial guess and estimator randomness, so differences are real.
+on scene, unknowns, estimator and options, engines, renderer and its options, blur, noise,
+resolution, render mode, iterations and seed (a table from before renderers were recorded counts as
+the default renderer). Seeds fix truth, initial guess and estimator randomness, so differences are
+real.
 
 Test, per estimator x scene x unknown set (x other settings), on d = ln(new / baseline) of each
 matched seed's normalized min MSE after N iterations: WORSE when a one-sided Wilcoxon signed-rank
@@ -21,7 +23,8 @@ test (zero differences dropped), Holm-corrected over all configurations compared
 p < --alpha (default 0.05) AND the geometric-mean ratio exp(mean d) >= --min-ratio (default 1.25);
 also WORSE when more matched cells failed than in the baseline. BETTER is the mirror image. An
 unchanged run gives d = 0 for every seed and is never flagged. With n seeds the smallest possible
-p is 2^-n, which must beat alpha / (number of configurations): e.g. 10 seeds for 20 configurations."""
+p is 2^-n, which must beat alpha / (number of configurations): e.g. 10 seeds for 20
+configurations."""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -44,7 +47,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         type=float,
         default=MIN_RATIO,
         metavar="R",
-        help=f"smallest geometric-mean error ratio new/baseline that counts as worse (default: {MIN_RATIO})",
+        help="smallest geometric-mean error ratio new/baseline that counts as worse "
+        f"(default: {MIN_RATIO})",
     )
     p.add_argument(
         "--all", action="store_true", help="list every configuration, not only changed ones"
@@ -86,6 +90,7 @@ def main(args: argparse.Namespace) -> int:
                 "bodies",
                 "engine",
                 "observe_engine",
+                "renderer",
                 "blur",
                 "noise",
                 "resolution",
@@ -112,8 +117,9 @@ def main(args: argparse.Namespace) -> int:
         else ""
     )
     print(
-        f"compared {int(t['matched'].sum())} cells in {len(t)} configurations: {summary}{unmatched} "
-        f"(worse: one-sided Wilcoxon, Holm-corrected p < {args.alpha}, and geometric-mean ratio >= {args.min_ratio})"
+        f"compared {int(t['matched'].sum())} cells in {len(t)} configurations: "
+        f"{summary}{unmatched} (worse: one-sided Wilcoxon, Holm-corrected p < {args.alpha}, "
+        f"and geometric-mean ratio >= {args.min_ratio})"
     )
     if len(res.worse):
         print(

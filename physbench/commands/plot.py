@@ -27,7 +27,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         type=int,
         default=3,
         metavar="N",
-        help="scene instances averaged in the image-MSE landscape, which simulates (default: 3; 0 skips it)",
+        help="scene instances averaged in the image-MSE landscape, which simulates "
+        "(default: 3; 0 skips it)",
     )
 
 
@@ -53,7 +54,8 @@ def main(args: argparse.Namespace) -> int:
     df = read_table(out)
     if df.empty:
         raise PhysbenchError(
-            f"{str(out)!r}: the results table is empty; run `physbench bench SPEC --out {out}` first"
+            f"{str(out)!r}: the results table is empty; run `physbench bench SPEC --out {out}` "
+            "first"
         )
     figures = plots.plot_all(
         df, out / "plots", seeds=args.seeds, landscape_seeds=args.landscape_seeds

@@ -117,3 +117,20 @@ def test_holm() -> None:
 
     assert np.allclose(holm([0.01, 0.04, 0.03, 0.5]), [0.04, 0.09, 0.09, 0.5])
     assert np.allclose(holm([1.0]), [1.0])
+
+
+def test_a_table_without_renderer_columns_matches_the_default_renderer(
+    baseline: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    old = tmp_path / "old"
+    old.mkdir()
+    base = pd.read_parquet(baseline / "results.parquet")
+    write_table(base.drop(columns=["renderer", "renderer_name", "renderer_options"]), old)
+    assert main(["compare", str(baseline), str(old)]) == 0
+    assert "compared 16 cells in 2 configurations: 2 identical" in capsys.readouterr().out
+    assert main(["compare", str(old), str(baseline)]) == 0
+    assert "2 identical" in capsys.readouterr().out
+    # another renderer's cells are other configurations: nothing matches
+    other = base.assign(renderer="blocks", renderer_name="blocks")
+    with pytest.raises(Exception, match="no cell of the new sweep matches a baseline cell"):
+        compare(other, base.drop(columns=["renderer", "renderer_name", "renderer_options"]))

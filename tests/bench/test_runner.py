@@ -1,11 +1,12 @@
-"""``physbench bench``: the long table, summaries, failed cells, resume-by-skipping, and identical
-tables from every executor."""
+"""``physbench bench``: the long table, summaries, failed cells, resume-by-skipping, identical
+tables from every executor, and the renderer of a spec or of ``--renderer`` really drawing."""
 
 from __future__ import annotations
 
 import json
 from collections.abc import Iterator
 from pathlib import Path
+from types import ModuleType
 from typing import Any, ClassVar
 
 import numpy as np
@@ -20,6 +21,7 @@ from physbench.errors import PhysbenchError
 from physbench.estimators.base import CorrectionEstimator
 from physbench.hookspecs import hookimpl
 from physbench.plugins import build_registry, get_registry, reset_registry
+from physbench.render.base import DEFAULT_RENDERER
 
 TINY = {
     "name": "tiny",
@@ -176,3 +178,59 @@ def test_cli_prints_table_and_final_line(
         == 0
     )
     assert "(2 run, 0 already done" in capsys.readouterr().out
+
+
+def test_a_plugin_renderer_is_selected_by_spec_and_by_the_command_line(
+    tmp_path: Path, blocks: ModuleType, capsys: pytest.CaptureFixture[str]
+) -> None:
+    small = {**TINY, "estimators": ["random"], "scenes": ["second_order"]}
+    base = run_sweep(parse_spec(small), tmp_path / "default", executor="serial", progress=False)
+    assert blocks.CALLS == 0 and (base.table["renderer"] == DEFAULT_RENDERER).all()
+    assert (base.table["renderer_options"] == "{}").all()
+
+    spec = parse_spec({**small, "renderer": {"name": "blocks", "options": {"gain": 0.5}}})
+    res = run_sweep(spec, tmp_path / "blocks", executor="serial", progress=False)
+    # per cell at least the observation and one render per iteration
+    assert blocks.CALLS >= 2 * (1 + 3)
+    df = res.table
+    assert list(df.columns) == list(SCHEMA) and (df["status"] == "ok").all()
+    assert set(df["renderer"]) == {"blocks(gain=0.5)"} and set(df["renderer_name"]) == {"blocks"}
+    assert set(df["renderer_options"]) == {'{"gain":0.5}'}
+    # the same truths and guesses, seen through other frames: other image errors
+    assert df["params"].tolist() == base.table["params"].tolist()
+    assert not np.allclose(df["image_mse"], base.table["image_mse"])
+    st = pd.read_csv(tmp_path / "blocks" / "stats.csv")
+    assert st["renderer"].tolist() == ["blocks(gain=0.5)"]
+
+    toml = tmp_path / "s.toml"
+    toml.write_text(
+        'name = "cli"\nestimators = ["random"]\nseeds = 2\niterations = 3\nresolution = 32\n'
+        'scenes = ["second_order"]\n'
+    )
+    before = blocks.CALLS
+    argv = ["bench", str(toml), "--out", str(tmp_path / "cli"), "--executor", "serial", "-q"]
+    assert main([*argv, "--renderer", "blocks", "-R", "gain=0.5"]) == 0
+    renders = blocks.CALLS - before
+    assert renders == before  # as many renders as the spec's run
+    cli = pd.read_parquet(tmp_path / "cli" / "results.parquet")
+    pd.testing.assert_frame_equal(without_timings(cli), without_timings(df), check_exact=True)
+    capsys.readouterr()
+    assert main([*argv, "--renderer", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert "--renderer = 'nope': unknown renderer 'nope'; known renderers: " in err, err
+
+
+def test_several_renderers_split_the_summary(tmp_path: Path, blocks: ModuleType) -> None:
+    spec = parse_spec(
+        {
+            **TINY,
+            "estimators": ["random"],
+            "scenes": ["second_order"],
+            "renderer": [DEFAULT_RENDERER, "blocks"],
+        }
+    )
+    run_sweep(spec, tmp_path, executor="serial", progress=False)
+    summary = pd.read_csv(tmp_path / "summary.csv")
+    assert summary.columns.tolist() == ["scene", "renderer", "estimator", "Mass"]
+    ours = summary[summary["estimator"] == "random"]
+    assert ours["renderer"].tolist() == [DEFAULT_RENDERER, "blocks"]

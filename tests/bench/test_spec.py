@@ -1,4 +1,5 @@
-"""Sweep specs: expansion into cells, seeds, and clear errors for bad specs and output folders."""
+"""Sweep specs: expansion into cells (the renderer axis among them), seeds, and clear errors for
+bad specs and output folders."""
 
 from __future__ import annotations
 
@@ -8,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from physbench.bench.spec import SpecError, load_spec, parse_spec
+from physbench.bench.spec import RendererSpec, SpecError, load_spec, parse_spec, with_renderer
 from physbench.cli import main
+from physbench.render.base import DEFAULT_RENDERER
 
 GOOD = {
     "name": "t",
@@ -107,7 +109,8 @@ def test_missing_axis_and_duplicate_cells() -> None:
 def test_cli_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     spec = tmp_path / "s.toml"
     spec.write_text(
-        'name = "s"\nestimators = ["random"]\nseeds = 1\niterations = 1\nresolution = 16\nscenes = ["three_circles"]\n'
+        'name = "s"\nestimators = ["random"]\nseeds = 1\niterations = 1\nresolution = 16\n'
+        'scenes = ["three_circles"]\n'
     )
     blocker = tmp_path / "file.txt"
     blocker.write_text("")
@@ -157,7 +160,94 @@ def test_argument_parsing_imports_nothing_heavy() -> None:
         "import sys\nfrom physbench.cli import build_parser\n"
         "for c in ('bench', 'plot', 'compare'):\n"
         "    build_parser(c)\n"
-        "print([m for m in ('numpy', 'pandas', 'physbench.bench.runner', 'matplotlib') if m in sys.modules])"
+        "heavy = ('numpy', 'pandas', 'physbench.bench.runner', 'matplotlib')\n"
+        "print([m for m in heavy if m in sys.modules])"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.usefixtures("blocks")
+def test_renderer_axis_forms_and_product() -> None:
+    assert parse_spec(GOOD).renderers == (RendererSpec(DEFAULT_RENDERER, DEFAULT_RENDERER),)
+    one = parse_spec({**GOOD, "renderer": "blocks"})
+    assert {(c.config.renderer, c.renderer_label) for c in one.cells()} == {("blocks", "blocks")}
+    spec = parse_spec(
+        {
+            **GOOD,
+            "renderer": [
+                DEFAULT_RENDERER,
+                "blocks",
+                {"name": "blocks", "label": "dim", "options": {"gain": 0.5}},
+                {"name": "blocks", "options": {"gain": 0.25}},
+            ],
+        }
+    )
+    assert [r.label for r in spec.renderers] == [
+        DEFAULT_RENDERER,
+        "blocks",
+        "dim",
+        "blocks(gain=0.25)",
+    ]
+    cells = spec.cells()
+    assert len(cells) == 4 * len(parse_spec(GOOD).cells()) == len({c.key for c in cells})
+    # the renderer is outside the other axes: each renderer's block is one whole default product
+    block = len(cells) // 3 // 4  # 3 scene x unknown sets
+    assert [c.renderer_label for c in cells[block - 1 : block + 1]] == [DEFAULT_RENDERER, "blocks"]
+    dim = next(c for c in cells if c.renderer_label == "dim").config
+    assert (dim.renderer, dict(dim.renderer_options)) == ("blocks", {"gain": 0.5})
+    # the default renderer's cells keep their keys when a renderer axis is added
+    assert cells[0].key == parse_spec(GOOD).cells()[0].key
+
+
+@pytest.mark.parametrize(
+    ("renderer", "message"),
+    [
+        ("nope", "s.toml: renderer = 'nope': unknown renderer 'nope'; known renderers: "),
+        (
+            ["blocks", {"name": "blocks", "options": {"gain": 7}}],
+            "s.toml: renderer[1] = 'blocks': gain = 7: expected a number in (0, 1]",
+        ),
+        (
+            {"name": "blocks", "options": {"colour": "red"}},
+            "s.toml: renderer = 'blocks': renderer 'blocks' does not take options",
+        ),
+        (
+            {"name": "blocks", "options": {"resolution": 8}},
+            "renderer option 'resolution': set it with --resolution",
+        ),
+        (["blocks", "blocks"], "renderer: two renderers are labelled 'blocks'"),
+        ({"name": "blocks", "gain": 1}, "renderer[0]: unknown key 'gain'; known keys: name,"),
+        ([], "empty product: the axis 'renderer' has no values"),
+    ],
+)
+@pytest.mark.usefixtures("blocks")
+def test_bad_renderers_fail_before_anything_runs(
+    tmp_path: Path, renderer: object, message: str
+) -> None:
+    with pytest.raises(SpecError) as err:
+        parse_spec({**GOOD, "renderer": renderer}, path=str(tmp_path / "s.toml"))
+    assert message in str(err.value), str(err.value)
+
+
+@pytest.mark.usefixtures("blocks")
+def test_renderer_modes_are_checked_with_every_render_mode() -> None:
+    with pytest.raises(
+        SpecError, match="renderer = 'blocks': mode = 'instance': renderer 'blocks'"
+    ):
+        parse_spec({**GOOD, "renderer": "blocks", "render_mode": ["mark", "instance"]})
+
+
+@pytest.mark.usefixtures("blocks")
+def test_renderer_override() -> None:
+    spec = parse_spec({**GOOD, "renderer": {"name": "blocks", "options": {"gain": 0.5}}})
+    swapped = with_renderer(spec, DEFAULT_RENDERER, {})
+    assert swapped.renderers == (RendererSpec(DEFAULT_RENDERER, DEFAULT_RENDERER),)
+    assert [c.key for c in swapped.cells()] == [c.key for c in parse_spec(GOOD).cells()]
+    updated = with_renderer(spec, None, {"gain": 0.25})  # -R alone: the spec's renderer
+    assert updated.renderers == (RendererSpec("blocks", "blocks(gain=0.25)", {"gain": 0.25}),)
+    with pytest.raises(SpecError, match="--renderer = 'blocks': gain = 2: expected a number"):
+        with_renderer(spec, None, {"gain": 2})
+    two = parse_spec({**GOOD, "renderer": [DEFAULT_RENDERER, "blocks"]})
+    with pytest.raises(SpecError, match=r"the spec has 2 renderers .*; name the one to run"):
+        with_renderer(two, None, {"gain": 0.5})
