@@ -31,6 +31,7 @@ class ResNet3DEstimator(CorrectionEstimator):
         self, weights: str | None = None, threads: int = 1, symmetric: bool = False
     ) -> None:
         self.weights_path, self.threads, self.symmetric = weights, threads, symmetric
+        self.options = {"weights": weights, "threads": threads, "symmetric": symmetric}
 
     def start(self, task: Task, *, seed: int) -> None:
         import torch
