@@ -160,7 +160,7 @@ def test_unclear_errors_fail() -> None:
 def test_check_estimator_lists_every_failure() -> None:
     with pytest.raises(ConformanceError) as info:
         check_estimator(Unseeded, subprocess=False)
-    assert "fails 1 conformance check(s)" in str(info.value) and "- deterministic:" in str(
+    assert "fails 1 conformance check(s)" in str(info.value) and "- check_deterministic:" in str(
         info.value
     )
     with pytest.raises(ConformanceError, match=r"fails 2 conformance check\(s\)"):
