@@ -152,16 +152,19 @@ def _run(
     try:
         return apply_measurements(sim.simulate(scene, params, effects=effects), effects)
     except Exception as exc:
-        hint = (
-            "; if the effect needs something the probe scene lacks, declare it in scene_needs "
-            f"(one of {', '.join(SCENE_FEATURES)})"
-            if not getattr(cls, "scene_needs", ())
-            else ""
-        )
         raise ConformanceError(
             f"{label(cls)}: simulating the probe scene {scene.name!r} in {sim.name} with "
-            f"{list(effects)!r} raised {type(exc).__name__}: {exc}{hint}"
+            f"{list(effects)!r} raised {type(exc).__name__}: {exc}{_needs_hint(cls)}"
         ) from exc
+
+
+def _needs_hint(cls: type) -> str:
+    if getattr(cls, "scene_needs", ()):
+        return ""
+    return (
+        "; if the effect needs something the probe scene lacks, declare it in scene_needs "
+        f"(one of {', '.join(SCENE_FEATURES)})"
+    )
 
 
 def _difference(a: Trajectory, b: Trajectory) -> tuple[float, float, str]:
@@ -322,7 +325,13 @@ def check_traits(
     values = active_values(cls, on_values)
     traj = _run(cls, _engines()[0], scene, [])
     eff = _build(cls, options, **values)
-    eff.setup(scene, {})
+    try:
+        eff.setup(scene, {})
+    except Exception as exc:
+        raise ConformanceError(
+            f"{label(cls)}: setup() on the probe scene {scene.name!r} raised "
+            f"{type(exc).__name__}: {exc}{_needs_hint(cls)}"
+        ) from exc
     if not cls.applies_forces:
         for k in range(traj.frames):
             f, tau = eff.forces(float(traj.times[k]), traj.states[k].copy())

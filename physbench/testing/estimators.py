@@ -84,6 +84,12 @@ def check_respects_ranges(cls: type, *, unknowns: Sequence[str] = UNKNOWNS, **op
             run_toy(cls, options, seed=1, iterations=8, params=ps, bodies=bodies)
         except EstimatorError as exc:
             raise ConformanceError(f"{label(cls)}: {exc}") from exc
+        except Exception as exc:
+            raise ConformanceError(
+                f"{label(cls)}: a run on the toy task with unknowns {list(ps)} of bodies "
+                f"{list(bodies) if bodies else 'a, b'} raised {type(exc).__name__}: {exc} "
+                "(if the estimator cannot be asked for these, narrow the kit setting unknowns)"
+            ) from exc
 
 
 def _trace(h: History) -> dict[str, Any]:
@@ -162,7 +168,9 @@ def check_bad_input(
 
     t = toy_task()
     est = cls(**options)
-    step = Step(0, dict(t.observation.truth or {}), t.observation.frames, 0.0)
+    # What the loop would pass: marked frames too, for an estimator that is per_object.
+    marked = dict(t.observation.marked) if getattr(cls, "per_object", False) else {}
+    step = Step(0, dict(t.observation.truth or {}), t.observation.frames, 0.0, marked=marked)
     try:
         est.propose(step)
     except (PhysbenchError, RuntimeError) as exc:

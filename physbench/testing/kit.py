@@ -36,13 +36,16 @@ def label(cls: type) -> str:
 class Subject:
     """A component class under test: ``cls(**options)`` builds it; ``kit`` holds settings of its
     kind's checks (e.g. ``{"bad_options": [...]}`` for an estimator); ``requires`` names modules
-    it imports lazily (the parametrized tests are skipped when one is missing); ``id`` is the
-    first part of its pytest ids (default: the class name)."""
+    it imports lazily (the parametrized tests are skipped when one is missing);
+    ``expected_failures`` maps check names to the reason the component fails them today (their
+    parametrized tests are strict xfails: they fail once the component is fixed, so the entry
+    gets removed); ``id`` is the first part of its pytest ids (default: the class name)."""
 
     cls: type
     options: Mapping[str, Any] = field(default_factory=dict)
     kit: Mapping[str, Any] = field(default_factory=dict)
     requires: tuple[str, ...] = ()
+    expected_failures: Mapping[str, str] = field(default_factory=dict)
     id: str = ""
 
     @property
@@ -152,21 +155,29 @@ def parametrize_with_checks(components: Iterable[type | Subject]) -> Any:
             check(component)
 
     A subject whose :attr:`Subject.requires` are not installed gets skipped tests, with the
-    reason naming the missing modules.
+    reason naming the missing modules; its :attr:`Subject.expected_failures` become strict
+    xfails. A name in ``expected_failures`` that is not one of its checks raises
+    :class:`ConformanceError`.
     """
     import pytest
 
     params = []
     for component in components:
         s = as_subject(component)
-        missing = s.missing()
-        marks = (
-            [pytest.mark.skip(reason=f"{s.name} needs {', '.join(missing)}, not installed")]
-            if missing
-            else []
-        )
         checks = checks_for(s)
+        stale = sorted(set(s.expected_failures) - {c.name for c in checks})
+        if stale:
+            raise ConformanceError(
+                f"{s.name}: expected_failures names {stale}, which are not among its checks "
+                f"{[c.name for c in checks]}"
+            )
+        missing = s.missing()
+        skip = pytest.mark.skip(reason=f"{s.name} needs {', '.join(missing)}, not installed")
         for check in checks:
+            marks = [skip] if missing else []
+            if check.name in s.expected_failures:
+                reason = s.expected_failures[check.name]
+                marks.append(pytest.mark.xfail(raises=ConformanceError, strict=True, reason=reason))
             params.append(pytest.param(s, check, marks=marks, id=f"{s.name}-{check.name}"))
     return pytest.mark.parametrize(("component", "check"), params)
 

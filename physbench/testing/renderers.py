@@ -202,8 +202,8 @@ def check_frames(cls: type, **options: Any) -> None:
 
 
 def check_deterministic(cls: type, **options: Any) -> None:
-    """The same input gives identical frames twice, from a fresh instance, and after the same
-    instance rendered another scene (no state leaks between calls)."""
+    """The same input gives identical frames twice, from a fresh instance, and from an instance
+    that rendered another scene first (no state leaks between calls)."""
     scene = probe_scene()
     other = replace(alone(scene, "block"), bounds=(-1.0, -1.0, 5.0, 4.0))
     for mode in _modes(cls):
@@ -211,8 +211,9 @@ def check_deterministic(cls: type, **options: Any) -> None:
         a = _render(cls, ren, scene).copy()
         again = _render(cls, ren, scene).copy()
         fresh = _render(cls, _build(cls, options, mode), scene).copy()
-        _render(cls, ren, other)
-        after = _render(cls, ren, scene)
+        first_other = _build(cls, options, mode)
+        _render(cls, first_other, other)
+        after = _render(cls, first_other, scene)
         for what, b in (
             ("again", again),
             ("from a fresh instance", fresh),

@@ -14,14 +14,17 @@ from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.estimators.random_search import RandomSearch
 from physbench.params import Params
 from physbench.testing import (
+    Check,
     ConformanceError,
     EstimatorConformance,
+    Subject,
     check_bad_input,
     check_deterministic,
     check_deterministic_in_subprocess,
     check_estimator,
     check_protocol,
     check_respects_ranges,
+    parametrize_with_checks,
 )
 
 
@@ -101,6 +104,16 @@ class CrashesBeforeStart(Base):
 class AcceptsBadWidth(Base):
     def __init__(self, width: float = 1.0) -> None:
         self.width, self.task = width, None
+
+
+class MassOnly(Base):
+    """Can only be asked for masses (like a learned estimator trained for mass)."""
+
+    def start(self, task: Task, *, seed: int) -> None:
+        asked = sorted({u.name for u in task.space.unknowns})
+        if asked != ["mass"]:
+            raise PhysbenchError(f"mass_only: cannot estimate {asked}")
+        super().start(task, seed=seed)
 
 
 def test_a_correct_estimator_passes() -> None:
@@ -185,3 +198,30 @@ def test_the_base_class_reports_a_broken_estimator() -> None:
         TestBroken().test_respects_ranges()
     with pytest.raises(ConformanceError, match="set the class attribute 'estimator'"):
         EstimatorConformance().test_protocol()
+
+
+@parametrize_with_checks(
+    [
+        Subject(Base, {"width": 0.8}, {"bad_options": [{"width": 0}]}),
+        Subject(MassOnly, kit={"unknowns": ("mass",)}),
+    ]
+)
+def test_correct_estimators_pass_every_parametrized_check(component: Subject, check: Check) -> None:
+    check(component)
+
+
+def test_the_unknowns_setting_limits_what_the_toy_task_asks() -> None:
+    with pytest.raises(
+        ConformanceError,
+        match=r"raised PhysbenchError: mass_only: cannot estimate \['elasticity', 'mass'\] \(if",
+    ):
+        check_respects_ranges(MassOnly)
+    check_respects_ranges(MassOnly, unknowns=("mass",))
+    check_deterministic(MassOnly, unknowns=("mass",))
+    with pytest.raises(ConformanceError, match=r"kit setting unknowns = \('friction',\)"):
+        check_deterministic(MassOnly, unknowns=("friction",))
+
+
+class TestMassOnlyThroughTheBaseClass(EstimatorConformance):
+    estimator = MassOnly
+    unknowns: ClassVar[Sequence[str]] = ("mass",)
