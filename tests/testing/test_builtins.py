@@ -5,9 +5,11 @@ from __future__ import annotations
 
 from typing import Any
 
+from physbench.effects import BUILTIN_EFFECTS
 from physbench.estimators.resnet3d.weights import SHIPPED
 from physbench.plugins import build_registry
 from physbench.testing import Check, Subject, parametrize_with_checks
+from physbench.testing.kit import kind_of
 
 KINDS = ("simulator", "renderer", "effect", "estimator")
 
@@ -46,13 +48,12 @@ BUILTINS = builtins()
 
 def test_every_kind_has_builtins() -> None:
     # Guards the parametrized test below against an empty registry (it would pass vacuously).
-    names = {kind: build_registry(env=False).names(kind) for kind in KINDS}
-    assert {"pymunk", "box2d"} <= set(names["simulator"]) and "raster" in names["renderer"]
-    assert len(names["effect"]) >= 11 and {"random", "tpe", "cmaes"} <= set(names["estimator"])
-    assert {s.cls.name for s in BUILTINS} == {
-        n for kind in KINDS for n in names[kind] if n != "scipy"
-    }
-    assert set(SETTINGS) <= {s.cls.name for s in BUILTINS}
+    by_kind = {kind: {s.cls.name for s in BUILTINS if kind_of(s.cls) == kind} for kind in KINDS}
+    assert by_kind["simulator"] == {"pymunk", "box2d"} and by_kind["renderer"] == {"raster"}
+    assert by_kind["effect"] == {cls.name for cls in BUILTIN_EFFECTS}
+    assert {"random", "tpe", "cmaes", "optuna", "resnet3d"} <= by_kind["estimator"]
+    assert "scipy" not in by_kind["estimator"]  # the example plugin tests itself
+    assert set(SETTINGS) <= by_kind["estimator"]
 
 
 @parametrize_with_checks(BUILTINS)
