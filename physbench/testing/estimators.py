@@ -212,6 +212,37 @@ def check_bad_input(
             raise ConformanceError(f"{label(cls)}: bad options {dict(bad)} were accepted")
 
 
+def check_marked_views(cls: type, **options: Any) -> None:
+    """A :attr:`~physbench.estimators.base.CorrectionEstimator.per_object` estimator refuses, in
+    ``start()``, a task whose marked observation lacks an unknown body, naming that body (an
+    observation file without ``marked_<body>`` frames then gets a clear error, not a failure deep
+    inside ``propose()``)."""
+    t = toy_task(("mass",))
+    marked = {b: f for b, f in t.observation.marked.items() if b != "b"}
+    task = Task(
+        t.scene,
+        t.space,
+        t.observation.frames,
+        draw_problem(t.space, 0)[1],
+        t.renderer,
+        iterations=8,
+        marked_observation=marked,
+    )
+    try:
+        cls(**options).start(task, seed=0)
+    except (PhysbenchError, ValueError, KeyError) as exc:
+        if "'b'" not in str(exc) and '"b"' not in str(exc):
+            raise ConformanceError(
+                f"{label(cls)}: start() without the marked view of body 'b' raised {exc!s} "
+                "without naming the body"
+            ) from exc
+    else:
+        raise ConformanceError(
+            f"{label(cls)}: is per_object, but start() accepted a task without the marked view "
+            "of unknown body 'b' (task.marked_observation); raise PhysbenchError naming it"
+        )
+
+
 #: Kit settings the estimator checks take.
 SETTINGS = frozenset({"bad_options", "subprocess", "unknowns"})
 #: Every estimator check, in the order they run.
@@ -220,15 +251,18 @@ CHECKS = (
     check_respects_ranges,
     check_deterministic,
     check_bad_input,
+    check_marked_views,
     check_deterministic_in_subprocess,
 )
 
 
 def yield_checks(subject: Subject) -> Iterator[Any]:
-    """The estimator checks for ``subject``: all, less the other-process check when its kit
-    setting ``subprocess`` is false."""
+    """The estimator checks for ``subject``: ``check_marked_views`` only when it is
+    ``per_object``, the other-process check unless its kit setting ``subprocess`` is false."""
     for check in CHECKS:
         if check is check_deterministic_in_subprocess and not subject.kit.get("subprocess", True):
+            continue
+        if check is check_marked_views and getattr(subject.cls, "per_object", False) is not True:
             continue
         yield check
 

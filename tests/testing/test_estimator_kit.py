@@ -24,8 +24,10 @@ from physbench.testing import (
     check_estimator,
     check_protocol,
     check_respects_ranges,
+    checks_for,
     parametrize_with_checks,
 )
+from physbench.testing.estimators import check_marked_views
 
 
 class Base(CorrectionEstimator):
@@ -104,6 +106,22 @@ class CrashesBeforeStart(Base):
 class AcceptsBadWidth(Base):
     def __init__(self, width: float = 1.0) -> None:
         self.width, self.task = width, None
+
+
+class PerObject(Base):
+    """Corrects one marked object at a time (here: ignores them), and checks it gets them."""
+
+    per_object: ClassVar[bool] = True
+
+    def start(self, task: Task, *, seed: int) -> None:
+        for body in task.space.bodies:
+            if body not in task.marked_observation:
+                raise PhysbenchError(f"per_object: no marked view of body {body!r}")
+        super().start(task, seed=seed)
+
+
+class PerObjectUnchecked(Base):
+    per_object: ClassVar[bool] = True
 
 
 class MassOnly(Base):
@@ -204,6 +222,7 @@ def test_the_base_class_reports_a_broken_estimator() -> None:
     [
         Subject(Base, {"width": 0.8}, {"bad_options": [{"width": 0}]}),
         Subject(MassOnly, kit={"unknowns": ("mass",)}),
+        PerObject,
     ]
 )
 def test_correct_estimators_pass_every_parametrized_check(component: Subject, check: Check) -> None:
@@ -225,3 +244,14 @@ def test_the_unknowns_setting_limits_what_the_toy_task_asks() -> None:
 class TestMassOnlyThroughTheBaseClass(EstimatorConformance):
     estimator = MassOnly
     unknowns: ClassVar[Sequence[str]] = ("mass",)
+
+
+def test_per_object_estimators_must_ask_for_their_marked_views() -> None:
+    assert "check_marked_views" in [c.name for c in checks_for(PerObject)]
+    assert "check_marked_views" not in [c.name for c in checks_for(Base)]
+    check_marked_views(PerObject)
+    with pytest.raises(
+        ConformanceError,
+        match="start\\(\\) accepted a task without the marked view of unknown body 'b'",
+    ):
+        check_marked_views(PerObjectUnchecked)
