@@ -32,7 +32,14 @@ from physbench.errors import PhysbenchError
 from physbench.parameter import Parameter
 from physbench.scene import Body, Box, Circle, Joint, Scene, Segment
 from physbench.simulators.base import Simulator
-from physbench.testing.kit import Check, ConformanceError, Subject, label, run_checks
+from physbench.testing.kit import (
+    Check,
+    ConformanceError,
+    Subject,
+    label,
+    require_contract,
+    run_checks,
+)
 from physbench.trajectory import STATE_FIELDS, Trajectory
 
 #: Largest pose and velocity difference between the built-in engines with an effect on, per probe
@@ -95,12 +102,12 @@ def contacts_scene() -> Scene:
     return Scene("kit_contacts", bodies, gravity=(0.0, 0.0), frames=31, statics=cushions).validate()
 
 
-def probe_scene(cls: type) -> Scene:
+def probe_scene(cls: type[Effect]) -> Scene:
     """The probe scene for effect class ``cls`` (see the module docstring)."""
-    needs = set(getattr(cls, "scene_needs", ()))
+    needs = set(cls.scene_needs)
     if "joints" in needs:
         return joints_scene()
-    if "contacts" in needs or getattr(cls, "changes_contacts", False):
+    if "contacts" in needs or cls.changes_contacts:
         return contacts_scene()
     return free_scene()
 
@@ -108,7 +115,7 @@ def probe_scene(cls: type) -> Scene:
 # --------------------------------------------------------------------------- helpers
 
 
-def active_values(cls: type, given: Mapping[str, float] | None = None) -> dict[str, float]:
+def active_values(cls: type[Effect], given: Mapping[str, float] | None = None) -> dict[str, float]:
     """``given``, else each parameter halfway from its neutral value to its farther bound."""
     if given is not None:
         return dict(given)
@@ -142,7 +149,7 @@ def _engines() -> list[Simulator]:
 
 
 def _run(
-    cls: type,
+    cls: type[Effect],
     sim: Simulator,
     scene: Scene,
     effects: Sequence[Effect],
@@ -158,8 +165,8 @@ def _run(
         ) from exc
 
 
-def _needs_hint(cls: type) -> str:
-    if getattr(cls, "scene_needs", ()):
+def _needs_hint(cls: type[Effect]) -> str:
+    if cls.scene_needs:
         return ""
     return (
         "; if the effect needs something the probe scene lacks, declare it in scene_needs "
@@ -174,33 +181,29 @@ def _difference(a: Trajectory, b: Trajectory) -> tuple[float, float, str]:
     d = np.abs(a.states - b.states)
     d = np.where(np.isfinite(d), d, np.inf)
     t, i, f = np.unravel_index(int(np.argmax(d)), d.shape)
-    where = f"frame {t}, body {a.bodies[i]!r}, {STATE_FIELDS[f]}: {a.states[t, i, f]!r} vs "
-    where += f"{b.states[t, i, f]!r}"
+    where = f"frame {t}, body {a.bodies[i]!r}, {STATE_FIELDS[f]}: {float(a.states[t, i, f])!r} vs "
+    where += f"{float(b.states[t, i, f])!r}"
     dt = float(np.abs(a.times - b.times).max()) if a.times.shape == b.times.shape else math.inf
     if dt > d.max():
         where = f"times differ by up to {dt:.3g} s"
     return max(float(d[:, :, :3].max()), dt), float(d[:, :, 3:].max()), where
 
 
-def _p(cls: type) -> tuple[Parameter, ...]:
-    return tuple(getattr(cls, "params", ()))
+def _p(cls: type[Effect]) -> tuple[Parameter, ...]:
+    return tuple(cls.params)
 
 
 # --------------------------------------------------------------------------- checks
 
 
-def check_protocol(cls: type, **options: Any) -> None:
+def check_protocol(cls: type[Effect], **options: Any) -> None:
     """``name`` is a non-empty string, ``params`` a tuple of
     :class:`~physbench.parameter.Parameter` with distinct names, the traits are bools,
     ``scene_needs`` names known features, ``neutral()`` is ``None`` or a value in range for every
     parameter, and ``cls(**options)`` builds an Effect whose ``parameters()`` are keyed by its
     ``key``."""
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not name.strip():
-        raise ConformanceError(
-            f"{label(cls)}: class attribute 'name' must be a non-empty string, got {name!r}"
-        )
-    params = getattr(cls, "params", None)
+    require_contract(cls, Effect)
+    params = cls.params
     if not isinstance(params, tuple) or not all(isinstance(p, Parameter) for p in params):
         raise ConformanceError(
             f"{label(cls)}: class attribute 'params' must be a tuple of "
@@ -209,13 +212,17 @@ def check_protocol(cls: type, **options: Any) -> None:
     names = [p.name for p in params]
     if len(set(names)) != len(names):
         raise ConformanceError(f"{label(cls)}: parameter names repeat: {names}")
-    for trait in ("applies_forces", "changes_contacts", "measures"):
-        if not isinstance(getattr(cls, trait, None), bool):
+    traits = {
+        "applies_forces": cls.applies_forces,
+        "changes_contacts": cls.changes_contacts,
+        "measures": cls.measures,
+    }
+    for trait, value in traits.items():
+        if not isinstance(value, bool):
             raise ConformanceError(
-                f"{label(cls)}: trait {trait!r} must be True or False, "
-                f"got {getattr(cls, trait, None)!r}"
+                f"{label(cls)}: trait {trait!r} must be True or False, got {value!r}"
             )
-    needs = getattr(cls, "scene_needs", ())
+    needs = cls.scene_needs
     if not isinstance(needs, tuple) or not set(needs) <= set(SCENE_FEATURES):
         raise ConformanceError(
             f"{label(cls)}: scene_needs = {needs!r}: expected a tuple of "
@@ -240,7 +247,7 @@ def check_protocol(cls: type, **options: Any) -> None:
             )
 
 
-def check_defaults_in_range(cls: type, **options: Any) -> None:
+def check_defaults_in_range(cls: type[Effect], **options: Any) -> None:
     """Every declared parameter has a finite range ``low < high`` and a default inside it."""
     for p in _p(cls):
         if not (math.isfinite(p.low) and math.isfinite(p.high) and p.low < p.high):
@@ -277,7 +284,7 @@ def _refused(cls: type, what: str, name: str, run: Callable[..., object], *args:
         raise ConformanceError(f"{label(cls)}: {what} was accepted")
 
 
-def check_rejects_out_of_range(cls: type, **options: Any) -> None:
+def check_rejects_out_of_range(cls: type[Effect], **options: Any) -> None:
     """A value outside a parameter's range (or NaN) is refused with an error naming the
     parameter: at construction, in ``setup`` and through ``simulate(params=...)``."""
     scene = probe_scene(cls)
@@ -294,7 +301,7 @@ def check_rejects_out_of_range(cls: type, **options: Any) -> None:
             _refused(cls, what, p.name, _run, cls, sim, scene, [eff], values)
 
 
-def check_neutral(cls: type, **options: Any) -> None:
+def check_neutral(cls: type[Effect], **options: Any) -> None:
     """At its :meth:`~physbench.effects.base.Effect.neutral` values the effect changes nothing:
     the measured trajectory of the probe scene equals the one without it (within 1e-9)."""
     neutral = cls.neutral()
@@ -315,7 +322,7 @@ def check_neutral(cls: type, **options: Any) -> None:
 
 
 def check_traits(
-    cls: type, *, on_values: Mapping[str, float] | None = None, **options: Any
+    cls: type[Effect], *, on_values: Mapping[str, float] | None = None, **options: Any
 ) -> None:
     """The declared traits match what the effect does at its "on" values on the probe scene's
     states: ``applies_forces = False`` -> zero forces and torques; ``changes_contacts = False``
@@ -363,7 +370,9 @@ def check_traits(
             )
 
 
-def check_acts(cls: type, *, on_values: Mapping[str, float] | None = None, **options: Any) -> None:
+def check_acts(
+    cls: type[Effect], *, on_values: Mapping[str, float] | None = None, **options: Any
+) -> None:
     """At its "on" values the effect changes the measured trajectory of its probe scene (else it
     is inert, or acts through a path its traits do not declare)."""
     scene = probe_scene(cls)
@@ -381,7 +390,7 @@ def check_acts(cls: type, *, on_values: Mapping[str, float] | None = None, **opt
 
 
 def check_values_from_params(
-    cls: type, *, on_values: Mapping[str, float] | None = None, **options: Any
+    cls: type[Effect], *, on_values: Mapping[str, float] | None = None, **options: Any
 ) -> None:
     """Values given through ``simulate(params={"<label>.<param>": v})`` to an instance built with
     ``label=...`` act exactly as the same values given at construction (the simulator passes them
@@ -403,7 +412,7 @@ def check_values_from_params(
 
 
 def check_engines_agree(
-    cls: type, *, on_values: Mapping[str, float] | None = None, **options: Any
+    cls: type[Effect], *, on_values: Mapping[str, float] | None = None, **options: Any
 ) -> None:
     """The built-in engines (pymunk, Box2D) agree on the probe scene with the effect on, within
     :data:`AGREEMENT`, one instance serving both runs (state must not leak between
@@ -451,7 +460,7 @@ def yield_checks(subject: Subject) -> Iterator[Any]:
 
 
 def check_effect(
-    cls: type, /, *, on_values: Mapping[str, float] | None = None, **options: Any
+    cls: type[Effect], /, *, on_values: Mapping[str, float] | None = None, **options: Any
 ) -> None:
     """Every effect check that applies to ``cls(**options)``; raises one
     :class:`ConformanceError` listing every failure."""

@@ -32,6 +32,21 @@ def label(cls: type) -> str:
     return f"{cls.__module__}.{cls.__qualname__} (name {getattr(cls, 'name', '?')!r})"
 
 
+def require_contract(cls: object, base: type) -> None:
+    """``cls`` subclasses ``base`` and has a non-empty string ``name``: what every kit's
+    protocol check asks first."""
+    if not (isinstance(cls, type) and issubclass(cls, base)):
+        raise ConformanceError(
+            f"{cls!r} does not subclass {base.__module__}.{base.__qualname__}, the contract of "
+            "its kind"
+        )
+    name = cls.name  # type: ignore[attr-defined]  # every base class declares it
+    if not isinstance(name, str) or not name.strip():
+        raise ConformanceError(
+            f"{label(cls)}: class attribute 'name' must be a non-empty string, got {name!r}"
+        )
+
+
 @dataclass(frozen=True)
 class Subject:
     """A component class under test: ``cls(**options)`` builds it; ``kit`` holds settings of its

@@ -17,7 +17,14 @@ import numpy as np
 
 from physbench.render.base import MODES, Renderer, RenderError
 from physbench.scene import Body, Box, Circle, Scene
-from physbench.testing.kit import Check, ConformanceError, Subject, label, run_checks
+from physbench.testing.kit import (
+    Check,
+    ConformanceError,
+    Subject,
+    label,
+    require_contract,
+    run_checks,
+)
 from physbench.trajectory import Trajectory
 
 #: Image width the kit asks for when the options give none.
@@ -99,8 +106,8 @@ def _render(
         ) from exc
 
 
-def _modes(cls: type) -> tuple[str, ...]:
-    return tuple(getattr(cls, "modes", ()))
+def _modes(cls: type[Renderer]) -> tuple[str, ...]:
+    return tuple(cls.modes)
 
 
 #: Channels ``C`` of each mode for a scene of ``n`` bodies (see :data:`MODES`).
@@ -110,16 +117,12 @@ CHANNELS = {"mark": lambda n: 2, "instance": lambda n: n, "mask": lambda n: 1}
 # --------------------------------------------------------------------------- checks
 
 
-def check_protocol(cls: type, **options: Any) -> None:
+def check_protocol(cls: type[Renderer], **options: Any) -> None:
     """``name`` is a non-empty string, ``modes`` a non-empty tuple of known layouts
     (:data:`~physbench.render.base.MODES`), and ``cls(resolution=..., mode=m, **options)`` builds
     a :class:`~physbench.render.base.Renderer` for every declared mode."""
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not name.strip():
-        raise ConformanceError(
-            f"{label(cls)}: class attribute 'name' must be a non-empty string, got {name!r}"
-        )
-    modes = getattr(cls, "modes", None)
+    require_contract(cls, Renderer)
+    modes = cls.modes
     if not isinstance(modes, tuple) or not modes or not set(modes) <= set(MODES):
         raise ConformanceError(
             f"{label(cls)}: class attribute 'modes' must be a non-empty tuple of "
@@ -133,7 +136,7 @@ def check_protocol(cls: type, **options: Any) -> None:
             )
 
 
-def check_shape(cls: type, **options: Any) -> None:
+def check_shape(cls: type[Renderer], **options: Any) -> None:
     """In every mode ``shape(scene, frames)`` is what ``render()`` returns, for the scene's frame
     count and for another, with the mode's channel count; a ``(height, width)`` resolution is
     honoured or refused with a :class:`~physbench.render.base.RenderError` naming it."""
@@ -178,7 +181,7 @@ def check_shape(cls: type, **options: Any) -> None:
             )
 
 
-def check_frames(cls: type, **options: Any) -> None:
+def check_frames(cls: type[Renderer], **options: Any) -> None:
     """In every mode the frames are float32, finite, inside [0, 1] and show the bodies."""
     scene = probe_scene()
     for mode in _modes(cls):
@@ -201,7 +204,7 @@ def check_frames(cls: type, **options: Any) -> None:
             )
 
 
-def check_deterministic(cls: type, **options: Any) -> None:
+def check_deterministic(cls: type[Renderer], **options: Any) -> None:
     """The same input gives identical frames twice, from a fresh instance, and from an instance
     that rendered another scene first (no state leaks between calls)."""
     scene = probe_scene()
@@ -226,7 +229,7 @@ def check_deterministic(cls: type, **options: Any) -> None:
                 )
 
 
-def check_out(cls: type, **options: Any) -> None:
+def check_out(cls: type[Renderer], **options: Any) -> None:
     """``render(..., out=buffer)`` fills the float32 buffer of ``shape()`` and returns it, with the
     frames a plain call returns, whatever the buffer held."""
     scene = probe_scene()
@@ -251,7 +254,7 @@ def _far(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(np.asarray(a, dtype=float) - b).max())
 
 
-def check_marking(cls: type, **options: Any) -> None:
+def check_marking(cls: type[Renderer], **options: Any) -> None:
     """``mark`` mode: with ``focus=body`` channel 1 shows that body and channel 0 every other body
     but not the focus body; without a focus channel 1 is empty."""
     scene = probe_scene()
@@ -282,7 +285,7 @@ def check_marking(cls: type, **options: Any) -> None:
             )
 
 
-def check_channel_layout(cls: type, **options: Any) -> None:
+def check_channel_layout(cls: type[Renderer], **options: Any) -> None:
     """``instance`` mode: channel ``i`` shows body ``i`` alone; ``mask`` mode: the one channel
     shows every body."""
     scene = probe_scene()
@@ -322,7 +325,7 @@ def _refused(cls: type, kw: Mapping[str, Any], value: object) -> None:
         raise ConformanceError(f"{label(cls)}: {cls.__name__}(**{dict(kw)!r}) was accepted")
 
 
-def check_bad_options(cls: type, **options: Any) -> None:
+def check_bad_options(cls: type[Renderer], **options: Any) -> None:
     """A resolution that is not a whole number >= 1, an unknown mode and every known mode the
     renderer does not declare raise :class:`~physbench.render.base.RenderError` naming the
     value."""
@@ -361,7 +364,7 @@ def yield_checks(subject: Subject) -> Iterator[Any]:
         yield check
 
 
-def check_renderer(cls: type, /, **options: Any) -> None:
+def check_renderer(cls: type[Renderer], /, **options: Any) -> None:
     """Every renderer check for the modes ``cls`` declares; raises one :class:`ConformanceError`
     listing every failure."""
     subject = Subject(cls, options)

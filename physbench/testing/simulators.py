@@ -29,6 +29,7 @@ from physbench.testing.kit import (
     import_path,
     label,
     load,
+    require_contract,
     run_checks,
     run_in_child,
 )
@@ -172,16 +173,12 @@ def _worst(
 # --------------------------------------------------------------------------- checks
 
 
-def check_protocol(cls: type, **options: Any) -> None:
+def check_protocol(cls: type[Simulator], **options: Any) -> None:
     """``name`` is a non-empty string; ``cls(**options)`` builds a
     :class:`~physbench.simulators.base.Simulator` whose ``simulate`` returns one frame per scene
     frame, one row per body in scene order, times ``k / fps``, and the scene's initial state in
     frame 0."""
-    name = getattr(cls, "name", None)
-    if not isinstance(name, str) or not name.strip():
-        raise ConformanceError(
-            f"{label(cls)}: class attribute 'name' must be a non-empty string, got {name!r}"
-        )
+    require_contract(cls, Simulator)
     scene = contact_scene()
     traj = _simulate(cls, _build(cls, options), scene)
     times = np.arange(scene.frames) / scene.fps
@@ -200,20 +197,20 @@ def check_protocol(cls: type, **options: Any) -> None:
         )
         raise ConformanceError(
             f"{label(cls)}: frame 0 must be the scene's initial state; body "
-            f"{scene.bodies[i].name!r} has {STATE_FIELDS[f]} = {traj.states[0, i, f]!r}, "
-            f"the scene says {initial[i, f]!r}"
+            f"{scene.bodies[i].name!r} has {STATE_FIELDS[f]} = {float(traj.states[0, i, f])!r}, "
+            f"the scene says {float(initial[i, f])!r}"
         )
 
 
 def _first_difference(a: np.ndarray, b: np.ndarray, scene: Scene) -> str:
     t, i, f = np.argwhere(~((a == b) | (np.isnan(a) & np.isnan(b))))[0]
     return (
-        f"frame {t}, body {scene.bodies[i].name!r}, {STATE_FIELDS[f]}: {a[t, i, f]!r} vs "
-        f"{b[t, i, f]!r}"
+        f"frame {t}, body {scene.bodies[i].name!r}, {STATE_FIELDS[f]}: {float(a[t, i, f])!r} vs "
+        f"{float(b[t, i, f])!r}"
     )
 
 
-def check_deterministic(cls: type, **options: Any) -> None:
+def check_deterministic(cls: type[Simulator], **options: Any) -> None:
     """The same scene gives the identical trajectory twice from one instance and once from a
     fresh one (a scene with contacts, friction and rotation)."""
     scene = contact_scene()
@@ -228,7 +225,7 @@ def check_deterministic(cls: type, **options: Any) -> None:
             )
 
 
-def check_deterministic_in_subprocess(cls: type, **options: Any) -> None:
+def check_deterministic_in_subprocess(cls: type[Simulator], **options: Any) -> None:
     """A fresh Python process (another hash seed) gives the identical trajectory. Options must be
     JSON values; the class must be importable at module level."""
     spec = {"cls": import_path(cls), "options": options}
@@ -253,7 +250,7 @@ def _child_states(spec: Mapping[str, Any]) -> list[Any]:
     return states
 
 
-def check_free_fall(cls: type, **options: Any) -> None:
+def check_free_fall(cls: type[Simulator], **options: Any) -> None:
     """Bodies thrown in gravity follow ``x0 + v0 t + g t²/2`` and ``v0 + g t``, and turn at their
     constant angular velocity."""
     scene = free_fall_scene()
@@ -286,7 +283,7 @@ def check_free_fall(cls: type, **options: Any) -> None:
             )
 
 
-def check_collision(cls: type, **options: Any) -> None:
+def check_collision(cls: type[Simulator], **options: Any) -> None:
     """Two free balls (1 kg and 3 kg, elasticity 1, no gravity) meet head on: total momentum is
     conserved at every frame, and after the impact their velocities are the elastic ones (-4 and
     0 m/s) within 2% of the approach speed."""
@@ -316,7 +313,7 @@ def check_collision(cls: type, **options: Any) -> None:
         )
 
 
-def check_explosion_raises(cls: type, **options: Any) -> None:
+def check_explosion_raises(cls: type[Simulator], **options: Any) -> None:
     """An absurd scene (an impulse of 1e9 N·s on a 1 kg ball) raises
     :class:`~physbench.errors.SimulationError`, not another exception, NaN or a body light-years
     away."""
@@ -341,7 +338,7 @@ def check_explosion_raises(cls: type, **options: Any) -> None:
     )
 
 
-def check_applies_params(cls: type, **options: Any) -> None:
+def check_applies_params(cls: type[Simulator], **options: Any) -> None:
     """``simulate(scene, {"pushed.mass": 4.0})`` simulates the body with that mass: a 1 N push
     moves it ``t²/8`` m instead of ``t²/2``; other bodies are untouched."""
     scene = push_scene()
@@ -372,7 +369,7 @@ def check_applies_params(cls: type, **options: Any) -> None:
                 )
 
 
-def check_applies_effects(cls: type, **options: Any) -> None:
+def check_applies_effects(cls: type[Simulator], **options: Any) -> None:
     """``simulate(scene, {"kit_push.f": 3.0}, effects=[KitPush()])`` calls the effect's ``setup``
     with its values and applies its force every substep: 3 N on a 1 kg body."""
     scene = replace(push_scene(), forces=())  # the same bodies, without the scene's own force
@@ -418,7 +415,7 @@ def yield_checks(subject: Subject) -> Iterator[Any]:
         yield check
 
 
-def check_simulator(cls: type, /, *, subprocess: bool = True, **options: Any) -> None:
+def check_simulator(cls: type[Simulator], /, *, subprocess: bool = True, **options: Any) -> None:
     """Every simulator check on ``cls(**options)``; raises one :class:`ConformanceError` listing
     every failure."""
     subject = Subject(cls, options, {"subprocess": subprocess})

@@ -100,7 +100,8 @@ class SwallowsOptions(Base):
 
 class CrashesBeforeStart(Base):
     def propose(self, step: Step) -> Params:
-        return self.task.space.sample(self.rng)  # type: ignore[union-attr]  # AttributeError on None
+        # AttributeError on None
+        return self.task.space.sample(self.rng)  # type: ignore[union-attr]
 
 
 class AcceptsBadWidth(Base):

@@ -82,3 +82,15 @@ def test_the_toy_simulator_is_a_simulator_but_not_physics() -> None:
     assert checks_for(ToySimulator)[0].name == "check_protocol"
     with pytest.raises(ConformanceError, match="free fall"):
         check_free_fall(ToySimulator)
+
+
+def test_a_class_outside_the_contract_is_named() -> None:
+    from physbench.testing import check_effect, check_renderer, check_simulator
+
+    for check, base in (
+        (check_simulator, "physbench.simulators.base.Simulator"),
+        (check_renderer, "physbench.render.base.Renderer"),
+        (check_effect, "physbench.effects.base.Effect"),
+    ):
+        with pytest.raises(ConformanceError, match=f"does not subclass {base}"):
+            check(dict)
