@@ -451,6 +451,9 @@ def yield_checks(subject: Subject) -> Iterator[Any]:
     """The effect checks for ``subject``: ``check_neutral`` only when it has neutral values, the
     value checks only when it has parameters."""
     cls = subject.cls
+    if not (isinstance(cls, type) and issubclass(cls, Effect)):
+        yield from CHECKS  # the protocol check says why, and the kit stops there
+        return
     for check in CHECKS:
         if check is check_neutral and cls.neutral() is None:
             continue

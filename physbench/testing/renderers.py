@@ -355,6 +355,9 @@ CHECKS = (
 def yield_checks(subject: Subject) -> Iterator[Any]:
     """The renderer checks for the modes ``subject`` declares: ``check_marking`` needs ``mark``,
     ``check_channel_layout`` ``instance`` or ``mask``."""
+    if not (isinstance(subject.cls, type) and issubclass(subject.cls, Renderer)):
+        yield from CHECKS  # the protocol check says why, and the kit stops there
+        return
     modes = set(_modes(subject.cls))
     for check in CHECKS:
         if check is check_marking and "mark" not in modes:
