@@ -42,6 +42,10 @@ if TYPE_CHECKING:
     from physbench.trajectory import Trajectory
 
 
+#: Scene features an effect can need (:attr:`Effect.scene_needs`).
+SCENE_FEATURES = ("joints", "contacts")
+
+
 class EffectError(PhysbenchError, ValueError):
     """A bad effect value or configuration; the message names the effect, the key and the value."""
 
@@ -84,6 +88,11 @@ class Effect:
     changes_contacts: ClassVar[bool] = False
     #: Whether :meth:`measure` changes the reported trajectory.
     measures: ClassVar[bool] = False
+    #: What a scene must contain for the effect to act (:data:`SCENE_FEATURES`): ``"joints"`` for
+    #: an effect on pivot joints (it raises on a scene without), ``"contacts"`` for one that acts
+    #: when bodies collide (implied by :attr:`changes_contacts`). The conformance kit probes the
+    #: effect on a scene that has them.
+    scene_needs: ClassVar[tuple[str, ...]] = ()
 
     def __init__(
         self, *, bodies: Iterable[str] | None = None, label: str | None = None, **values: float
@@ -124,6 +133,14 @@ class Effect:
         return {f"{self.key}.{k}": v for k, v in self.values.items()}
 
     # ----------------------------------------------------------------- configuration
+
+    @classmethod
+    def neutral(cls) -> dict[str, float] | None:
+        """Parameter values at which the effect changes nothing (the simulated and measured
+        trajectory equal those without it), or ``None`` when there are none (a contact law
+        replaces the scene's restitution at every value). Default: the parameters' defaults; the
+        conformance kit checks it."""
+        return {p.name: float(p.default) for p in cls.params if p.default is not None}
 
     def parameters(self) -> tuple[Parameter, ...]:
         """This instance's parameters, qualified by its :attr:`key` (``linear_drag.c``)."""

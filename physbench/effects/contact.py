@@ -45,6 +45,11 @@ class VelocityDependentRestitution(Effect):
         ),
     )
 
+    @classmethod
+    def neutral(cls) -> None:
+        """None: every value replaces the scene's restitution, so no value leaves it as is."""
+        return None
+
     def __init__(self, *, statics_only: bool = False, **kw: object) -> None:
         super().__init__(**kw)  # type: ignore[arg-type]
         self.statics_only = bool(statics_only)

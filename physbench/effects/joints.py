@@ -21,6 +21,8 @@ class JointEffect(Effect):
     by index into ``scene.joints`` (default: all). ``bodies`` is not used by joint effects.
     """
 
+    scene_needs: ClassVar[tuple[str, ...]] = ("joints",)
+
     def __init__(self, *, joints: Sequence[int] | None = None, **values: float) -> None:
         super().__init__(**values)
         self.joints = None if joints is None else tuple(int(j) for j in joints)

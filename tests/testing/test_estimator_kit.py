@@ -14,15 +14,20 @@ from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.estimators.random_search import RandomSearch
 from physbench.params import Params
 from physbench.testing import (
+    Check,
     ConformanceError,
     EstimatorConformance,
+    Subject,
     check_bad_input,
     check_deterministic,
     check_deterministic_in_subprocess,
     check_estimator,
     check_protocol,
     check_respects_ranges,
+    checks_for,
+    parametrize_with_checks,
 )
+from physbench.testing.estimators import check_marked_views
 
 
 class Base(CorrectionEstimator):
@@ -95,12 +100,39 @@ class SwallowsOptions(Base):
 
 class CrashesBeforeStart(Base):
     def propose(self, step: Step) -> Params:
-        return self.task.space.sample(self.rng)  # type: ignore[union-attr]  # AttributeError on None
+        # AttributeError on None
+        return self.task.space.sample(self.rng)  # type: ignore[union-attr]
 
 
 class AcceptsBadWidth(Base):
     def __init__(self, width: float = 1.0) -> None:
         self.width, self.task = width, None
+
+
+class PerObject(Base):
+    """Corrects one marked object at a time (here: ignores them), and checks it gets them."""
+
+    per_object: ClassVar[bool] = True
+
+    def start(self, task: Task, *, seed: int) -> None:
+        for body in task.space.bodies:
+            if body not in task.marked_observation:
+                raise PhysbenchError(f"per_object: no marked view of body {body!r}")
+        super().start(task, seed=seed)
+
+
+class PerObjectUnchecked(Base):
+    per_object: ClassVar[bool] = True
+
+
+class MassOnly(Base):
+    """Can only be asked for masses (like a learned estimator trained for mass)."""
+
+    def start(self, task: Task, *, seed: int) -> None:
+        asked = sorted({u.name for u in task.space.unknowns})
+        if asked != ["mass"]:
+            raise PhysbenchError(f"mass_only: cannot estimate {asked}")
+        super().start(task, seed=seed)
 
 
 def test_a_correct_estimator_passes() -> None:
@@ -160,7 +192,7 @@ def test_unclear_errors_fail() -> None:
 def test_check_estimator_lists_every_failure() -> None:
     with pytest.raises(ConformanceError) as info:
         check_estimator(Unseeded, subprocess=False)
-    assert "fails 1 conformance check(s)" in str(info.value) and "- deterministic:" in str(
+    assert "fails 1 conformance check(s)" in str(info.value) and "- check_deterministic:" in str(
         info.value
     )
     with pytest.raises(ConformanceError, match=r"fails 2 conformance check\(s\)"):
@@ -185,3 +217,42 @@ def test_the_base_class_reports_a_broken_estimator() -> None:
         TestBroken().test_respects_ranges()
     with pytest.raises(ConformanceError, match="set the class attribute 'estimator'"):
         EstimatorConformance().test_protocol()
+
+
+@parametrize_with_checks(
+    [
+        Subject(Base, {"width": 0.8}, {"bad_options": [{"width": 0}]}),
+        Subject(MassOnly, kit={"unknowns": ("mass",)}),
+        PerObject,
+    ]
+)
+def test_correct_estimators_pass_every_parametrized_check(component: Subject, check: Check) -> None:
+    check(component)
+
+
+def test_the_unknowns_setting_limits_what_the_toy_task_asks() -> None:
+    with pytest.raises(
+        ConformanceError,
+        match=r"raised PhysbenchError: mass_only: cannot estimate \['elasticity', 'mass'\] \(if",
+    ):
+        check_respects_ranges(MassOnly)
+    check_respects_ranges(MassOnly, unknowns=("mass",))
+    check_deterministic(MassOnly, unknowns=("mass",))
+    with pytest.raises(ConformanceError, match=r"kit setting unknowns = \('friction',\)"):
+        check_deterministic(MassOnly, unknowns=("friction",))
+
+
+class TestMassOnlyThroughTheBaseClass(EstimatorConformance):
+    estimator = MassOnly
+    unknowns: ClassVar[Sequence[str]] = ("mass",)
+
+
+def test_per_object_estimators_must_ask_for_their_marked_views() -> None:
+    assert "check_marked_views" in [c.name for c in checks_for(PerObject)]
+    assert "check_marked_views" not in [c.name for c in checks_for(Base)]
+    check_marked_views(PerObject)
+    with pytest.raises(
+        ConformanceError,
+        match="start\\(\\) accepted a task without the marked view of unknown body 'b'",
+    ):
+        check_marked_views(PerObjectUnchecked)

@@ -1,10 +1,8 @@
-"""The example plugin: physbench's conformance suite, discovery through the entry point, and a
-real ``physbench run``. Needs the package installed (``pip install ./plugins/physbench-scipy``)."""
+"""The example plugin: physbench's estimator kit (one test per method x check), discovery through
+the entry point, and a real ``physbench run``. Needs the package installed
+(``pip install ./plugins/physbench-scipy``)."""
 
 from __future__ import annotations
-
-from collections.abc import Mapping, Sequence
-from typing import Any, ClassVar
 
 import numpy as np
 import pytest
@@ -12,22 +10,19 @@ from physbench_scipy import ScipyMinimize
 
 from physbench.cli import main
 from physbench.plugins import build_registry
-from physbench.testing import EstimatorConformance, run_toy
+from physbench.testing import Check, Subject, parametrize_with_checks, run_toy
+
+BAD_OPTIONS = [{"method": "bfgs"}, {"step": 0.0}, {"xatol": -1}]
 
 
-class TestNelderMeadConformance(EstimatorConformance):
-    estimator = ScipyMinimize
-    options: ClassVar[Mapping[str, Any]] = {"method": "nelder-mead"}
-    bad_options: ClassVar[Sequence[Mapping[str, Any]]] = [
-        {"method": "bfgs"},
-        {"step": 0.0},
-        {"xatol": -1},
+@parametrize_with_checks(
+    [
+        Subject(ScipyMinimize, {"method": m}, {"bad_options": BAD_OPTIONS}, id=f"scipy-{m}")
+        for m in ("nelder-mead", "powell")
     ]
-
-
-class TestPowellConformance(EstimatorConformance):
-    estimator = ScipyMinimize
-    options: ClassVar[Mapping[str, Any]] = {"method": "powell"}
+)
+def test_conformance(component: Subject, check: Check) -> None:
+    check(component)
 
 
 def test_found_through_the_entry_point() -> None:

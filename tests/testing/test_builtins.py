@@ -1,0 +1,61 @@
+"""Every built-in simulator, renderer, effect and estimator passes its kind's conformance kit:
+one test per component x check (``pytest -k RasterRenderer`` runs one component's)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from physbench.effects import BUILTIN_EFFECTS
+from physbench.estimators.resnet3d.weights import SHIPPED
+from physbench.plugins import build_registry
+from physbench.testing import Check, Subject, parametrize_with_checks
+from physbench.testing.kit import kind_of
+
+KINDS = ("simulator", "renderer", "effect", "estimator")
+
+#: Kit settings, options and optional modules of the built-ins that need them (by registered name).
+SETTINGS: dict[str, dict[str, Any]] = {
+    "tpe": {"kit": {"bad_options": [{"startup": -1}, {"candidates": 0}, {"gamma": 1.5}]}},
+    "cmaes": {"kit": {"bad_options": [{"sigma": 0.0}, {"popsize": 1}, {"elitist": "yes"}]}},
+    "optuna": {"kit": {"bad_options": [{"sampler": "grid"}, {"startup": 2.5}]}},
+    "resnet3d": {
+        # Shipped weights for mass; the toy task's frames are resampled to the network's input.
+        "options": {"weights": str(SHIPPED / "three_circles__mass.safetensors")},
+        "kit": {"unknowns": ("mass",), "bad_options": [{"weights": "no_such.safetensors"}]},
+        "requires": ("torch", "safetensors"),
+        "expected_failures": {
+            "check_bad_input": "ResNet3DEstimator.propose() before start() raises AttributeError "
+            "instead of an error saying that start() must come first",
+        },
+    },
+}
+
+
+def builtins() -> list[Subject]:
+    """The components physbench itself registers (not those of installed plugins)."""
+    reg = build_registry(env=False)
+    out = []
+    for kind in KINDS:
+        for name in reg.names(kind):
+            info = reg.info(kind, name)
+            if info.package == "physbench":
+                out.append(Subject(info.obj, **SETTINGS.get(name, {})))
+    return out
+
+
+BUILTINS = builtins()
+
+
+def test_every_kind_has_builtins() -> None:
+    # Guards the parametrized test below against an empty registry (it would pass vacuously).
+    by_kind = {kind: {s.cls.name for s in BUILTINS if kind_of(s.cls) == kind} for kind in KINDS}
+    assert by_kind["simulator"] == {"pymunk", "box2d"} and by_kind["renderer"] == {"raster"}
+    assert by_kind["effect"] == {cls.name for cls in BUILTIN_EFFECTS}
+    assert {"random", "tpe", "cmaes", "optuna", "resnet3d"} <= by_kind["estimator"]
+    assert "scipy" not in by_kind["estimator"]  # the example plugin tests itself
+    assert set(SETTINGS) <= by_kind["estimator"]
+
+
+@parametrize_with_checks(BUILTINS)
+def test_builtin_conforms(component: Subject, check: Check) -> None:
+    check(component)
