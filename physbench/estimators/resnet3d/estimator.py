@@ -21,17 +21,30 @@ class ResNet3DEstimator(CorrectionEstimator):
     ``symmetric`` (also feed the pair swapped and use ``(f(obs, sim) - f(sim, obs)) / 2``: the truth
     becomes an exact fixed point, so with an observation from the model's own renderer the loop
     converges to 1e-7-1e-5 instead of 2e-5-2e-4; off by default because it hurts on blurred
-    observations, which the network only ever saw in the observed slot).
+    observations, which the network only ever saw in the observed slot), ``any_renderer`` (accept
+    frames of a renderer other than the one the weights were trained on; off by default, since the
+    weights were never validated on such frames).
     """
 
     name: ClassVar[str] = "resnet3d"
     per_object: ClassVar[bool] = True
 
     def __init__(
-        self, weights: str | None = None, threads: int = 1, symmetric: bool = False
+        self,
+        weights: str | None = None,
+        threads: int = 1,
+        symmetric: bool = False,
+        any_renderer: bool = False,
     ) -> None:
         self.weights_path, self.threads, self.symmetric = weights, threads, symmetric
-        self.options = {"weights": weights, "threads": threads, "symmetric": symmetric}
+        self.any_renderer = any_renderer
+        self.options = {
+            "weights": weights,
+            "threads": threads,
+            "symmetric": symmetric,
+            "any_renderer": any_renderer,
+        }
+        self.targets: list[tuple[str, list[str], np.ndarray]] | None = None
 
     def start(self, task: Task, *, seed: int) -> None:
         import torch
@@ -54,11 +67,13 @@ class ResNet3DEstimator(CorrectionEstimator):
             state, meta = weights.load(info.path)
         self.params = tuple(meta["data"]["params"])
         trained_on = DataSpec.from_dict(meta["data"]).renderer
-        if task.renderer is not None and type(task.renderer).name != trained_on:
+        rendered_by = None if task.renderer is None else type(task.renderer).name
+        if rendered_by not in (None, trained_on) and not self.any_renderer:
             raise PhysbenchError(
                 f"resnet3d weights for {task.scene.name} were trained on frames of renderer "
-                f"{trained_on!r}; this run renders with {type(task.renderer).name!r} (choose "
-                f"--renderer {trained_on}, or train weights for it with physbench train --renderer)"
+                f"{trained_on!r}; this run renders with {rendered_by!r} (choose --renderer "
+                f"{trained_on}, train weights for it with physbench train --renderer, or accept "
+                "it with -o any_renderer=true)"
             )
         if self.threads:
             torch.set_num_threads(self.threads)
@@ -93,6 +108,8 @@ class ResNet3DEstimator(CorrectionEstimator):
 
         from physbench.estimators.resnet3d.inputs import make_input
 
+        if self.targets is None:
+            raise PhysbenchError("resnet3d: propose() called before start()")
         marked = step.marked
         if not marked:
             raise PhysbenchError(

@@ -83,3 +83,5 @@ def test_weights_refuse_frames_of_another_renderer(squares_renderer) -> None:  #
     config = RunConfig(estimator="resnet3d", renderer="squares", iterations=2, resolution=32)
     with pytest.raises(PhysbenchError, match=r"trained on frames of renderer 'raster'.*'squares'"):
         run_config(config)
+    accepted = run_config(RunConfig(**{**config.__dict__, "options": {"any_renderer": True}}))
+    assert accepted.meta["renderer"] == "squares" and len(accepted) == 2
