@@ -1,4 +1,4 @@
-"""The correction loop, its history, the metric and observations (on the closed-form toy task)."""
+"""The correction loop and its history, on the closed-form toy task."""
 
 from __future__ import annotations
 
@@ -19,12 +19,10 @@ from physbench.loop import (
     draw_problem,
     refine,
 )
-from physbench.metrics import format_mean_std, image_mse, mean_std, running_best
+from physbench.metrics import running_best
 from physbench.observation import (
     Observation,
     ObservationError,
-    load_observation,
-    save_observation,
     simulate_observation,
 )
 from physbench.params import ParamSpace
@@ -108,15 +106,6 @@ def test_best_is_chosen_by_image_mse_without_peeking_at_the_truth() -> None:
     losses = [r.loss for r in h.iterations]
     assert [r.best_iteration for r in h.iterations] == running_best(losses)
     assert all(r.best_nmse == h.iterations[r.best_iteration].nmse for r in h.iterations)
-
-
-def test_normalized_mse_divides_by_the_range_maximum() -> None:
-    t = toy_task(("mass", "elasticity"), seed=0)
-    est = {"a.mass": 4.0, "a.elasticity": 0.5, "b.mass": 10.0, "b.elasticity": 1.0}
-    truth = {"a.mass": 2.0, "a.elasticity": 0.3, "b.mass": 10.0, "b.elasticity": 1.0}
-    assert t.space.normalized_mse(est, truth) == pytest.approx(
-        ((2 / 10) ** 2 + (0.2 / 1.0) ** 2) / 4
-    )
 
 
 def test_history_round_trips_through_json_and_pandas() -> None:
@@ -269,33 +258,6 @@ def test_any_number_of_unknown_bodies() -> None:
     obs = simulate_observation(scene, draw_problem(space, 0)[0], sim, ren)
     h = refine(obs, scene, space, sim, ren, RandomSearch(), iterations=4)
     assert len(h.keys) == 6 and all(len(r.params) == 6 for r in h.iterations)
-
-
-def test_observation_files_round_trip_and_bad_files_are_explained(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    t = toy_task()
-    path = tmp_path / "obs.npz"
-    save_observation(path, t.observation)
-    back = load_observation(path)
-    assert back.truth is None and np.array_equal(back.frames, t.observation.frames)
-    assert set(back.marked) == {"a", "b"}
-    np.savez(tmp_path / "nokey.npz", images=t.observation.frames)
-    with pytest.raises(ObservationError, match=r"no 'frames' array .*found: images"):
-        load_observation(tmp_path / "nokey.npz")
-    np.savez(tmp_path / "flat.npz", frames=t.observation.frames[0])
-    with pytest.raises(ObservationError, match=r"shape \(2, 16, 16\); expected 4 axes"):
-        load_observation(tmp_path / "flat.npz")
-    with pytest.raises(ObservationError, match="does not exist"):
-        load_observation(tmp_path / "missing.npz")
-    (tmp_path / "junk.npz").write_text("not a zip")
-    with pytest.raises(ObservationError, match=r"cannot read as \.npz"):
-        load_observation(tmp_path / "junk.npz")
-
-
-def test_metrics() -> None:
-    assert running_best([3.0, 1.0, 1.0, 0.5, 2.0]) == [0, 1, 1, 3, 3]
-    assert image_mse(np.ones((2, 2)), np.zeros((2, 2))) == 1.0
-    assert mean_std([1.0, 3.0]) == (2.0, pytest.approx(2**0.5))
-    assert format_mean_std(0.011, 0.003) == "(1.1 ± 0.3)e-02"
 
 
 def test_bouncing_balls_end_to_end_with_six_masses_and_marked_objects() -> None:
