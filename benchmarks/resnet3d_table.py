@@ -1,94 +1,21 @@
-"""Issue-4 tables from a `physbench bench benchmarks/resnet3d.toml` run.
-
-1. The criteria, for ``resnet3d`` per Table 1 row: the paper's NN value, normalized min MSE after
-   2 and after 11 iterations, their ratio, and the ratio of blurred to sharp after 11 iterations.
-   Ratios are ratios of means over the same seeds (same scene instances and initial guesses), with a
-   90 % paired bootstrap interval over seeds, so a reader can tell a real miss from the spread of
-   heavy-tailed errors. Two more blur columns: the ratio on seeds 0-9 only (the issue's 10 runs), and
-   a diagnostic, the ratio of the *final* iterates' errors: the metric picks the best iterate by
-   image MSE, which under blur compares blurred with sharp frames and can keep a worse iterate.
-2. Every estimator: mean ± std after 2 and after 11 iterations, per scene, unknowns, bodies, blur.
+"""Issue-4 tables from a `physbench bench benchmarks/resnet3d.toml` run
+(:mod:`physbench.bench.resnet3d_table` says what they hold).
 
     python benchmarks/resnet3d_table.py results/resnet3d > results/resnet3d/table.md
 """
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
+import argparse
 
-import pandas as pd
-
-from physbench.bench.tables import paper_value, ratio_ci
-
-KEYS = ["scene", "unknowns", "bodies"]
-FIRST_TEN = 10
+from physbench.bench.resnet3d_table import table
 
 
-def _at(g: pd.DataFrame, n: int, column: str = "best_nmse") -> pd.Series:
-    """Best-so-far (or, with ``column="nmse"``, that iterate's) normalized MSE after ``n``
-    iterations, indexed by seed."""
-    return g[g.iteration == n - 1].set_index("seed")[column].sort_index()
-
-
-def _fmt_ratio(r: tuple[float, float, float], limit: float = 2.0) -> str:
-    mark = "yes" if r[0] <= limit else "no"
-    return f"{r[0]:.2f} [{r[1]:.2f}, {r[2]:.2f}] | {mark}"
-
-
-def criteria(ok: pd.DataFrame) -> list[str]:
-    rows = [
-        "| scene | unknowns | bodies | paper NN | after 2 | after 11 | ≤ paper | 2 / 11 [90 %] | ≤ 2 | "
-        "blur 3, after 11 | blur / sharp [90 %] | ≤ 2 | blur / sharp, seeds 0-9 | blur / sharp, final iterate | seeds |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    nn = ok[ok.estimator_name == "resnet3d"]
-    for (scene, unknowns, bodies), g in nn.groupby(KEYS, sort=True):
-        sharp, blur = g[g.blur == 0], g[g.blur > 0]
-        a2, a11, b11 = _at(sharp, 2), _at(sharp, 11), _at(blur, 11)
-        common = a11.index.intersection(b11.index)
-        paper = paper_value(scene, unknowns, "NN") if bodies == "all" else None
-        first = common[common < FIRST_TEN]
-        rows.append(
-            f"| {scene} | {unknowns} | {bodies} | {f'{paper[0]:.1e}' if paper else '–'} | {a2.mean():.2e} | "
-            f"{a11.mean():.2e} | {('yes' if a11.mean() <= paper[0] else 'no') if paper else '–'} | "
-            f"{_fmt_ratio(ratio_ci(a2.values, a11.values))} | {b11.mean():.2e} | "
-            f"{_fmt_ratio(ratio_ci(b11[common].values, a11[common].values))} | "
-            f"{b11[first].mean() / a11[first].mean():.2f} | "
-            f"{_at(blur, 11, 'nmse')[common].mean() / _at(sharp, 11, 'nmse')[common].mean():.2f} | {len(a11)} |"
-        )
-    return rows
-
-
-def table(folder: str | Path) -> str:
-    df = pd.read_parquet(Path(folder) / "results.parquet")
-    ok = df[df.status == "ok"]
-    rows = [
-        "## resnet3d against the issue's criteria",
-        "",
-        *criteria(ok),
-        "",
-        "## Every estimator at equal iterations",
-        "",
-        "| scene | unknowns | bodies | blur | estimator | after 2 | after 11 | 2 / 11 | seeds |",
-        "|---|---|---|---|---|---|---|---|---|",
-    ]
-    keys = [*KEYS, "blur", "estimator_name"]
-    for key, g in ok.groupby(keys, sort=True):
-        a2, a11 = _at(g, 2), _at(g, 11)
-        rows.append(
-            f"| {key[0]} | {key[1]} | {key[2]} | {key[3]:g} | {key[4]} | {a2.mean():.2e} ± {a2.std():.1e} | "
-            f"{a11.mean():.2e} ± {a11.std():.1e} | {a2.mean() / a11.mean():.2f} | {len(a11)} |"
-        )
-    failed = df[df.status != "ok"].drop_duplicates("cell")
-    if len(failed):
-        rows.append("")
-        for key, g in failed.groupby(keys):
-            rows.append(
-                f"failed: {' '.join(map(str, key))}: {len(g)} cells ({g.error.iloc[0][:120]})"
-            )
-    return "\n".join(rows)
+def main() -> None:
+    ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    ap.add_argument("folder", nargs="?", default="results/resnet3d", help="the sweep's --out")
+    print(table(ap.parse_args().folder))
 
 
 if __name__ == "__main__":
-    print(table(sys.argv[1] if len(sys.argv) > 1 else "results/resnet3d"))
+    main()

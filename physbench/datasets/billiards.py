@@ -1,26 +1,31 @@
 """A real three-cushion billiards match (Dogan, 2022-12-25): 182 shots, tracked ball centres.
 
-Each shot becomes a :class:`~physbench.datasets.Case`: a top-down scene (gravity 0) of the 2.84 ×
-1.42 m table, its four cushions as thick segments whose inner surface is the table edge, and the
-three balls (``white``, ``yellow``, ``red``) at rest at their first tracked positions. The cue
-strike is an impulse on the cue ball (see :func:`cue_strike`); tracking starts slightly before it.
-The recording has ``x, y``; balls are only sampled while they move.
+Each shot becomes a :class:`~physbench.datasets.run.DatasetRun`: a top-down scene (gravity 0) of
+the 2.84 × 1.42 m table, its four cushions as thick segments whose inner surface is the table edge,
+and the three balls (``white``, ``yellow``, ``red``) at rest at their first tracked positions. The
+cue strike is an impulse on the cue ball (see :func:`cue_strike`); tracking starts slightly before
+it. The recording has ``x, y``; balls are only sampled while they move.
 
 The plain model misses rolling resistance, cushion losses and spin (see PROVENANCE.md);
-:func:`rolling_decelerations` measures the first from the tracks.
+:func:`rolling_decelerations` measures the first from the tracks. :func:`rolling_segments` cuts
+each ball's track after its last contact with another ball, where only rolling and the cushions
+act; :func:`cushion_bounces` and :func:`straight_stretches` measure those two on such a segment.
 """
 
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Iterable
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from physbench.datasets import Case, DatasetError, data_dir, data_file
+from physbench.datasets.files import DatasetError, data_dir, data_file
+from physbench.datasets.run import DatasetRun
 from physbench.recording import Recording, Track
-from physbench.scene import Body, Circle, Force, Scene, Segment
+from physbench.scene import Body, Circle, Force, Scene, Segment, body_unknown
 
 NAME = "billiards"
 FOLDER = "billiards_dogan"
@@ -39,7 +44,8 @@ def _table(path: Path) -> np.ndarray:
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     if data.shape[1] != 6:
         raise DatasetError(
-            f"{path}: expected 6 columns shot_index,shot_id,ball_id,t_s,x_m,y_m, got {data.shape[1]}"
+            f"{path}: expected 6 columns shot_index,shot_id,ball_id,t_s,x_m,y_m, "
+            f"got {data.shape[1]}"
         )
     return data
 
@@ -95,8 +101,8 @@ def load(
     substeps: int = 10,
     ball_elasticity: float = 0.95,
     cushion_elasticity: float = 0.9,
-) -> list[Case]:
-    """One case per shot (``shots``: shot indices 0-181, default all)."""
+) -> list[DatasetRun]:
+    """One run per shot (``shots``: shot indices 0-181, default all)."""
     data = read_table(root)
     index = data[:, 0].astype(int)
     available = np.unique(index)
@@ -150,7 +156,9 @@ def load(
             substeps=substeps,
             statics=cushions(cushion_elasticity),
             forces=forces,
-            description=f"three-cushion shot {shot} (tracking id {shot_id}), cue ball {cue}, top-down",
+            description=(
+                f"three-cushion shot {shot} (tracking id {shot_id}), cue ball {cue}, top-down"
+            ),
             meta={"dataset": NAME, "cue": cue},
         ).validate()
         notes = {
@@ -163,7 +171,7 @@ def load(
             "samples": counts,
         }
         cases.append(
-            Case(
+            DatasetRun(
                 f"shot_{shot}",
                 scene,
                 rec,
@@ -218,3 +226,221 @@ def rolling_decelerations(
                     out.append(dec)
             i = j
     return np.asarray(out)
+
+
+# --------------------------------------------------------------------------- rolling segments
+
+#: Time after a ball's last contact with another ball before its rolling segment starts: after a
+#: hit a ball slides (friction about 10x rolling resistance) until it rolls, which a 2D scene lacks.
+SEGMENT_SETTLE = 1.0  # s
+#: Shortest rolling segment.
+MIN_SEGMENT = 3.0  # s
+#: Fewest samples of a ball's whole track, and of its segment.
+MIN_TRACK_SAMPLES, MIN_SEGMENT_SAMPLES = 60, 40
+#: Slowest start of a segment (from a line through its first 6 samples).
+MIN_SEGMENT_SPEED = 0.3  # m/s
+#: Samples are 2-4 cm apart at speed: a contact can fall between two of them, so two balls count
+#: as touching up to this far beyond touching.
+CONTACT_MARGIN = 0.04  # m
+
+
+def last_ball_contact(recording: Recording, ball: str) -> float:
+    """When ``ball`` last touched another ball (0 when never): the last sample at which another
+    ball is within :data:`CONTACT_MARGIN` of touching it, or the time another ball starts to
+    move (something hit it), whichever is later."""
+    tr = recording.tracks[ball]
+    t_last = 0.0
+    for other, o in recording.tracks.items():
+        if other == ball:
+            continue
+        ox, oy = np.interp(tr.t, o.t, o.x), np.interp(tr.t, o.t, o.y)
+        close = np.hypot(tr.x - ox, tr.y - oy) < 2 * BALL_RADIUS + CONTACT_MARGIN
+        if close.any():
+            t_last = max(t_last, float(tr.t[np.nonzero(close)[0][-1]]))
+        if len(o) > 2:
+            started = (
+                float(o.t[0])
+                if o.t[0] > 0.05
+                else float(o.t[np.argmax(np.diff(o.t) <= MAX_START_STEP)])
+            )
+            t_last = max(t_last, started)
+    return t_last
+
+
+def rolling_segment(
+    shot: DatasetRun, ball: str, max_speed: float | None = None
+) -> DatasetRun | None:
+    """``ball``'s track in ``shot`` from :data:`SEGMENT_SETTLE` after its last contact with
+    another ball (:func:`last_ball_contact`) to the end of the shot, when at least
+    :data:`MIN_SEGMENT` long and moving at its start: a run of one ball ``ball`` on the table that
+    only rolling and the cushions act on, its time from 0 at the segment's start. With
+    ``max_speed`` (m/s), the segment starts when the ball is first slower than that. ``None`` when
+    the track holds no such segment.
+
+    The ball is frictionless and unpushed, its start velocity a line through the segment's first
+    6 samples. The scene's one unknown is the ball's elasticity against cushions of elasticity 1,
+    with one body name for every segment, so that runs of different balls and shots share the
+    cushion restitution. Its range, 0.4-1, brackets the 0.55-0.6 that :func:`cushion_bounces`
+    measures; a lossless base fit would otherwise make up for the missing rolling loss at the
+    cushions."""
+    rec = shot.recording
+    tr = rec.tracks[ball]
+    if len(tr) < MIN_TRACK_SAMPLES:
+        return None
+    t0 = last_ball_contact(rec, ball) + SEGMENT_SETTLE
+    if max_speed is not None:
+        dt = np.diff(tr.t)
+        sp = np.hypot(np.diff(tr.x), np.diff(tr.y)) / dt
+        slow = np.nonzero((tr.t[1:] >= t0) & (sp < max_speed) & (dt <= MAX_START_STEP))[0]
+        if slow.size == 0:
+            return None
+        t0 = float(tr.t[slow[0]])
+    keep = tr.t >= t0
+    if keep.sum() < MIN_SEGMENT_SAMPLES or tr.t[-1] - t0 < MIN_SEGMENT:
+        return None
+    t, x, y = tr.t[keep] - tr.t[keep][0], tr.x[keep], tr.y[keep]
+    if np.any(np.diff(t[:6]) > MAX_START_STEP):  # must start while moving
+        return None
+    vx, vy = np.polyfit(t[:6], x[:6], 1)[0], np.polyfit(t[:6], y[:6], 1)[0]
+    if math.hypot(vx, vy) < MIN_SEGMENT_SPEED:
+        return None
+    name = f"{shot.name}/{ball}"
+    recording = Recording({"ball": Track(t, x, y)}, run=name, fields=("x", "y"), source=rec.source)
+    scene = replace(
+        shot.scene,
+        name=f"billiards_{shot.name}_{ball}",
+        bodies=(
+            Body(
+                "ball",
+                Circle(BALL_RADIUS),
+                (float(x[0]), float(y[0])),
+                velocity=(float(vx), float(vy)),
+                mass=BALL_MASS,
+                elasticity=0.85,
+                friction=0.0,
+            ),
+        ),
+        statics=cushions(1.0),
+        forces=(),
+        frames=recording.frames_for(shot.scene.fps),
+        unknowns=(body_unknown("ball", "elasticity", 0.4, 1.0),),
+        description=f"{shot.name}: {ball} after its last ball contact",
+    ).validate()
+    notes = {"shot": shot.name, "ball": ball, "start_s": float(tr.t[keep][0])}
+    return DatasetRun(name, scene, recording, shot.expected_effects, notes)
+
+
+def rolling_segments(
+    shots: Iterable[DatasetRun], *, count: int | None = None, max_speed: float | None = None
+) -> list[DatasetRun]:
+    """:func:`rolling_segment` of every ball of each shot in turn, the first ``count`` found
+    (default: all)."""
+    out: list[DatasetRun] = []
+    for shot in shots:
+        for ball in shot.recording.tracks:
+            seg = rolling_segment(shot, ball, max_speed)
+            if seg is None:
+                continue
+            out.append(seg)
+            if count is not None and len(out) >= count:
+                return out
+    return out
+
+
+# --------------------------------------------------------------------------- cushions and rolling
+
+#: Time windows on either side of a cushion contact that the velocities in and out are fitted on.
+BOUNCE_WINDOW = (0.05, 0.4)  # s
+
+
+@dataclass(frozen=True)
+class CushionBounce:
+    """One bounce off a cushion: the run and time, the speed normal to the cushion coming in and
+    the tangential velocity coming in (m/s), the restitution ``e_n = |v_n out| / |v_n in|``, the
+    share of the tangential velocity kept, and the share of the speed kept."""
+
+    run: str
+    t: float
+    vn_in: float
+    vt_in: float
+    e_n: float
+    t_kept: float
+    speed_kept: float
+
+
+@dataclass(frozen=True)
+class StraightStretch:
+    """A stretch of rolling away from the cushions: its deceleration (m/s², positive when
+    slowing), start speed (m/s) and duration (s)."""
+
+    run: str
+    deceleration: float
+    speed: float
+    seconds: float
+
+
+def _cushion_lines() -> tuple[np.ndarray, np.ndarray]:
+    """The lowest and highest ball centre on the table, per axis."""
+    return np.array([BALL_RADIUS, BALL_RADIUS]), np.array(TABLE) - BALL_RADIUS
+
+
+def cushion_bounces(run: str, track: Track) -> list[CushionBounce]:
+    """Every cushion bounce of ``track`` (a ball in a rolling segment, whose positions touch the
+    cushion line when it bounces): velocities from straight-line fits over
+    :data:`BOUNCE_WINDOW` before and after the contact, split into the components normal and
+    tangential to the cushion. Bounces with another cushion within 2 cm in those windows, fewer
+    than 4 samples in either, or coming in nearly along or straight at the cushion are left
+    out."""
+    lo, hi = _cushion_lines()
+    near_s, far_s = BOUNCE_WINDOW
+    t, p = track.t, np.stack([track.x, track.y], axis=1)
+    near = np.minimum(np.abs(p - lo), np.abs(p - hi))
+    out = []
+    for axis in (0, 1):
+        for wall in (lo[axis], hi[axis]):
+            at = np.abs(p[:, axis] - wall) < 1e-3
+            for i in np.nonzero(at & ~np.roll(at, 1))[0]:
+                th = t[i]
+                before = (t > th - far_s) & (t < th - near_s)
+                after = (t > th + near_s) & (t < th + far_s)
+                if before.sum() < 4 or after.sum() < 4:
+                    continue
+                if (near[before | after] < 0.02).any():  # another cushion within the windows
+                    continue
+                vin = np.polyfit(t[before], p[before], 1)[0]
+                vout = np.polyfit(t[after], p[after], 1)[0]
+                n, tg = axis, 1 - axis
+                if abs(vin[n]) < 0.05 or abs(vin[tg]) < 1e-3:
+                    continue
+                out.append(
+                    CushionBounce(
+                        run,
+                        float(th),
+                        vn_in=float(abs(vin[n])),
+                        vt_in=float(vin[tg]),
+                        e_n=float(abs(vout[n]) / abs(vin[n])),
+                        t_kept=float(vout[tg] / vin[tg]),
+                        speed_kept=float(np.hypot(*vout) / np.hypot(*vin)),
+                    )
+                )
+    return out
+
+
+def straight_stretches(run: str, track: Track) -> list[StraightStretch]:
+    """Rolling deceleration of ``track`` on each stretch at least 5 cm from every cushion line
+    and at least 1 s (12 samples) long that is still rolling at its end: a quadratic fit of the
+    path length over time."""
+    lo, hi = _cushion_lines()
+    t, p = track.t, np.stack([track.x, track.y], axis=1)
+    away = (np.minimum(np.abs(p - lo), np.abs(p - hi)) > 0.05).all(axis=1)
+    idx = np.nonzero(away)[0]
+    out = []
+    for part in np.split(idx, np.nonzero(np.diff(idx) > 1)[0] + 1):
+        if part.size < 12 or t[part[-1]] - t[part[0]] < 1.0:
+            continue
+        seconds = t[part[-1]] - t[part[0]]
+        path = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p[part], axis=0).T))])
+        c2, c1, _ = np.polyfit(t[part] - t[part[0]], path, 2)
+        if c1 > 0.05 and c1 + 2 * c2 * seconds > 0.02:  # still rolling at the end
+            out.append(StraightStretch(run, float(-2 * c2), float(c1), float(seconds)))
+    return out

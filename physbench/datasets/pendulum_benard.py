@@ -1,13 +1,14 @@
 """A small rod pendulum on a hobby rig (jensen-benard 2025): three free swings, encoder angle at
 a nominal 1 kHz.
 
-Each file becomes a case from the first extreme of the swing (before it the hand still moves the
-rod; the rate there is 0). The scene is a uniform 0.13 m, 0.1 kg rod on a frictionless pivot (the
-plain model); the recording tracks the angle (``fields = ("angle",)``, converted to rad; ``x, y`` are
-the rod centre it implies). Times are the nominal sample index / 1000 s: the logger's real interval
-is >= 1 ms and jitters. For one pendulum a clock error is a change of its inertia, so leave the
-rod's inertia unknown (discovery offers :class:`~physbench.effects.ClockScale` only with a force of
-known size); a clock that differs from file to file is not modelled.
+Each file becomes a :class:`~physbench.datasets.run.DatasetRun` from the first extreme of the
+swing (before it the hand still moves the rod; the rate there is 0). The scene is a uniform
+0.13 m, 0.1 kg rod on a frictionless pivot (the plain model); the recording tracks the angle
+(``fields = ("angle",)``, converted to rad; ``x, y`` are the rod centre it implies). Times are the
+nominal sample index / 1000 s: the logger's real interval is >= 1 ms and jitters. For one pendulum
+a clock error is a change of its inertia, so leave the rod's inertia unknown (discovery offers
+:class:`~physbench.effects.ClockScale` only with a force of known size); a clock that differs from
+file to file is not modelled.
 """
 
 from __future__ import annotations
@@ -18,8 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from physbench.datasets import Case, DatasetError, data_dir
 from physbench.datasets._arms import Arm, chain, chain_tracks
+from physbench.datasets.files import DatasetError, data_dir
+from physbench.datasets.run import DatasetRun
 from physbench.recording import Recording
 from physbench.scene import Scene
 
@@ -63,8 +65,8 @@ def load(
     root: str | Path | None = None,
     fps: float = 200.0,
     substeps: int = 5,
-) -> list[Case]:
-    """One case per file, keeping every ``every``-th sample from the first extreme on."""
+) -> list[DatasetRun]:
+    """One run per file, keeping every ``every``-th sample from the first extreme on."""
     cases = []
     for number in files:
         deg, header = read(number, root)
@@ -89,7 +91,10 @@ def load(
             frames=rec.frames_for(fps),
             substeps=substeps,
             joints=joints,
-            description=f"rod pendulum free swing {number} from {math.degrees(phi[0, 0]):.0f}° (jensen-benard)",
+            description=(
+                f"rod pendulum free swing {number} from {math.degrees(phi[0, 0]):.0f}° "
+                "(jensen-benard)"
+            ),
             meta={"dataset": NAME},
         ).validate()
         notes = {
@@ -103,5 +108,5 @@ def load(
             "sensor_offset",
             "clock_scale",
         )
-        cases.append(Case(rec.run, scene, rec, effects, notes))
+        cases.append(DatasetRun(rec.run, scene, rec, effects, notes))
     return cases

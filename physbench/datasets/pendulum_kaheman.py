@@ -1,10 +1,11 @@
 """Single and double compound pendulum, encoder angles (Kaheman et al. 2022), free swing.
 
-A case is a window of the record: the arms' geometry and inertia are the authors' fitted values
-(:data:`SINGLE`, :data:`DOUBLE`), the initial angles and rates the data's at the window start, and
-the scene the plain, lossless model. The recording tracks the arm angles (``fields = ("angle",)``);
-its ``x, y`` are the shape centres the angles imply. Data angles θ (from upright, clockwise-positive
-as seen in the scene) map to scene angles φ = π - θ; rates to -dθ/dt.
+A :class:`~physbench.datasets.run.DatasetRun` is a window of the record: the arms' geometry and
+inertia are the authors' fitted values (:data:`SINGLE`, :data:`DOUBLE`), the initial angles and
+rates the data's at the window start, and the scene the plain, lossless model. The recording
+tracks the arm angles (``fields = ("angle",)``); its ``x, y`` are the shape centres the angles
+imply. Data angles θ (from upright, clockwise-positive as seen in the scene) map to scene angles
+φ = π - θ; rates to -dθ/dt.
 """
 
 from __future__ import annotations
@@ -14,8 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from physbench.datasets import Case, DatasetError, data_dir, data_file
 from physbench.datasets._arms import Arm, chain, chain_tracks
+from physbench.datasets.files import DatasetError, data_dir, data_file
+from physbench.datasets.run import DatasetRun
 from physbench.recording import Recording
 from physbench.scene import Scene
 
@@ -58,8 +60,8 @@ def load(
     root: str | Path | None = None,
     fps: float = 100.0,
     substeps: int = 10,
-) -> list[Case]:
-    """Cases of ``arms`` (1 or 2): consecutive windows of ``duration`` s from ``start`` (default:
+) -> list[DatasetRun]:
+    """Runs of ``arms`` (1 or 2): consecutive windows of ``duration`` s from ``start`` (default:
     one window to the end), at most ``windows`` of them, keeping every ``every``-th sample."""
     data = read(arms, root)
     t_all = data[:, 2]
@@ -102,7 +104,10 @@ def load(
             frames=rec.frames_for(fps),
             substeps=substeps,
             joints=joints,
-            description=f"{'single' if arms == 1 else 'double'} pendulum free swing from t = {rows[0, 2]:g} s (Kaheman et al. 2022)",
+            description=(
+                f"{'single' if arms == 1 else 'double'} pendulum free swing from "
+                f"t = {rows[0, 2]:g} s (Kaheman et al. 2022)"
+            ),
             meta={"dataset": NAME},
         ).validate()
         notes = {
@@ -110,7 +115,7 @@ def load(
             "rest_angle_offset_rad": math.pi - 3.167,
         }
         cases.append(
-            Case(
+            DatasetRun(
                 rec.run,
                 scene,
                 rec,

@@ -20,7 +20,7 @@ from physbench.errors import PhysbenchError
 from physbench.recording import Recording, Track
 
 if TYPE_CHECKING:
-    from physbench.datasets import Case
+    from physbench.datasets.run import DatasetRun
     from physbench.scene import Scene
 
 #: Fewest samples (recordings) or frames (frames) a run needs in its fitted and held-out parts.
@@ -77,9 +77,13 @@ class Run:
         return "recording" if self.recording is not None else "frames"
 
 
-def runs_from_cases(cases: Iterable[Case]) -> list[Run]:
-    """One run per data-set case (:func:`physbench.datasets.load`)."""
-    return [Run(c.name, c.scene, recording=c.recording, source=c.recording.source) for c in cases]
+def runs_from_dataset(runs: Iterable[DatasetRun]) -> list[Run]:
+    """One discovery run per data-set run (:func:`physbench.datasets.load`)."""
+    return [Run(r.name, r.scene, recording=r.recording, source=r.recording.source) for r in runs]
+
+
+#: The old name, until ``physbench/discover/__init__.py`` exports :func:`runs_from_dataset`.
+runs_from_cases = runs_from_dataset
 
 
 def load_runs(

@@ -1,5 +1,5 @@
 """The committed real-data discovery results (``results/discover/``, written by
-``python results/discover/run_real.py``): their layout and the claims README and docs/discover.md
+``python benchmarks/discover_real.py``): their layout and the claims README and docs/discover.md
 make about them. These tests read the committed files; they do not recompute anything."""
 
 from __future__ import annotations

@@ -7,32 +7,17 @@ that the claims README makes about them hold.
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
-from types import ModuleType
 
 import numpy as np
 import pandas as pd
 import pytest
 
+from physbench.bench.resnet3d_table import table
 from physbench.bench.tables import PAPER, ratio_ci
 
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "results" / "resnet3d"
-
-
-def _table_module() -> ModuleType:
-    if "resnet3d_table" in sys.modules:
-        return sys.modules["resnet3d_table"]
-    spec = importlib.util.spec_from_file_location(
-        "resnet3d_table", ROOT / "benchmarks" / "resnet3d_table.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["resnet3d_table"] = module
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +40,7 @@ def _resnet3d_after_11(
 
 
 def test_committed_table_is_generated_from_the_committed_results() -> None:
-    expected = _table_module().table(RESULTS) + "\n"
+    expected = table(RESULTS) + "\n"
     assert (RESULTS / "table.md").read_text() == expected, (
         "results/resnet3d/table.md is stale: python benchmarks/resnet3d_table.py results/resnet3d > results/resnet3d/table.md"
     )

@@ -8,12 +8,8 @@ Euler, whose positions under constant acceleration ``a`` lag the continuous solu
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 from dataclasses import replace
-from pathlib import Path
-from types import ModuleType
 from typing import ClassVar
 
 import numpy as np
@@ -35,6 +31,7 @@ from physbench.scene import (
 )
 from physbench.scenes.bin import bin_walls
 from physbench.simulators.box2d_sim import Box2DSimulator
+from physbench.simulators.divergence import Comparison, compare
 from physbench.simulators.pymunk_sim import PymunkSimulator
 from physbench.simulators.stepping import SteppingSimulator
 from physbench.trajectory import Trajectory
@@ -550,18 +547,6 @@ def test_params_are_applied(sim: SteppingSimulator) -> None:
 # --------------------------------------------------------------------------- paper scenes
 
 
-def _divergence_module() -> ModuleType:
-    if "engine_divergence" in sys.modules:
-        return sys.modules["engine_divergence"]
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "engine_divergence.py"
-    spec = importlib.util.spec_from_file_location("engine_divergence", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["engine_divergence"] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
-
-
 #: Per scene, limits on the final-position difference per body between engines (m) over seeds
 #: 0-9: (mean, max). About 2x the mean and 1.4x the max measured by
 #: benchmarks/engine_divergence.py (docs/engines.md). Before the step-order and skin fixes
@@ -578,9 +563,8 @@ PAPER_LIMITS = {
 ALLOWED_MISSES = {"bouncing_balls": 1}
 
 
-def _paper_rows(name: str, **kwargs: float) -> list:
-    ed = _divergence_module()
-    rows = [c for seed in range(10) if (c := ed.compare(name, seed, **kwargs)) is not None]
+def _paper_rows(name: str, **kwargs: float) -> list[Comparison]:
+    rows = [c for seed in range(10) if (c := compare(name, seed, **kwargs)) is not None]
     if not rows:
         pytest.skip(f"scene {name} not available")
     return rows
