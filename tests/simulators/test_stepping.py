@@ -1,4 +1,5 @@
-"""Both built-in simulators against analytic solutions and against each other.
+"""The shared stepping loop, run through both built-in engines: analytic free motion, contacts,
+joints, force windows and impulses, effects, typed failures, determinism.
 
 Every test runs in both engines. Tolerances: pymunk works in float64; Box2D stores float32, so its
 values carry ~1e-7 relative rounding per step (``FLOAT``). Both integrate with semi-implicit
@@ -9,7 +10,6 @@ Euler, whose positions under constant acceleration ``a`` lag the continuous solu
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import ClassVar
 
 import numpy as np
@@ -30,25 +30,10 @@ from physbench.scene import (
     StaticPolygon,
 )
 from physbench.scenes.bin import bin_walls
-from physbench.simulators.box2d_sim import Box2DSimulator
-from physbench.simulators.divergence import Comparison, compare
-from physbench.simulators.pymunk_sim import PymunkSimulator
 from physbench.simulators.stepping import SteppingSimulator
 from physbench.trajectory import Trajectory
 
 G = 9.81
-ENGINES = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}
-#: Absolute tolerance for values of order 1-10 after a few hundred steps, per engine.
-FLOAT = {"pymunk": 1e-9, "box2d": 1e-4}
-
-
-@pytest.fixture(params=sorted(ENGINES))
-def sim(request: pytest.FixtureRequest) -> SteppingSimulator:
-    return ENGINES[request.param]()
-
-
-def _tol(sim: SteppingSimulator) -> float:
-    return FLOAT[sim.name]
 
 
 def _period(t: np.ndarray, x: np.ndarray) -> float:
@@ -59,11 +44,10 @@ def _period(t: np.ndarray, x: np.ndarray) -> float:
     return float(2 * np.mean(np.diff(tz)))
 
 
-# --------------------------------------------------------------------------- free motion
-
-
 @pytest.mark.parametrize("v0", [(0.0, 0.0), (3.0, 7.0)], ids=["free_fall", "projectile"])
-def test_ballistic_motion_matches_analytic(sim: SteppingSimulator, v0: tuple[float, float]) -> None:
+def test_ballistic_motion_matches_analytic(
+    sim: SteppingSimulator, tol: float, v0: tuple[float, float]
+) -> None:
     scene = Scene(
         "ballistic",
         (Body("b", Circle(0.1), (1.0, 15.0), velocity=v0),),
@@ -78,7 +62,7 @@ def test_ballistic_motion_matches_analytic(sim: SteppingSimulator, v0: tuple[flo
     x = 1.0 + v0[0] * t
     y_exact = 15.0 + v0[1] * t - G * t**2 / 2
     y_euler = y_exact - G * h * t / 2  # semi-implicit Euler's known O(h) lag
-    tol = _tol(sim)
+    tol = tol
     np.testing.assert_allclose(s[:, 0], x, atol=tol)
     np.testing.assert_allclose(s[:, 1], y_euler, atol=tol)
     np.testing.assert_allclose(s[:, 3], v0[0], atol=tol)
@@ -131,16 +115,13 @@ def test_angle_is_ccw_and_velocities_match_finite_differences(sim: SteppingSimul
     assert corner[1] > 0.19 and abs(corner[0]) < 0.02
 
 
-# --------------------------------------------------------------------------- collisions
-
-
 @pytest.mark.parametrize(
     ("m1", "m2", "e1", "e2"),
     [(1.0, 3.0, 1.0, 1.0), (2.0, 0.5, 1.0, 1.0), (1.0, 3.0, 0.8, 0.5)],
     ids=["elastic_light_heavy", "elastic_heavy_light", "restitution_product"],
 )
 def test_head_on_collision(
-    sim: SteppingSimulator, m1: float, m2: float, e1: float, e2: float
+    sim: SteppingSimulator, tol: float, m1: float, m2: float, e1: float, e2: float
 ) -> None:
     u1, u2 = 2.0, -1.0
     scene = Scene(
@@ -154,7 +135,7 @@ def test_head_on_collision(
     )
     s = sim.simulate(scene).states
     p = m1 * s[:, 0, 3:5] + m2 * s[:, 1, 3:5]
-    np.testing.assert_allclose(p, p[[0]].repeat(len(p), 0), atol=_tol(sim))  # momentum
+    np.testing.assert_allclose(p, p[[0]].repeat(len(p), 0), atol=tol)  # momentum
     e = e1 * e2  # physbench's mixing rule: the product
     v1 = (m1 * u1 + m2 * u2 - m2 * e * (u1 - u2)) / (m1 + m2)
     v2 = (m1 * u1 + m2 * u2 + m1 * e * (u1 - u2)) / (m1 + m2)
@@ -193,27 +174,6 @@ def test_bounce_restitution_is_product(sim: SteppingSimulator, floor_kind: str) 
     assert 0 < i < j
     ratio = (s[j, 1] - r) / drop
     assert ratio == pytest.approx(0.4**2, abs=0.008)
-
-
-def test_box2d_velocity_threshold_is_documented_divergence() -> None:
-    """Box2D treats impacts below 1 m/s as inelastic (compiled-in ``b2_velocityThreshold``); pymunk
-    bounces at any speed unless asked to mimic it. docs/engines.md describes this."""
-    drop = 0.03  # impact at 0.77 m/s
-    scene = Scene(
-        "slow_bounce",
-        (Body("ball", Circle(0.1), (2.0, 0.1 + drop), elasticity=1.0),),
-        statics=(Segment((0.0, 0.0), (4.0, 0.0), elasticity=1.0),),
-        fps=120,
-        frames=40,
-        substeps=5,
-    )
-    rise = {name: ENGINES[name]().simulate(scene).body("ball")[:, 4].max() for name in ENGINES}
-    assert rise["pymunk"] > 0.6  # bounced back at ~e · 0.77 m/s
-    assert rise["box2d"] < 0.01  # stuck to the floor
-    mimic = PymunkSimulator(velocity_threshold=1.0)
-    assert mimic.simulate(scene).body("ball")[:, 4].max() < 0.01
-    fast = replace(scene, bodies=(replace(scene.bodies[0], position=(2.0, 0.4)),))  # 2.4 m/s
-    assert mimic.simulate(fast).body("ball")[:, 4].max() > 2.0  # faster impacts still bounce
 
 
 @pytest.mark.parametrize("floor_kind", ["segment", "polygon"])
@@ -280,25 +240,6 @@ def test_resting_contact_has_no_skin(sim: SteppingSimulator) -> None:
     assert s[:, 1] == pytest.approx([0.1, 0.1, 0.3, 0.1], abs=2e-3)
 
 
-def test_fast_bodies_and_ccd() -> None:
-    """Box2D (bullets, continuous collision) keeps a 40 m/s box inside the bin; pymunk has no
-    continuous collision and lets it tunnel through the wall — reported as an explosion."""
-    scene = Scene(
-        "fast",
-        (Body("b", Box(0.1, 0.1), (2.0, 2.0), velocity=(40.0, 0.0), elasticity=1.0),),
-        gravity=(0.0, 0.0),
-        statics=bin_walls((0.0, 0.0, 4.0, 4.0)),
-        frames=11,
-    )
-    s = Box2DSimulator().simulate(scene).body("b")
-    assert s[-1, 3] == pytest.approx(-40.0, rel=1e-4) and 0 < s[-1, 0] < 4
-    with pytest.raises(SimulationError, match="left the world"):
-        PymunkSimulator().simulate(scene)
-
-
-# --------------------------------------------------------------------------- joints and mass
-
-
 def test_pendulum_small_angle_period(sim: SteppingSimulator) -> None:
     """Bob of radius 1 cm on a 1 m pivot, 0.05 rad amplitude. The exact physical-pendulum period
     differs from 2π√(L/g) by the amplitude factor 1 + θ₀²/16 (1.6e-4) and √(I_pivot / m L²)
@@ -355,9 +296,6 @@ def test_pivot_joint_between_bodies(sim: SteppingSimulator) -> None:
     assert np.hypot(*(end - s[:, 1, 0:2]).T).max() < 3e-3
     assert s[:, 1, 1].min() < 2.2  # it really swung
     assert np.ptp(s[:, 1, 2]) < 1e-6  # a pivot lets the ball keep its own (zero) rotation
-
-
-# --------------------------------------------------------------------------- forces
 
 
 @pytest.mark.parametrize(("t0", "t1"), [(0.1, 0.2), (0.1037, 0.2511), (0.0, 0.0004), (0.95, 1.2)])
@@ -423,9 +361,6 @@ def test_effects_apply_force_and_torque(sim: SteppingSimulator) -> None:
         sim.simulate(scene, effects=[_Broken()])
 
 
-# --------------------------------------------------------------------------- failures
-
-
 def _assert_names(err: SimulationError, sim: SteppingSimulator, body: str) -> None:
     assert err.engine == sim.name and err.body == body and isinstance(err.frame, int)
     assert f"[{sim.name}]" in str(err) and repr(body) in str(err)
@@ -479,116 +414,17 @@ def test_nan_impulse_raises(sim: SteppingSimulator) -> None:
     _assert_names(info.value, sim, "b")
 
 
-def test_box2d_polygon_vertex_limit_raises() -> None:
-    pts = tuple(
-        (0.2 * math.cos(2 * math.pi * i / 20), 0.2 * math.sin(2 * math.pi * i / 20))
-        for i in range(20)
-    )
-    scene = Scene("many", (Body("poly", Polygon(pts), (2.0, 2.0)),))
-    assert PymunkSimulator().simulate(scene).frames == 30
-    with pytest.raises(SimulationError, match="b2_maxPolygonVertices") as info:
-        Box2DSimulator().simulate(scene)
-    assert info.value.body == "poly" and info.value.frame == 0
-
-
-# --------------------------------------------------------------------------- determinism
-
-
-def _busy_scene() -> Scene:
-    bodies = (
-        Body("a", Circle(0.3), (1.0, 2.5), velocity=(3.0, 0.0), elasticity=0.7, friction=0.4),
-        Body("b", Box(0.5, 0.4), (2.0, 0.3), angle=0.1, mass=2.0, elasticity=0.3),
-        Body(
-            "c",
-            Polygon(((-0.2, -0.2), (0.3, -0.2), (0.0, 0.3))),
-            (3.0, 1.0),
-            com_offset=(0.05, 0.0),
-        ),
-    )
-    return Scene(
-        "busy",
-        bodies,
-        statics=bin_walls((0.0, 0.0, 4.0, 4.0)),
-        forces=(Force("a", (50.0, -30.0), 0.0, 0.2),),
-        frames=90,
-    )
-
-
-def test_deterministic(sim: SteppingSimulator) -> None:
-    scene = _busy_scene()
+def test_deterministic(sim: SteppingSimulator, busy_scene: Scene) -> None:
+    scene = busy_scene
     first, second = sim.simulate(scene), type(sim)().simulate(scene)
     assert first.states.tobytes() == second.states.tobytes()
     assert np.ptp(first.states[:, :, 0], axis=0).min() > 0.01  # something happened
 
 
-def test_pymunk_batch_read_matches_per_body_read(monkeypatch: pytest.MonkeyPatch) -> None:
-    """pymunk's experimental batch reader is a pure speed-up: without it, the same trajectory."""
-    import physbench.simulators.pymunk_sim as pymunk_sim
-
-    scene = _busy_scene()
-    world = PymunkSimulator().build(scene)
-    assert world._batch is not None  # in use with the pinned pymunk 7
-    fast = PymunkSimulator().simulate(scene)
-    monkeypatch.setattr(pymunk_sim._BatchReader, "for_world", classmethod(lambda cls, w: None))
-    assert PymunkSimulator().build(scene)._batch is None
-    slow = PymunkSimulator().simulate(scene)
-    assert fast.states.tobytes() == slow.states.tobytes()
-
-
-def test_params_are_applied(sim: SteppingSimulator) -> None:
-    scene = _busy_scene()
+def test_params_are_applied(sim: SteppingSimulator, busy_scene: Scene) -> None:
+    scene = busy_scene
     base = sim.simulate(scene)
     heavy = sim.simulate(scene, {"b.mass": 8.0})
     assert isinstance(heavy, Trajectory)
     assert not np.array_equal(base.states, heavy.states)
     assert np.array_equal(heavy.states, sim.simulate(scene.with_params({"b.mass": 8.0})).states)
-
-
-# --------------------------------------------------------------------------- paper scenes
-
-
-#: Per scene, limits on the final-position difference per body between engines (m) over seeds
-#: 0-9: (mean, max). About 2x the mean and 1.4x the max measured by
-#: benchmarks/engine_divergence.py (docs/engines.md). Before the step-order and skin fixes
-#: three_circles measured mean 0.025, max 0.055 and failed them (and one stacked_boxes seed's
-#: outcome differed).
-PAPER_LIMITS = {
-    "three_circles": (0.02, 0.04),
-    "second_order": (0.035, 0.11),
-    "stacked_boxes": (0.09, 0.5),
-    "bouncing_balls": (0.15, 0.3),
-}
-#: Seeds (of 10) allowed a different qualitative outcome: only the chaotic pool table, where a 1 mm
-#: shift of the start already changes one seed's outcome within Box2D.
-ALLOWED_MISSES = {"bouncing_balls": 1}
-
-
-def _paper_rows(name: str, **kwargs: float) -> list[Comparison]:
-    rows = [c for seed in range(10) if (c := compare(name, seed, **kwargs)) is not None]
-    if not rows:
-        pytest.skip(f"scene {name} not available")
-    return rows
-
-
-@pytest.mark.parametrize("name", sorted(PAPER_LIMITS))
-def test_paper_scenes_agree_between_engines(name: str) -> None:
-    """Same parameters, both engines: same bodies move and no two bodies swap sides, and final
-    positions within the measured divergence."""
-    rows = _paper_rows(name)
-    misses = [c.seed for c in rows if not c.same]
-    assert len(misses) <= ALLOWED_MISSES.get(name, 0), misses
-    final = np.concatenate([c.final_diff for c in rows])
-    mean_limit, max_limit = PAPER_LIMITS[name]
-    assert final.mean() <= mean_limit
-    assert final.max() <= max_limit
-
-
-def test_second_order_agrees_closely_once_the_velocity_threshold_matches() -> None:
-    """second_order is not chaotic (1 mm at the start moves the end < 1 cm); with Box2D's 1 m/s
-    restitution threshold mimicked in pymunk the engines agree to 0.3 cm mean, 1.8 cm max
-    (measured), so anything systematic (step order, skin, mixing) shows here."""
-    rows = _paper_rows("second_order", velocity_threshold=1.0)
-    assert all(c.same for c in rows)
-    final = np.concatenate([c.final_diff for c in rows])
-    assert final.mean() <= 0.008
-    assert final.max() <= 0.03
