@@ -1,12 +1,15 @@
 """Shared fixtures: a third-party renderer registered the way a user would, through
-``PHYSBENCH_PLUGINS`` (a module on ``sys.path``, no packaging)."""
+``PHYSBENCH_PLUGINS`` (a module on ``sys.path``, no packaging), and a fresh interpreter that says
+which heavy modules an import pulls in."""
 
 from __future__ import annotations
 
 import importlib
+import json
+import subprocess
 import sys
 import textwrap
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 import pytest
@@ -42,7 +45,9 @@ class Squares(Renderer):
             cols = ((traj.states[:, i, 0] - xmin) / (xmax - xmin) * w).astype(int)
             rows = ((ymax - traj.states[:, i, 1]) / (ymax - ymin) * h).astype(int)
             for t, (r, c) in enumerate(zip(rows, cols)):
-                frames[t, ch, max(r, 0) : max(r + self.size, 0), max(c, 0) : max(c + self.size, 0)] = 1
+                rows_t = slice(max(r, 0), max(r + self.size, 0))
+                cols_t = slice(max(c, 0), max(c + self.size, 0))
+                frames[t, ch, rows_t, cols_t] = 1
         if out is not None:
             out[...] = frames
             return out
@@ -67,3 +72,26 @@ def squares_renderer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterato
     yield importlib.import_module("pb_squares")
     reset_registry()
     sys.modules.pop("pb_squares", None)
+
+
+#: The optional libraries a plain import must not pull in (the optimisers are imported when a run
+#: starts, pandas and matplotlib when a table or a figure is made).
+HEAVY = ("hyperopt", "nevergrad", "optuna", "pandas", "matplotlib", "scipy")
+
+
+@pytest.fixture
+def heavy_imports() -> Callable[..., list[str]]:
+    """``heavy_imports(*modules, heavy=HEAVY)``: the names in ``heavy`` that a fresh interpreter
+    has imported after importing ``modules``."""
+
+    def check(*modules: str, heavy: Sequence[str] = HEAVY) -> list[str]:
+        code = (
+            f"import sys\nimport {', '.join(modules)}\n"
+            f"print(__import__('json').dumps([m for m in {list(heavy)!r} if m in sys.modules]))"
+        )
+        out = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, check=True
+        )
+        return list(json.loads(out.stdout))
+
+    return check
