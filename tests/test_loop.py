@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
@@ -69,6 +70,10 @@ def _run(estimator, *, iterations: int = 6, params=("mass",), sim=None, obs=None
         iterations=iterations,
         seed=seed,
     )
+
+
+def test_importing_the_loop_imports_no_optimiser(heavy_imports: Callable[..., list[str]]) -> None:
+    assert heavy_imports("physbench.loop") == []
 
 
 def test_one_simulation_and_one_propose_per_iteration() -> None:

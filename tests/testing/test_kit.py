@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
 from physbench.effects import LinearDrag, VelocityDependentRestitution
@@ -94,3 +96,8 @@ def test_a_class_outside_the_contract_is_named() -> None:
     ):
         with pytest.raises(ConformanceError, match=f"does not subclass {base}"):
             check(dict)
+
+
+def test_importing_the_kits_imports_no_optimiser(heavy_imports: Callable[..., list[str]]) -> None:
+    # the kits run every built-in estimator: each imports its library when a run starts
+    assert heavy_imports("physbench.testing") == []
