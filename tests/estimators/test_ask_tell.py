@@ -42,8 +42,8 @@ def _task(initial: dict[str, float]) -> Task:
     return Task(t.scene, t.space, t.observation.frames, initial, t.renderer, iterations=3)
 
 
-def _step(loss: object) -> Step:
-    return Step(iteration=0, params={}, frames=np.zeros((1, 2, 4, 4)), loss=loss)  # type: ignore[arg-type]
+def _step(loss: float) -> Step:
+    return Step(iteration=0, params={}, frames=np.zeros((1, 2, 4, 4)), loss=loss)
 
 
 def test_start_maps_the_initial_guess_to_the_unit_cube_and_passes_the_seed() -> None:
@@ -59,7 +59,8 @@ def test_start_maps_the_initial_guess_to_the_unit_cube_and_passes_the_seed() -> 
 def test_propose_tells_the_loss_then_returns_the_point_asked() -> None:
     est = Scripted([0.5, 0.25], [0.0, 1.0])
     est.start(_task({"a.mass": 1.0, "b.mass": 1.0}), seed=0)
-    assert est.propose(_step(np.float32(0.25))) == {"a.mass": 5.5, "b.mass": 3.25}
+    step = _step(np.float32(0.25))  # type: ignore[arg-type]
+    assert est.propose(step) == {"a.mass": 5.5, "b.mass": 3.25}
     assert est.propose(_step(0.125)) == {"a.mass": 1.0, "b.mass": 10.0}
     assert est.told == [0.25, 0.125] and all(type(v) is float for v in est.told)
 

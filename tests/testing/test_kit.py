@@ -13,7 +13,6 @@ from physbench.simulators.pymunk_sim import PymunkSimulator
 from physbench.testing import (
     ConformanceError,
     Subject,
-    ToySimulator,
     checks_for,
     parametrize_with_checks,
 )
@@ -74,16 +73,6 @@ def test_mistakes_in_the_subject_are_named() -> None:
         parametrize_with_checks([Subject(RasterRenderer, expected_failures={"check_typo": "x"})])
     with pytest.raises(ConformanceError, match="subclasses none of the component base classes"):
         checks_for(int)
-
-
-def test_the_toy_simulator_is_a_simulator_but_not_physics() -> None:
-    # The closed-form stand-in of the estimator kit is typed as a Simulator, and the simulator
-    # kit says plainly why it is not an engine.
-    from physbench.testing.simulators import check_free_fall
-
-    assert checks_for(ToySimulator)[0].name == "check_protocol"
-    with pytest.raises(ConformanceError, match="free fall"):
-        check_free_fall(ToySimulator)
 
 
 def test_a_class_outside_the_contract_is_named() -> None:
