@@ -1,13 +1,20 @@
-"""Shared fixtures: a third-party renderer registered the way a user would, through
-``PHYSBENCH_PLUGINS`` (a module on ``sys.path``, no packaging)."""
+"""Shared fixtures of tests in several folders: throwaway plugins registered the way a third party
+registers a module without packaging it (through ``PHYSBENCH_PLUGINS``), a small sweep to compare
+against, and a fresh interpreter that says which heavy modules an import pulls in."""
 
 from __future__ import annotations
 
 import importlib
+import json
+import shutil
+import subprocess
 import sys
 import textwrap
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
+from typing import Any
 
 import pytest
 
@@ -42,7 +49,9 @@ class Squares(Renderer):
             cols = ((traj.states[:, i, 0] - xmin) / (xmax - xmin) * w).astype(int)
             rows = ((ymax - traj.states[:, i, 1]) / (ymax - ymin) * h).astype(int)
             for t, (r, c) in enumerate(zip(rows, cols)):
-                frames[t, ch, max(r, 0) : max(r + self.size, 0), max(c, 0) : max(c + self.size, 0)] = 1
+                rows_t = slice(max(r, 0), max(r + self.size, 0))
+                cols_t = slice(max(c, 0), max(c + self.size, 0))
+                frames[t, ch, rows_t, cols_t] = 1
         if out is not None:
             out[...] = frames
             return out
@@ -55,15 +64,223 @@ def register_renderers():
 """
 
 
+#: A renderer that is not the default one: every body a 3x3 block at its centre, channel 1 the
+#: focus body (``mark``), the block's value ``gain``. ``CALLS`` counts renders.
+TOY_RENDERER = """
+import numpy as np
+from typing import ClassVar
+
+from physbench.hookspecs import hookimpl
+from physbench.render.base import Renderer, RenderError
+
+CALLS = 0
+
+
+class Blocks(Renderer):
+    name: ClassVar[str] = "blocks"
+    modes: ClassVar[tuple[str, ...]] = ("mark",)
+
+    def __init__(self, resolution=64, mode="mark", gain=1.0):
+        super().__init__(resolution, mode)
+        if not 0 < gain <= 1:
+            raise RenderError(f"gain = {gain!r}: expected a number in (0, 1]")
+        self.gain = gain
+
+    def render(self, scene, traj, *, focus=None, out=None):
+        global CALLS
+        CALLS += 1
+        w = self.resolution if isinstance(self.resolution, int) else self.resolution[1]
+        h = w if isinstance(self.resolution, int) else self.resolution[0]
+        x0, y0, x1, y1 = scene.bounds
+        frames = np.zeros((traj.frames, 2, h, w), np.float32)
+        for i, name in enumerate(traj.bodies):
+            ch = 1 if name == focus else 0
+            px = np.clip(((traj.states[:, i, 0] - x0) / (x1 - x0) * w).astype(int), 1, w - 2)
+            py = np.clip(((y1 - traj.states[:, i, 1]) / (y1 - y0) * h).astype(int), 1, h - 2)
+            for t in range(traj.frames):
+                frames[t, ch, py[t] - 1 : py[t] + 2, px[t] - 1 : px[t] + 2] = self.gain
+        if out is not None:
+            out[...] = frames
+            return out
+        return frames
+
+
+@hookimpl
+def register_renderers():
+    return [Blocks]
+"""
+
+#: A scene whose generator reads the module constant ``FRAMES`` (change it to change the scene)
+#: and counts its calls, and an estimator whose default ``step`` is the module constant ``STEP``.
+TOY_SCENE_AND_ESTIMATOR = """
+import dataclasses
+from typing import ClassVar
+
+import numpy as np
+
+from physbench.estimators.base import CorrectionEstimator
+from physbench.hookspecs import hookimpl
+from physbench.scenes import second_order
+from physbench.scenes.generator import scene_generator
+
+FRAMES = 8
+STEP = 0.5
+GENERATED = 0
+
+
+@scene_generator("toy_scene", "second_order, shortened to FRAMES frames")
+def generate(seed=0):
+    global GENERATED
+    GENERATED += 1
+    return dataclasses.replace(second_order.generate(seed), name="toy_scene", frames=FRAMES)
+
+
+class Toy(CorrectionEstimator):
+    name: ClassVar[str] = "toy"
+
+    def __init__(self, step=None):
+        self.options = {"step": STEP if step is None else step}
+
+    def start(self, task, *, seed):
+        self.space, self.rng = task.space, np.random.default_rng(seed)
+
+    def propose(self, step):
+        u = self.rng.random(len(self.space)) * self.options["step"]
+        return self.space.from_unit(u)
+
+
+@hookimpl
+def register_scenes():
+    return [generate]
+
+
+@hookimpl
+def register_estimators():
+    return [Toy]
+"""
+
+
 @pytest.fixture
-def squares_renderer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[object]:
-    """Registers the ``squares`` renderer through ``PHYSBENCH_PLUGINS``; yields its module (whose
-    ``CALLS`` list records every render call)."""
-    (tmp_path / "pb_squares.py").write_text(textwrap.dedent(SQUARES))
-    monkeypatch.syspath_prepend(str(tmp_path))
-    monkeypatch.setenv("PHYSBENCH_PLUGINS", "pb_squares")
-    importlib.invalidate_caches()
+def plugin(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Callable[..., ModuleType]]:
+    """``plugin(name, source, ...)``: write each module into ``tmp_path``, register them all
+    through ``PHYSBENCH_PLUGINS`` and rebuild the registry; returns the (last) imported module.
+    Everything is undone afterwards."""
+    folder = tmp_path / "plugins"
+    folder.mkdir()
+    monkeypatch.syspath_prepend(str(folder))
+    names: list[str] = []
+
+    def register(name: str, source: str) -> ModuleType:
+        (folder / f"{name}.py").write_text(textwrap.dedent(source))
+        names.append(name)
+        monkeypatch.setenv("PHYSBENCH_PLUGINS", ",".join(names))
+        importlib.invalidate_caches()
+        reset_registry()
+        return importlib.import_module(name)
+
+    yield register
     reset_registry()
-    yield importlib.import_module("pb_squares")
-    reset_registry()
-    sys.modules.pop("pb_squares", None)
+    for name in names:
+        sys.modules.pop(name, None)
+
+
+@pytest.fixture
+def blocks(plugin: Callable[..., ModuleType]) -> ModuleType:
+    """The registered toy renderer ``blocks``'s module (``blocks.CALLS`` counts its renders)."""
+    return plugin("toy_blocks", TOY_RENDERER)
+
+
+@pytest.fixture
+def toy(plugin: Callable[..., ModuleType]) -> ModuleType:
+    """The module registering the scene ``toy_scene`` and the estimator ``toy``; set its
+    ``FRAMES`` or ``STEP`` to change the scene or the estimator's default."""
+    return plugin("toy_scene_estimator", TOY_SCENE_AND_ESTIMATOR)
+
+
+@pytest.fixture
+def squares_renderer(plugin: Callable[..., ModuleType]) -> ModuleType:
+    """Registers the ``squares`` renderer as the module ``pb_squares``; its ``CALLS`` list records
+    every render call."""
+    return plugin("pb_squares", SQUARES)
+
+
+#: A sweep small enough for a test and with enough seeds for ``compare``: the one-sided
+#: signed-rank test needs >= 5 seeds to reach p < 0.05.
+COMPARE_SPEC: dict[str, Any] = {
+    "name": "cmp",
+    "estimators": ["random", {"name": "optuna", "options": {"sampler": "random"}}],
+    "seeds": 8,
+    "iterations": 2,
+    "resolution": 16,
+    "scenes": [{"name": "three_circles", "unknowns": ["mass"]}],
+}
+
+
+@dataclass(frozen=True)
+class CompareSweep:
+    """:data:`COMPARE_SPEC` run once (``baseline``, an output folder), and edited copies of it."""
+
+    spec: dict[str, Any]
+    baseline: Path
+
+    def variant(self, tmp_path: Path, change: str) -> Path:
+        """A copy of the baseline folder in ``tmp_path / change`` whose ``random`` cells are
+        ``"regressed"`` (every seed 3x worse), ``"one_seed"`` (seed 0 100x worse: real, but not
+        significant on its own), ``"improved"`` (3x better) or ``"failing"`` (seed 3 failed)."""
+        import pandas as pd
+
+        from physbench.bench.runner import write_table
+
+        new = tmp_path / change
+        shutil.copytree(self.baseline, new)
+        df = pd.read_parquet(new / "results.parquet")
+        sel = df["estimator"] == "random"
+        if change == "regressed":
+            df.loc[sel, "best_nmse"] *= 3
+        elif change == "one_seed":
+            df.loc[sel & (df["seed"] == 0), "best_nmse"] *= 100
+        elif change == "improved":
+            df.loc[sel, "best_nmse"] /= 3
+        elif change == "failing":
+            last = df.index[sel & (df["seed"] == 3)]
+            df.loc[last, "status"] = "failed"
+        else:
+            raise ValueError(
+                f"change = {change!r}: expected regressed, one_seed, improved, failing"
+            )
+        write_table(df, new)
+        return new
+
+
+@pytest.fixture(scope="session")
+def compare_sweep(tmp_path_factory: pytest.TempPathFactory) -> CompareSweep:
+    """The baseline sweep of the ``compare`` tests, run once per session."""
+    from physbench.bench.runner import run_sweep
+    from physbench.bench.spec import parse_spec
+
+    out = tmp_path_factory.mktemp("baseline")
+    run_sweep(parse_spec(COMPARE_SPEC), out, executor="serial", progress=False)
+    return CompareSweep(COMPARE_SPEC, out)
+
+
+#: The optional libraries a plain import must not pull in (the optimisers are imported when a run
+#: starts, pandas and matplotlib when a table or a figure is made).
+HEAVY = ("hyperopt", "nevergrad", "optuna", "pandas", "matplotlib", "scipy")
+
+
+@pytest.fixture
+def heavy_imports() -> Callable[..., list[str]]:
+    """``heavy_imports(*modules, then="", heavy=HEAVY)``: the names in ``heavy`` that a fresh
+    interpreter has imported after importing ``modules`` and running the statement ``then``."""
+
+    def check(*modules: str, then: str = "", heavy: Sequence[str] = HEAVY) -> list[str]:
+        code = (
+            f"import sys\nimport {', '.join(modules)}\n{then}\n"
+            f"print(__import__('json').dumps([m for m in {list(heavy)!r} if m in sys.modules]))"
+        )
+        out = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, check=True
+        )
+        return list(json.loads(out.stdout))
+
+    return check

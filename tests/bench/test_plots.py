@@ -1,6 +1,6 @@
-"""``physbench plot DIR``: the figures (Figs. 3, 4, 5 and the win rate) and the self-contained
-report; the landscape draws with the table's renderer, and tables from before renderer columns
-plot."""
+"""The sweep figures: win rates count ties as half, the landscape is zero at the nominal value and
+draws with the table's renderer, and tables from before renderer columns plot (``physbench plot``
+itself: tests/commands/test_plot.py)."""
 
 from __future__ import annotations
 
@@ -15,44 +15,7 @@ from physbench.bench.plots import landscape, landscape_data, plot_all
 from physbench.bench.runner import run_sweep
 from physbench.bench.spec import parse_spec
 from physbench.bench.tables import final_rows, win_rate_table
-from physbench.cli import main
 from physbench.render.base import DEFAULT_RENDERER
-
-PNG = b"\x89PNG\r\n\x1a\n"
-
-
-def test_plot_command_writes_figures_and_report(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    spec = parse_spec(
-        {
-            "name": "plots",
-            "estimators": ["random", "optuna"],
-            "seeds": 2,
-            "iterations": 3,
-            "resolution": 16,
-            "scenes": [{"name": "three_circles", "unknowns": ["mass", "mass+elasticity"]}],
-        }
-    )
-    run_sweep(spec, tmp_path, executor="serial", progress=False)
-    assert main(["plot", str(tmp_path), "--landscape-seeds", "1"]) == 0
-    assert capsys.readouterr().out.startswith("4 figures in ")
-    names = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
-    assert names == [
-        "convergence_three_circles.png",
-        "landscape_three_circles.png",
-        "trajectories_three_circles_mass.png",
-        "win_rate.png",
-    ]
-    for name in names:
-        data = (tmp_path / "plots" / name).read_bytes()
-        assert data.startswith(PNG) and len(data) < 200_000
-    page = (tmp_path / "report.html").read_text()
-    assert page.count("data:image/png;base64,") == 4 and "<h2>Table 1 layout</h2>" in page
-    assert "(2.6 ± 0.9)e-03" in page and "Win rate" in page and 'src="http' not in page
-    assert pd.read_csv(tmp_path / "win_rate.csv", index_col=0).shape == (2, 2)
-    assert main(["plot", str(tmp_path / "missing")]) == 2
-    assert "no results.parquet there" in capsys.readouterr().err
 
 
 def test_win_rate_counts_ties_as_half() -> None:

@@ -1,5 +1,6 @@
-"""``physbench bench``: the long table, summaries, failed cells, resume-by-skipping, identical
-tables from every executor, and the renderer of a spec or of ``--renderer`` really drawing."""
+"""Running a sweep: the long table, summaries, failed cells, resume-by-skipping, identical tables
+from every executor, and the renderer of a spec really drawing (``physbench bench`` itself:
+tests/commands/test_bench.py)."""
 
 from __future__ import annotations
 
@@ -16,7 +17,6 @@ import pytest
 from physbench.bench.runner import run_sweep
 from physbench.bench.spec import parse_spec
 from physbench.bench.tables import SCHEMA, TIMINGS, bootstrap_ci, without_timings
-from physbench.cli import main
 from physbench.errors import PhysbenchError
 from physbench.estimators.base import CorrectionEstimator
 from physbench.hookspecs import hookimpl
@@ -149,40 +149,7 @@ def test_executors_give_identical_tables(tmp_path: Path) -> None:
         pd.testing.assert_frame_equal(without_timings(on_disk), base, check_exact=True)
 
 
-def test_cli_prints_table_and_final_line(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    spec = tmp_path / "s.toml"
-    spec.write_text(
-        'name = "cli"\nestimators = ["random"]\nseeds = 2\niterations = 2\nresolution = 16\n'
-        '[[scenes]]\nname = "second_order"\nunknowns = ["elasticity"]\n'
-    )
-    assert main(["bench", str(spec), "--out", str(tmp_path / "o"), "--executor", "serial"]) == 0
-    out = capsys.readouterr().out
-    assert "| second order | paper NN | (4 ± 2)e-03 |" in out
-    assert out.splitlines()[-1].startswith("cli: 2 cells (2 run, 0 already done, 0 failed) in ")
-    assert (tmp_path / "o" / "spec.toml").read_text() == spec.read_text()
-    assert (
-        main(
-            [
-                "bench",
-                str(spec),
-                "--out",
-                str(tmp_path / "o"),
-                "--executor",
-                "serial",
-                "-q",
-                "--fresh",
-            ]
-        )
-        == 0
-    )
-    assert "(2 run, 0 already done" in capsys.readouterr().out
-
-
-def test_a_plugin_renderer_is_selected_by_spec_and_by_the_command_line(
-    tmp_path: Path, blocks: ModuleType, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_a_plugin_renderer_is_selected_by_the_spec(tmp_path: Path, blocks: ModuleType) -> None:
     small = {**TINY, "estimators": ["random"], "scenes": ["second_order"]}
     base = run_sweep(parse_spec(small), tmp_path / "default", executor="serial", progress=False)
     assert blocks.CALLS == 0 and (base.table["renderer"] == DEFAULT_RENDERER).all()
@@ -201,23 +168,6 @@ def test_a_plugin_renderer_is_selected_by_spec_and_by_the_command_line(
     assert not np.allclose(df["image_mse"], base.table["image_mse"])
     st = pd.read_csv(tmp_path / "blocks" / "stats.csv")
     assert st["renderer"].tolist() == ["blocks(gain=0.5)"]
-
-    toml = tmp_path / "s.toml"
-    toml.write_text(
-        'name = "cli"\nestimators = ["random"]\nseeds = 2\niterations = 3\nresolution = 32\n'
-        'scenes = ["second_order"]\n'
-    )
-    before = blocks.CALLS
-    argv = ["bench", str(toml), "--out", str(tmp_path / "cli"), "--executor", "serial", "-q"]
-    assert main([*argv, "--renderer", "blocks", "-R", "gain=0.5"]) == 0
-    renders = blocks.CALLS - before
-    assert renders == before  # as many renders as the spec's run
-    cli = pd.read_parquet(tmp_path / "cli" / "results.parquet")
-    pd.testing.assert_frame_equal(without_timings(cli), without_timings(df), check_exact=True)
-    capsys.readouterr()
-    assert main([*argv, "--renderer", "nope"]) == 2
-    err = capsys.readouterr().err
-    assert "--renderer = 'nope': unknown renderer 'nope'; known renderers: " in err, err
 
 
 def test_several_renderers_split_the_summary(tmp_path: Path, blocks: ModuleType) -> None:

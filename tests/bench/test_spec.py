@@ -1,16 +1,14 @@
-"""Sweep specs: expansion into cells (the renderer axis among them), seeds, and clear errors for
-bad specs and output folders."""
+"""Sweep specs: expansion into cells (the renderer axis among them), seeds, clear errors for bad
+specs, and the shipped specs (the output-folder errors of ``physbench bench``:
+tests/commands/test_bench.py)."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from physbench.bench.spec import RendererSpec, SpecError, load_spec, parse_spec, with_renderer
-from physbench.cli import main
 from physbench.render.base import DEFAULT_RENDERER
 
 GOOD = {
@@ -106,35 +104,6 @@ def test_missing_axis_and_duplicate_cells() -> None:
         parse_spec({**GOOD, "scenes": ["three_circles", "three_circles"]})
 
 
-def test_cli_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    spec = tmp_path / "s.toml"
-    spec.write_text(
-        'name = "s"\nestimators = ["random"]\nseeds = 1\niterations = 1\nresolution = 16\n'
-        'scenes = ["three_circles"]\n'
-    )
-    blocker = tmp_path / "file.txt"
-    blocker.write_text("")
-    cases = [
-        ([str(tmp_path / "missing.toml")], "spec file"),
-        (
-            [str(spec), "--executor", "serial", "--out", str(blocker / "sub")],
-            "cannot write results there",
-        ),
-        ([str(spec), "--executor", "serial", "--address", "tcp://x:1"], "needs --executor dask"),
-        ([str(spec), "--workers", "0"], "--workers 0: expected a whole number >= 1"),
-    ]
-    for argv, message in cases:
-        if "--out" not in argv:
-            argv = [*argv, "--out", str(tmp_path / "out")]
-        code = main(["bench", *argv])
-        err = capsys.readouterr().err
-        assert code == 2 and err.startswith("physbench bench: error: ") and message in err, err
-    bad = tmp_path / "bad.toml"
-    bad.write_text("seeds = [\n")
-    assert main(["bench", str(bad), "--out", str(tmp_path / "o")]) == 2
-    assert "not valid TOML" in capsys.readouterr().err
-
-
 def test_shipped_specs_load() -> None:
     root = Path(__file__).resolve().parents[2] / "benchmarks"
     t1 = load_spec(root / "table1.toml")
@@ -153,18 +122,6 @@ def test_shipped_specs_load() -> None:
     assert len(load_spec(root / "smoke.toml").seeds) >= 5  # the compare test needs >= 5 seeds
     gap = load_spec(root / "reality_gap.toml")
     assert any(c.config.engine != c.config.observe_engine for c in gap.cells())
-
-
-def test_argument_parsing_imports_nothing_heavy() -> None:
-    code = (
-        "import sys\nfrom physbench.cli import build_parser\n"
-        "for c in ('bench', 'plot', 'compare'):\n"
-        "    build_parser(c)\n"
-        "heavy = ('numpy', 'pandas', 'physbench.bench.runner', 'matplotlib')\n"
-        "print([m for m in heavy if m in sys.modules])"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]"
 
 
 @pytest.mark.usefixtures("blocks")

@@ -17,7 +17,6 @@ from physbench.bench.runner import run_sweep
 from physbench.bench.spec import parse_spec
 from physbench.bench.stamp import StaleCellsError, Stamper
 from physbench.bench.tables import without_timings
-from physbench.cli import main
 
 TOY = {
     "name": "toy",
@@ -55,38 +54,25 @@ def test_cells_are_stamped_once_per_scene_and_seed(tmp_path: Path, toy: ModuleTy
     assert toy.GENERATED == 3 and len({s["scene"] for s in stamps}) == 3
 
 
-def test_a_changed_scene_generator_is_refused_until_allowed(
-    tmp_path: Path, toy: ModuleType, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_a_changed_scene_generator_is_refused(tmp_path: Path, toy: ModuleType) -> None:
     first = _sweep(tmp_path)
     assert (_sweep(tmp_path).ran, first.ran) == (0, CELLS)  # unchanged: resumes silently
     toy.FRAMES = 9
-    argv = ["bench", str(tmp_path / "spec.toml"), "--out", str(tmp_path), "-q"]
-    (tmp_path / "spec.toml").write_text(
-        'name = "toy"\nestimators = ["toy", "random"]\nseeds = 3\niterations = 2\n'
-        'resolution = 16\n[[scenes]]\nname = "toy_scene"\nunknowns = ["mass", "elasticity"]\n'
-    )
     before = {p: p.stat().st_mtime_ns for p in (tmp_path / "cells").glob("*.json")}
-    assert main([*argv, "--executor", "serial"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith(
-        f"physbench bench: error: {tmp_path}: 12 of 12 finished cells were produced by other "
-        "code or settings than this run would use:\n"
+    with pytest.raises(StaleCellsError) as err:
+        _sweep(tmp_path)
+    assert str(err.value).startswith(
+        f"{tmp_path}: 12 of 12 finished cells were produced by other code or settings than this "
+        "run would use:\n"
         "  - scene toy_scene, seeds 0-2: the generated scene differs (its generator or scene "
         "file changed)\n"
         "Resuming would mix their results with new ones. Rerun with --allow-stale"
-    ), err
-    assert "--fresh to start over" in err and "estimator" not in err
+    ), str(err.value)
+    assert "estimator" not in str(err.value)
     # refused before anything ran or was written
     assert {p: p.stat().st_mtime_ns for p in (tmp_path / "cells").glob("*.json")} == before
-
-    assert main([*argv, "--executor", "serial", "--allow-stale"]) == 0
-    assert "(0 run, 12 already done, 0 failed)" in capsys.readouterr().out
-    log = json.loads((tmp_path / "run.json").read_text())
-    assert log["runs"][-1]["kept_stale"] == 12
-    assert main([*argv, "--executor", "serial", "--fresh"]) == 0
-    assert "(12 run, 0 already done" in capsys.readouterr().out
-    assert _sweep(tmp_path).ran == 0  # fresh cells carry the new stamp
+    kept = _sweep(tmp_path, allow_stale=True)
+    assert (kept.ran, kept.skipped) == (0, CELLS)
 
 
 def test_a_changed_estimator_default_is_refused(tmp_path: Path, toy: ModuleType) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
 from physbench.effects import LinearDrag, VelocityDependentRestitution
@@ -11,7 +13,6 @@ from physbench.simulators.pymunk_sim import PymunkSimulator
 from physbench.testing import (
     ConformanceError,
     Subject,
-    ToySimulator,
     checks_for,
     parametrize_with_checks,
 )
@@ -74,16 +75,6 @@ def test_mistakes_in_the_subject_are_named() -> None:
         checks_for(int)
 
 
-def test_the_toy_simulator_is_a_simulator_but_not_physics() -> None:
-    # The closed-form stand-in of the estimator kit is typed as a Simulator, and the simulator
-    # kit says plainly why it is not an engine.
-    from physbench.testing.simulators import check_free_fall
-
-    assert checks_for(ToySimulator)[0].name == "check_protocol"
-    with pytest.raises(ConformanceError, match="free fall"):
-        check_free_fall(ToySimulator)
-
-
 def test_a_class_outside_the_contract_is_named() -> None:
     from physbench.testing import check_effect, check_renderer, check_simulator
 
@@ -94,3 +85,8 @@ def test_a_class_outside_the_contract_is_named() -> None:
     ):
         with pytest.raises(ConformanceError, match=f"does not subclass {base}"):
             check(dict)
+
+
+def test_importing_the_kits_imports_no_optimiser(heavy_imports: Callable[..., list[str]]) -> None:
+    # the kits run every built-in estimator: each imports its library when a run starts
+    assert heavy_imports("physbench.testing") == []

@@ -1,0 +1,159 @@
+"""``physbench bench SPEC --out DIR``: the table and the final line, ``--fresh``, a plugin renderer
+chosen with ``--renderer``, stale cells refused until ``--allow-stale`` or ``--fresh``, clear errors
+for bad specs and output folders, and an interrupt that says how to resume."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from types import ModuleType
+
+import pandas as pd
+import pytest
+
+from physbench.bench.runner import run_sweep
+from physbench.bench.spec import parse_spec
+from physbench.bench.tables import without_timings
+from physbench.cli import main
+
+#: What building the parser must not import (the work happens in ``main``).
+PARSING_HEAVY = ("numpy", "pandas", "physbench.bench.runner", "matplotlib")
+
+
+def test_cli_prints_table_and_final_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "cli"\nestimators = ["random"]\nseeds = 2\niterations = 2\nresolution = 16\n'
+        '[[scenes]]\nname = "second_order"\nunknowns = ["elasticity"]\n'
+    )
+    argv = ["bench", str(spec), "--out", str(tmp_path / "o"), "--executor", "serial"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "| second order | paper NN | (4 ± 2)e-03 |" in out
+    assert out.splitlines()[-1].startswith("cli: 2 cells (2 run, 0 already done, 0 failed) in ")
+    assert (tmp_path / "o" / "spec.toml").read_text() == spec.read_text()
+    assert main([*argv, "-q", "--fresh"]) == 0
+    assert "(2 run, 0 already done" in capsys.readouterr().out
+
+
+def test_a_plugin_renderer_is_selected_on_the_command_line(
+    tmp_path: Path, blocks: ModuleType, capsys: pytest.CaptureFixture[str]
+) -> None:
+    small = {
+        "name": "tiny",
+        "estimators": ["random"],
+        "seeds": 2,
+        "iterations": 3,
+        "resolution": 32,
+        "scenes": ["second_order"],
+        "renderer": {"name": "blocks", "options": {"gain": 0.5}},
+    }
+    df = run_sweep(parse_spec(small), tmp_path / "spec", executor="serial", progress=False).table
+    toml = tmp_path / "s.toml"
+    toml.write_text(
+        'name = "cli"\nestimators = ["random"]\nseeds = 2\niterations = 3\nresolution = 32\n'
+        'scenes = ["second_order"]\n'
+    )
+    before = blocks.CALLS
+    argv = ["bench", str(toml), "--out", str(tmp_path / "cli"), "--executor", "serial", "-q"]
+    assert main([*argv, "--renderer", "blocks", "-R", "gain=0.5"]) == 0
+    renders = blocks.CALLS - before
+    assert renders == before  # as many renders as the spec's run
+    cli = pd.read_parquet(tmp_path / "cli" / "results.parquet")
+    pd.testing.assert_frame_equal(without_timings(cli), without_timings(df), check_exact=True)
+    capsys.readouterr()
+    assert main([*argv, "--renderer", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert "--renderer = 'nope': unknown renderer 'nope'; known renderers: " in err, err
+
+
+def test_a_changed_scene_generator_is_refused_until_allowed(
+    tmp_path: Path, toy: ModuleType, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["bench", str(tmp_path / "spec.toml"), "--out", str(tmp_path), "-q"]
+    (tmp_path / "spec.toml").write_text(
+        'name = "toy"\nestimators = ["toy", "random"]\nseeds = 3\niterations = 2\n'
+        'resolution = 16\n[[scenes]]\nname = "toy_scene"\nunknowns = ["mass", "elasticity"]\n'
+    )
+    assert main([*argv, "--executor", "serial"]) == 0
+    assert "(12 run, 0 already done, 0 failed)" in capsys.readouterr().out
+    assert main([*argv, "--executor", "serial"]) == 0  # unchanged: resumes silently
+    assert "(0 run, 12 already done, 0 failed)" in capsys.readouterr().out
+    toy.FRAMES = 9
+    before = {p: p.stat().st_mtime_ns for p in (tmp_path / "cells").glob("*.json")}
+    assert main([*argv, "--executor", "serial"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"physbench bench: error: {tmp_path}: 12 of 12 finished cells were produced by other "
+        "code or settings than this run would use:\n"
+        "  - scene toy_scene, seeds 0-2: the generated scene differs (its generator or scene "
+        "file changed)\n"
+        "Resuming would mix their results with new ones. Rerun with --allow-stale"
+    ), err
+    assert "--fresh to start over" in err and "estimator" not in err
+    # refused before anything ran or was written
+    assert {p: p.stat().st_mtime_ns for p in (tmp_path / "cells").glob("*.json")} == before
+
+    assert main([*argv, "--executor", "serial", "--allow-stale"]) == 0
+    assert "(0 run, 12 already done, 0 failed)" in capsys.readouterr().out
+    log = json.loads((tmp_path / "run.json").read_text())
+    assert log["runs"][-1]["kept_stale"] == 12
+    assert main([*argv, "--executor", "serial", "--fresh"]) == 0
+    assert "(12 run, 0 already done" in capsys.readouterr().out
+    assert main([*argv, "--executor", "serial"]) == 0  # fresh cells carry the new stamp
+    assert "(0 run, 12 already done, 0 failed)" in capsys.readouterr().out
+
+
+def test_cli_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "s"\nestimators = ["random"]\nseeds = 1\niterations = 1\nresolution = 16\n'
+        'scenes = ["three_circles"]\n'
+    )
+    blocker = tmp_path / "file.txt"
+    blocker.write_text("")
+    cases = [
+        ([str(tmp_path / "missing.toml")], "spec file"),
+        (
+            [str(spec), "--executor", "serial", "--out", str(blocker / "sub")],
+            "cannot write results there",
+        ),
+        ([str(spec), "--executor", "serial", "--address", "tcp://x:1"], "needs --executor dask"),
+        ([str(spec), "--workers", "0"], "--workers 0: expected a whole number >= 1"),
+    ]
+    for argv, message in cases:
+        if "--out" not in argv:
+            argv = [*argv, "--out", str(tmp_path / "out")]
+        code = main(["bench", *argv])
+        err = capsys.readouterr().err
+        assert code == 2 and err.startswith("physbench bench: error: ") and message in err, err
+    bad = tmp_path / "bad.toml"
+    bad.write_text("seeds = [\n")
+    assert main(["bench", str(bad), "--out", str(tmp_path / "o")]) == 2
+    assert "not valid TOML" in capsys.readouterr().err
+
+
+def test_an_interrupt_says_the_finished_cells_are_saved(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from physbench.bench import runner
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "run_sweep", interrupted)
+    spec = tmp_path / "s.toml"
+    spec.write_text('name = "s"\nestimators = ["random"]\nseeds = 1\nscenes = ["three_circles"]\n')
+    assert main(["bench", str(spec), "--out", str(tmp_path / "o"), "-q"]) == 130
+    assert capsys.readouterr().err == (
+        f"physbench bench: interrupted; finished cells are saved in {tmp_path / 'o'}: re-run the "
+        "same command to resume\n"
+    )
+
+
+def test_argument_parsing_imports_nothing_heavy(heavy_imports: Callable[..., list[str]]) -> None:
+    then = "physbench.cli.build_parser('bench')"
+    assert heavy_imports("physbench.cli", then=then, heavy=PARSING_HEAVY) == []

@@ -1,0 +1,82 @@
+"""``physbench plot DIR``: the figures (Figs. 3, 4, 5 and the win rate) and the self-contained
+report, and clear errors for bad counts, a missing or an empty table."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from physbench.bench.runner import run_sweep, write_table
+from physbench.bench.spec import parse_spec
+from physbench.bench.tables import SCHEMA
+from physbench.cli import main
+
+PNG = b"\x89PNG\r\n\x1a\n"
+#: What building the parser must not import (the work happens in ``main``).
+PARSING_HEAVY = ("numpy", "pandas", "physbench.bench.runner", "matplotlib")
+
+
+def test_plot_command_writes_figures_and_report(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = parse_spec(
+        {
+            "name": "plots",
+            "estimators": ["random", "optuna"],
+            "seeds": 2,
+            "iterations": 3,
+            "resolution": 16,
+            "scenes": [{"name": "three_circles", "unknowns": ["mass", "mass+elasticity"]}],
+        }
+    )
+    run_sweep(spec, tmp_path, executor="serial", progress=False)
+    assert main(["plot", str(tmp_path), "--landscape-seeds", "1"]) == 0
+    assert capsys.readouterr().out.startswith("4 figures in ")
+    names = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
+    assert names == [
+        "convergence_three_circles.png",
+        "landscape_three_circles.png",
+        "trajectories_three_circles_mass.png",
+        "win_rate.png",
+    ]
+    for name in names:
+        data = (tmp_path / "plots" / name).read_bytes()
+        assert data.startswith(PNG) and len(data) < 200_000
+    page = (tmp_path / "report.html").read_text()
+    assert page.count("data:image/png;base64,") == 4 and "<h2>Table 1 layout</h2>" in page
+    assert "(2.6 ± 0.9)e-03" in page and "Win rate" in page and 'src="http' not in page
+    assert pd.read_csv(tmp_path / "win_rate.csv", index_col=0).shape == (2, 2)
+    assert main(["plot", str(tmp_path / "missing")]) == 2
+    assert "no results.parquet there" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--seeds", "0"], "--seeds 0: expected a whole number >= 1"),
+        (["--landscape-seeds", "-1"], "--landscape-seeds -1: expected a whole number >= 0"),
+    ],
+)
+def test_bad_counts_are_refused_before_reading(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], message: str
+) -> None:
+    assert main(["plot", str(tmp_path / "missing"), *argv]) == 2
+    assert capsys.readouterr().err == f"physbench plot: error: {message}\n"
+
+
+def test_an_empty_table_says_to_run_the_sweep_first(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    write_table(pd.DataFrame({c: pd.Series(dtype=t) for c, t in SCHEMA.items()}), tmp_path)
+    assert main(["plot", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "the results table is empty; run `physbench bench SPEC --out" in err, err
+    assert not (tmp_path / "plots").exists() and not (tmp_path / "report.html").exists()
+
+
+def test_argument_parsing_imports_nothing_heavy(heavy_imports: Callable[..., list[str]]) -> None:
+    then = "physbench.cli.build_parser('plot')"
+    assert heavy_imports("physbench.cli", then=then, heavy=PARSING_HEAVY) == []
