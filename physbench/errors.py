@@ -9,6 +9,13 @@ class PhysbenchError(Exception):
     """Base class of every error physbench raises on purpose."""
 
 
+def plural(noun: str) -> str:
+    """``body`` -> ``bodies``, ``scene`` -> ``scenes`` (the nouns error messages use)."""
+    if noun.endswith("y") and noun[-2:-1] not in ("a", "e", "o", "u"):
+        return noun[:-1] + "ies"
+    return noun + ("es" if noun.endswith(("s", "x", "ch", "sh")) else "s")
+
+
 class UnknownNameError(PhysbenchError, KeyError):
     """A name (scene, engine, estimator, parameter, ...) that is not registered."""
 
@@ -16,7 +23,10 @@ class UnknownNameError(PhysbenchError, KeyError):
         self.kind, self.name, self.known = kind, name, sorted(known)
         listed = ", ".join(self.known) or "(none registered)"
         at = f" {where}" if where else ""
-        super().__init__(f"unknown {kind} {name!r}{at}; known {kind}s{at}: {listed}")
+        head, of, rest = kind.partition(" of ")  # "body of scene 'x'": the head noun is plural
+        words = head.split(" ")
+        many = " ".join([*words[:-1], plural(words[-1])]) + of + rest
+        super().__init__(f"unknown {kind} {name!r}{at}; known {many}{at}: {listed}")
 
     def __str__(self) -> str:  # KeyError would quote the whole message
         return str(self.args[0])

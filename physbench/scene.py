@@ -231,10 +231,10 @@ class Scene:
         from physbench.errors import UnknownNameError
 
         raise UnknownNameError(
-            "unknown parameter",
+            "parameter",
             key,
             [u.key for u in self.unknowns],
-            where=f"of scene {self.name!r}",
+            where=f"among the unknowns of scene {self.name!r}",
         )
 
     def with_params(self, params: Mapping[str, float]) -> Scene:

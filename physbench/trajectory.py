@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from physbench.errors import UnknownNameError
+
 #: Columns of :attr:`Trajectory.states`, in order.
 STATE_FIELDS = ("x", "y", "angle", "vx", "vy", "omega")
 
@@ -35,10 +37,14 @@ class Trajectory:
 
     def body(self, name: str) -> np.ndarray:
         """``(T, 6)`` state of one body."""
+        if name not in self.bodies:
+            raise UnknownNameError("body", name, self.bodies, where="of the trajectory")
         return self.states[:, self.bodies.index(name)]
 
     def field(self, name: str) -> np.ndarray:
         """``(T, N)`` values of one state field across bodies."""
+        if name not in STATE_FIELDS:
+            raise UnknownNameError("state field", name, STATE_FIELDS)
         return self.states[:, :, STATE_FIELDS.index(name)]
 
     def to_npz_dict(self) -> dict[str, np.ndarray]:

@@ -33,11 +33,6 @@ def test_an_unknown_name_lists_the_known_names_sorted_and_is_not_quoted() -> Non
     )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="UnknownNameError forms the plural by appending 's': 'known bodys' (Scene.body_index, "
-    "Scene.with_params and the raster renderer's focus use the kind 'body')",
-)
 def test_the_plural_of_body_is_bodies() -> None:
     assert str(UnknownNameError("body", "c", ["a", "b"])) == "unknown body 'c'; known bodies: a, b"
 
@@ -66,3 +61,13 @@ def test_a_simulation_error_names_the_engine_frame_and_body() -> None:
     assert str(err) == "[pymunk] frame 12, body 'a': NaN state"
     assert (err.engine, err.frame, err.body) == ("pymunk", 12, "a")
     assert str(SimulationError("far away", engine="box2d", frame=0)) == "[box2d] frame 0: far away"
+
+
+def test_plurals_of_the_kinds_physbench_names() -> None:
+    from physbench.errors import plural
+
+    words = {"body": "bodies", "scene": "scenes", "box": "boxes", "key": "keys", "alias": "aliases"}
+    assert {w: plural(w) for w in words} == words
+    err = UnknownNameError("body of recording 'r'", "z", ["a"])
+    assert str(err) == "unknown body of recording 'r' 'z'; known bodies of recording 'r': a"
+    assert "known drag laws: " in str(UnknownNameError("drag law", "x", ["linear"]))

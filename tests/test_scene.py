@@ -212,13 +212,13 @@ def test_with_params_names_an_unknown_parameter_or_body() -> None:
 def test_body_index_and_unknown_find_by_name_or_list_the_known_names() -> None:
     assert GOOD.body_index("b") == 1
     assert GOOD.unknown("b.friction") is GOOD.unknowns[1]
-    with pytest.raises(UnknownNameError, match=r"^unknown body 'c'; known .*: a, b$"):
+    with pytest.raises(UnknownNameError, match=r"^unknown body 'c'; known bodies: a, b$"):
         GOOD.body_index("c")
     with pytest.raises(UnknownNameError) as err:
         GOOD.unknown("b.mass")
     assert str(err.value) == (
-        "unknown unknown parameter 'b.mass' of scene 's'; known unknown parameters of scene "
-        "'s': a.mass, b.friction"
+        "unknown parameter 'b.mass' among the unknowns of scene 's'; known parameters among the "
+        "unknowns of scene 's': a.mass, b.friction"
     )
 
 

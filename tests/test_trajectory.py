@@ -48,11 +48,6 @@ def test_body_and_field_select_by_name() -> None:
     assert np.shares_memory(traj.body("b"), traj.states)  # views, not copies
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="Trajectory.body/field raise tuple.index's bare ValueError, naming neither the "
-    "unknown name nor the known ones",
-)
 def test_an_unknown_body_or_field_is_named_with_the_known_ones() -> None:
     traj = _traj()
     with pytest.raises(UnknownNameError, match=r"'nope'.*a, b, c"):

@@ -301,7 +301,7 @@ def test_bad_options_raise_clear_errors(kwargs: dict[str, object], match: str) -
 
 
 def test_unknown_focus_lists_bodies(three: Scene) -> None:
-    with pytest.raises(UnknownNameError, match="known bodys: a, b, test"):
+    with pytest.raises(UnknownNameError, match="known bodies: a, b, test"):
         RasterRenderer().render(three, moving(three), focus="c")
 
 
