@@ -13,12 +13,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from physbench.discover.phrasing import describe
 from physbench.discover.residuals import EVENTS
 from physbench.discover.verdict import params_text, text
 
 if TYPE_CHECKING:
     from physbench.discover.diagnostics import RunView
-    from physbench.discover.select import Discovery
+    from physbench.discover.results import Discovery
 
 #: Runs and bodies drawn at most (the JSON holds every number).
 MAX_RUNS, MAX_BODIES = 3, 3
@@ -48,8 +49,8 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
 
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
-    base_v = views(disc.base)
-    final_v = views(disc.final) if disc.causes else base_v
+    base_v = views(disc.base.model)
+    final_v = views(disc.final.model) if disc.causes else base_v
     split = disc.split
     cut = (
         {p.run: p.t_end for p in split.fit}
@@ -219,7 +220,7 @@ def _html(disc: Discovery, figures: list[tuple[str, str]]) -> str:
     )
     findings: dict[str, Any] = disc.findings
     items = "".join(
-        f"<li>{e(f.text)}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>"
+        f"<li>{e(describe(f))}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>"
         for f in findings.get("base", [])
     )
     title = "physbench discover: " + (", ".join(disc.causes) if disc.causes else "no cause found")

@@ -13,24 +13,24 @@ import math
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
+from physbench.discover.phrasing import describe
+
 if TYPE_CHECKING:
-    from physbench.discover.select import CandidateResult, Discovery
+    from physbench.discover.results import CandidateResult, Discovery, Finding
 
 #: Findings shown in the text verdict.
 MAX_FINDINGS = 8
 
 
 def _unit(name: str, param: str) -> str:
-    try:
-        from physbench.plugins import get_registry
+    """The unit of parameter ``param`` of the registered effect ``name`` ("" when unknown)."""
+    from physbench.errors import UnknownNameError
+    from physbench.plugins import get_registry
 
-        cls = get_registry().get("effect", name)
-        for p in cls.params:
-            if p.name == param:
-                return p.unit
-    except Exception:
-        pass
-    return ""
+    try:
+        return get_registry().get("effect", name).param(param).unit
+    except UnknownNameError:
+        return ""
 
 
 def format_value(value: float, err: float | None) -> str:
@@ -76,7 +76,7 @@ def text(disc: Discovery) -> str:
     if fs:
         for f in fs[:MAX_FINDINGS]:
             hint = f"  [-> {', '.join(f.suggests)}]" if f.suggests else ""
-            lines.append(f"  - {f.text}{hint}")
+            lines.append(f"  - {describe(f)}{hint}")
         if len(fs) > MAX_FINDINGS:
             lines.append(f"  - ... {len(fs) - MAX_FINDINGS} more in the JSON")
     else:
@@ -182,7 +182,7 @@ def to_dict(disc: Discovery) -> dict[str, Any]:
                 "train_runs": [disc.runs[i].name for i in disc.split.train_runs],
                 "test_runs": [disc.runs[i].name for i in disc.split.test_runs],
             },
-            "findings": {k: [f.to_dict() for f in v] for k, v in disc.findings.items()},
+            "findings": {k: [finding_dict(f) for f in v] for k, v in disc.findings.items()},
             "residuals": {k: v.to_dict() for k, v in disc.breakdowns.items()},
             "skipped": [{"effect": n, "reason": r} for n, r in disc.skipped],
             "settings": {
@@ -192,6 +192,18 @@ def to_dict(disc: Discovery) -> dict[str, Any]:
             "seconds": disc.seconds,
         }
     )
+
+
+def finding_dict(f: Finding) -> dict[str, Any]:
+    """One finding in the JSON: where, the sentence, the numbers and the effects it points at."""
+    return {
+        "kind": f.kind,
+        "run": f.run,
+        "body": f.body,
+        "text": describe(f),
+        "values": {k: float(v) for k, v in f.values.items()},
+        "suggests": list(f.suggests),
+    }
 
 
 def to_json(disc: Discovery, **kwargs: Any) -> str:
