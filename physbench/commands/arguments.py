@@ -30,9 +30,12 @@ def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
     return out
 
 
-def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) -> None:
+def add_renderer_arguments(
+    p: argparse.ArgumentParser, *, resolution: int = 64, from_frames: bool = False
+) -> None:
     """``--renderer NAME``, ``--renderer-option KEY=VALUE`` (repeatable), ``--resolution PX`` and
-    ``--render-mode MODE``."""
+    ``--render-mode MODE``. ``from_frames``: for commands that fit observed frames, the resolution
+    and the mode default to ``None``, read from the frames (width, channel count)."""
     p.add_argument(
         "--renderer",
         default=None,
@@ -50,17 +53,25 @@ def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) 
     p.add_argument(
         "--resolution",
         type=int,
-        default=resolution,
+        default=None if from_frames else resolution,
         metavar="PX",
-        help=f"frame width in pixels (default: {resolution})",
+        help="frame width in pixels (default: "
+        + ("the frames' width" if from_frames else str(resolution))
+        + ")",
     )
     p.add_argument(
         "--render-mode",
         "--mode",
         dest="render_mode",
-        default="mark",
+        default=None if from_frames else "mark",
         choices=RENDER_MODES,
-        help="channel layout of the frames (default: mark)",
+        help="channel layout of the frames (default: "
+        + (
+            "from the frames' channels: 1 mask, 2 mark, one per body instance"
+            if from_frames
+            else "mark"
+        )
+        + ")",
     )
 
 

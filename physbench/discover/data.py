@@ -3,7 +3,7 @@ and how each run is split into the part a model is fitted on and the part it is 
 
 A run's scene reproduces the setup (geometry, initial state, the base model's unknowns); its data
 are either a :class:`~physbench.recording.Recording` (tracked trajectories, trajectory-space loss) or
-observed frames ``(T, C, H, W)`` (image loss with the raster renderer).
+observed frames ``(T, C, H, W)`` (image loss with a renderer chosen by name).
 """
 
 from __future__ import annotations
