@@ -12,7 +12,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "recording",
         metavar="RECORDING",
-        help="tracked trajectories (.csv: t,body,x,y[,angle][,run]) or observed frames (.npz, key 'frames')",
+        help="tracked trajectories (.csv: t,body,x,y[,angle][,run]) or observed frames "
+        "(.npz, key 'frames')",
     )
     p.add_argument(
         "--scene",
@@ -32,7 +33,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--estimator",
         default="lsq",
-        help="base fit: lsq (local least squares, default) or a registered estimator (tpe, cmaes, optuna, random) polished by lsq",
+        help="base fit: lsq (local least squares, default) or a registered estimator (tpe, "
+        "cmaes, optuna, random) polished by lsq",
     )
     p.add_argument(
         "--iterations",
@@ -47,14 +49,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--split",
         default="auto",
         choices=("auto", "time", "runs"),
-        help="hold out each run's later part (time) or whole runs (runs); auto: runs with >= 3 runs",
+        help="hold out each run's later part (time) or whole runs (runs); auto: runs with >= 3 "
+        "runs",
     )
     p.add_argument(
         "--nuisance",
         nargs="+",
         default=["auto"],
         metavar="NAME",
-        help="initial-state parameters fitted per run: auto, none, or names like ball.vx0 force0.fx",
+        help="initial-state parameters fitted per run: auto, none, or names like ball.vx0 "
+        "force0.fx",
     )
     p.add_argument("--run", help="use only this run of a multi-run CSV")
     p.add_argument(
@@ -115,7 +119,8 @@ def main(args: argparse.Namespace) -> int:
     if args.quiet:
         causes = ", ".join(disc.causes) or "none"
         print(
-            f"causes: {causes}; gain {disc.gain:.1%} (held-out error {disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})"
+            f"causes: {causes}; gain {disc.gain:.1%} (held-out error "
+            f"{disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})"
         )
     else:
         print(text(disc))

@@ -91,7 +91,8 @@ def candidates_for(
             skipped.append(
                 (
                     name,
-                    "no surface to roll on (gravity acts in the scene's plane and there is no static geometry)",
+                    "no surface to roll on (gravity acts in the scene's plane and there is no "
+                    "static geometry)",
                 )
             )
             continue
@@ -107,7 +108,8 @@ def candidates_for(
             skipped.append(
                 (
                     name,
-                    "no force of known size: a clock error would be a change of gravity and initial speeds",
+                    "no force of known size: a clock error would be a change of gravity and "
+                    "initial speeds",
                 )
             )
             continue

@@ -2,9 +2,9 @@
 vector (trust-region reflective, finite-difference Jacobian), optionally started from the best point
 of any registered black-box estimator (ask/tell, as in the correction loop).
 
-Uncertainty comes from the Jacobian at the optimum: ``cov ≈ s² (JᵀJ)⁻¹`` with ``s² = SSR / (n - p)``.
-It assumes independent residuals; tracking errors that are correlated in time, or model error,
-make it optimistic.
+Uncertainty comes from the Jacobian at the optimum: ``cov ≈ s² (JᵀJ)⁻¹`` with
+``s² = SSR / (n - p)``. It assumes independent residuals; tracking errors that are correlated in
+time, or model error, make it optimistic.
 """
 
 from __future__ import annotations
@@ -190,8 +190,8 @@ def probe_start(
     multiples: Sequence[float] = (2.5, 10.0, 25.0),
 ) -> float:
     """Move ``keys`` to the best of a few probe points before a local fit: each key alone at its
-    current value ± ``multiples`` of its scale (:attr:`FitParameter.scale`), then all keys at their best
-    probes together. Local least squares on contact-rich scenes stalls in the nearest valley; a
+    current value ± ``multiples`` of its scale (:attr:`FitParameter.scale`), then all keys at their
+    best probes together. Local least squares on contact-rich scenes stalls in the nearest valley; a
     handful of probes finds a better one cheaply. Returns the SSR at the chosen start (the model's
     values are set to it)."""
 

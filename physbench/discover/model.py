@@ -197,10 +197,11 @@ def apply_initial(
 def nuisance_params(
     run: Run, index: int, prefix: str, names: Sequence[str] | str = "auto"
 ) -> list[FitParameter]:
-    """The nuisance parameters of one run. ``"auto"``: angle and rate of every jointed body (when the
-    joints form chains hanging from the world); position and velocity (plus angle and rate when the
-    data hold angles) of every free body moving at t = 0; the vector of every scheduled impulse.
-    ``"none"``: nothing. Or a list of ``body.x0``-style names (``force<i>.fx`` for forces)."""
+    """The nuisance parameters of one run. ``"auto"``: angle and rate of every jointed body (when
+    the joints form chains hanging from the world); position and velocity (plus angle and rate
+    when the data hold angles) of every free body moving at t = 0; the vector of every scheduled
+    impulse. ``"none"``: nothing. Or a list of ``body.x0``-style names (``force<i>.fx`` for
+    forces)."""
     scene = run.scene
     parents = chain_parents(scene)
     jointed = {j.a for j in scene.joints} | {j.b for j in scene.joints if j.b is not None}
@@ -229,12 +230,14 @@ def nuisance_params(
             if target.startswith("force") and target[5:].isdigit() and name in ("fx", "fy"):
                 if int(target[5:]) >= len(scene.forces):
                     raise DiscoverError(
-                        f"nuisance {item!r}: scene {scene.name!r} has {len(scene.forces)} forces (force0..force{len(scene.forces) - 1})"
+                        f"nuisance {item!r}: scene {scene.name!r} has {len(scene.forces)} "
+                        f"forces (force0..force{len(scene.forces) - 1})"
                     )
             elif target not in scene.body_names or name not in NUISANCE:
                 raise DiscoverError(
                     f"nuisance {item!r}: expected BODY.NAME with a body of scene {scene.name!r} "
-                    f"({', '.join(scene.body_names)}) and NAME one of {', '.join(NUISANCE)}, or force<i>.fx/fy"
+                    f"({', '.join(scene.body_names)}) and NAME one of {', '.join(NUISANCE)}, "
+                    "or force<i>.fx/fy"
                 )
             elif target in jointed and name not in ("angle0", "omega0"):
                 raise DiscoverError(
@@ -242,7 +245,8 @@ def nuisance_params(
                 )
             elif target in jointed and (parents is None or target not in parents):
                 raise DiscoverError(
-                    f"nuisance {item!r}: the joints of scene {scene.name!r} do not form chains from the world"
+                    f"nuisance {item!r}: the joints of scene {scene.name!r} do not form chains "
+                    "from the world"
                 )
             wanted.append((target, name))
     out = []
@@ -371,7 +375,8 @@ class Problem:
             raise DiscoverError("runs with frames need a renderer for the image loss")
 
     def truncated(self, role: str, part: Part, horizon: float) -> tuple[Part, np.ndarray]:
-        """``part`` cut to the first ``horizon`` share of its time span, and its residual weights."""
+        """``part`` cut to the first ``horizon`` share of its time span, and its residual
+        weights."""
         layout = self.layouts[(role, part.run)]
         if horizon >= 1.0:
             return part, layout.weight
@@ -437,7 +442,8 @@ class Model:
         raise UnknownNameError("model parameter", key, [p.key for p in self.params])
 
     def extended(self, effect: Effect, starts: Mapping[str, float] | None = None) -> Model:
-        """This model plus ``effect`` (its parameters starting at ``starts``), values carried over."""
+        """This model plus ``effect`` (its parameters starting at ``starts``), values carried
+        over."""
         m = Model(
             self.problem, [*self.effects, effect], [*self.params, *effect_params(effect, starts)]
         )
@@ -453,7 +459,8 @@ class Model:
         return s
 
     def run_scene(self, run: int, values: Mapping[str, float]) -> tuple[Scene, dict[str, float]]:
-        """The run's scene with its nuisance applied, and the body + effect parameters to simulate."""
+        """The run's scene with its nuisance applied, and the body + effect parameters to
+        simulate."""
         state: dict[str, dict[str, float]] = {}
         forces: dict[int, dict[str, float]] = {}
         sim: dict[str, float] = {}

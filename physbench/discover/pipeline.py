@@ -207,7 +207,7 @@ def renderer_for(
         mode = {1: "mask", 2: "mark"}.get(c, "instance" if c == n else "")
         if not mode:
             raise DiscoverError(
-                f"frames have {c} channels; renderer modes give 1 (mask), 2 (mark) or {n} "
+                f"frames have {c} channels; the render modes give 1 (mask), 2 (mark) or {n} "
                 "(instance, one per body)"
             )
     r = make_renderer(

@@ -196,7 +196,8 @@ class Selection:
 
 @dataclass(frozen=True, eq=False)
 class Discovery:
-    """Everything a discovery found; :mod:`physbench.discover.verdict` turns it into text and JSON."""
+    """Everything a discovery found; :mod:`physbench.discover.verdict` turns it into text and
+    JSON."""
 
     runs: Sequence[Run]
     split: Split

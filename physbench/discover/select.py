@@ -1,6 +1,7 @@
 """Selecting the cause: fit base + each candidate effect jointly, compare them on held-out data and
 with an information criterion (:mod:`physbench.discover.significance`), and add effects greedily
-while that helps (:func:`select_causes`); then drop causes a later one made redundant (:func:`prune_causes`).
+while that helps (:func:`select_causes`); then drop causes a later one made redundant
+(:func:`prune_causes`).
 
 The most useful significant candidate (lowest held-out error) is added; the next round refits the
 ``shortlist`` best remaining candidates of this round, plus whatever the new model's residual
