@@ -5,6 +5,10 @@ of any registered black-box estimator (ask/tell, as in the correction loop).
 Uncertainty comes from the Jacobian at the optimum: ``cov ≈ s² (JᵀJ)⁻¹`` with
 ``s² = SSR / (n - p)``. It assumes independent residuals; tracking errors that are correlated in
 time, or model error, make it optimistic.
+
+:func:`fit_model` is the fit every stage uses, with the budgets, horizons and estimator of the
+:class:`~physbench.discover.settings.Settings`; :func:`score` scores a fitted model on the held-out
+data. The fits set the model's values to the optimum in place.
 """
 
 from __future__ import annotations

@@ -31,6 +31,8 @@ from physbench.discover.settings import Settings
 from physbench.errors import SimulationError
 
 if TYPE_CHECKING:
+    from physbench.discover.residuals import Breakdown
+    from physbench.discover.results import Finding
     from physbench.render.base import Renderer
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
@@ -155,8 +157,8 @@ def conclude(
     (unless ``diagnose`` is False); ``started``: :func:`time.perf_counter` at the start, for the
     time it took."""
     problem = selection.base.model.problem
-    found: dict[str, Any] = {}
-    breakdowns: dict[str, Any] = {}
+    found: dict[str, list[Finding]] = {}
+    breakdowns: dict[str, Breakdown] = {}
     if diagnose:
         base = diagnostics.diagnose(selection.base)
         final = diagnostics.diagnose(selection.final) if selection.causes else base
