@@ -41,8 +41,7 @@ from physbench.datasets.oscillation import LOSS_LAWS, fit_loss_laws, half_swing_
 from physbench.datasets.pendulum_benard import first_extreme
 from physbench.datasets.pendulum_benard import read as read_benard
 from physbench.datasets.pendulum_kaheman import read as read_kaheman
-from physbench.discover import Discovery, Settings, discover
-from physbench.discover.data import runs_from_dataset
+from physbench.discover import Discovery, Settings, discover, runs_from_dataset
 from physbench.discover.report import write_report
 from physbench.discover.verdict import text, to_dict
 from physbench.errors import PhysbenchError

@@ -48,24 +48,35 @@ def add_renderer_choice(
     )
 
 
-def add_renderer_arguments(p: argparse.ArgumentParser, *, resolution: int = 64) -> None:
-    """``--renderer NAME``, ``--renderer-option KEY=VALUE`` (repeatable), ``--resolution PX`` and
-    ``--render-mode MODE``."""
+def add_renderer_arguments(
+    p: argparse.ArgumentParser, *, resolution: int = 64, from_frames: bool = False
+) -> None:
+    """:func:`add_renderer_choice` plus ``--resolution PX`` and ``--render-mode MODE``.
+    ``from_frames``: for commands that fit observed frames, the resolution and the mode default to
+    ``None``, read from the frames (width, channel count)."""
     add_renderer_choice(p)
     p.add_argument(
         "--resolution",
         type=int,
-        default=resolution,
+        default=None if from_frames else resolution,
         metavar="PX",
-        help=f"frame width in pixels (default: {resolution})",
+        help="frame width in pixels (default: "
+        + ("the frames' width" if from_frames else str(resolution))
+        + ")",
     )
     p.add_argument(
         "--render-mode",
         "--mode",
         dest="render_mode",
-        default="mark",
+        default=None if from_frames else "mark",
         choices=RENDER_MODES,
-        help="channel layout of the frames (default: mark)",
+        help="channel layout of the frames (default: "
+        + (
+            "from the frames' channels: 1 mask, 2 mark, one per body instance"
+            if from_frames
+            else "mark"
+        )
+        + ")",
     )
 
 

@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import argparse
 
+from physbench.commands.arguments import add_renderer_arguments
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "recording",
         metavar="RECORDING",
-        help="tracked trajectories (.csv: t,body,x,y[,angle][,run]) or observed frames (.npz, key 'frames')",
+        help="tracked trajectories (.csv: t,body,x,y[,angle][,run]) or observed frames "
+        "(.npz, key 'frames')",
     )
     p.add_argument(
         "--scene",
@@ -30,7 +33,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--estimator",
         default="lsq",
-        help="base fit: lsq (local least squares, default) or a registered estimator (tpe, cmaes, optuna, random) polished by lsq",
+        help="base fit: lsq (local least squares, default) or a registered estimator (tpe, "
+        "cmaes, optuna, random) polished by lsq",
     )
     p.add_argument(
         "--iterations",
@@ -45,14 +49,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--split",
         default="auto",
         choices=("auto", "time", "runs"),
-        help="hold out each run's later part (time) or whole runs (runs); auto: runs with >= 3 runs",
+        help="hold out each run's later part (time) or whole runs (runs); auto: runs with >= 3 "
+        "runs",
     )
     p.add_argument(
         "--nuisance",
         nargs="+",
         default=["auto"],
         metavar="NAME",
-        help="initial-state parameters fitted per run: auto, none, or names like ball.vx0 force0.fx",
+        help="initial-state parameters fitted per run: auto, none, or names like ball.vx0 "
+        "force0.fx",
     )
     p.add_argument("--run", help="use only this run of a multi-run CSV")
     p.add_argument(
@@ -65,11 +71,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--min-delta-bic", type=float, default=None, help="BIC drop a cause must reach (default 10)"
     )
     p.add_argument("--max-causes", type=int, default=None, help="most effects added (default 3)")
-    p.add_argument(
-        "--render-mode",
-        choices=("mark", "mask", "instance"),
-        help="raster mode of .npz frames (default from C)",
-    )
+    add_renderer_arguments(p, from_frames=True)
     p.add_argument(
         "--seed", type=int, default=0, help="seed of a black-box base-fit estimator (default 0)"
     )
@@ -81,8 +83,8 @@ def main(args: argparse.Namespace) -> int:
     import sys
     from pathlib import Path
 
-    from physbench.discover import Settings, discover, load_runs
-    from physbench.discover.select import renderer_for
+    from physbench.commands.arguments import renderer_choice
+    from physbench.discover import Settings, discover, load_runs, renderer_for
     from physbench.discover.verdict import text, to_dict
     from physbench.plugins import create
 
@@ -107,12 +109,18 @@ def main(args: argparse.Namespace) -> int:
         seed=args.seed,
         **kw,
     )
-    renderer = renderer_for(runs, args.render_mode) if runs[0].frames is not None else None
+    renderer = None
+    if runs[0].frames is not None:  # the renderer flags apply to frames only
+        name, options = renderer_choice(args)
+        renderer = renderer_for(
+            runs, name, options, resolution=args.resolution, mode=args.render_mode
+        )
     disc = discover(runs, create("simulator", args.engine), settings=settings, renderer=renderer)
     if args.quiet:
         causes = ", ".join(disc.causes) or "none"
         print(
-            f"causes: {causes}; gain {disc.gain:.1%} (held-out error {disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})"
+            f"causes: {causes}; gain {disc.gain:.1%} (held-out error "
+            f"{disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})"
         )
     else:
         print(text(disc))

@@ -2,29 +2,78 @@
 physical effect explains the disagreement, and report how much better the extended model predicts
 data it was not fitted on.
 
-Modules, one concept each: :mod:`~physbench.discover.data` (runs, loading, the held-out split),
-:mod:`~physbench.discover.model` (base scene + effects + nuisance parameters -> residuals),
-:mod:`~physbench.discover.fit` (least squares, estimators, uncertainty),
+:func:`discover` runs every stage; the stages run one by one too (see ``docs/discover.md``)::
+
+    base = fit_base(runs, "pymunk", settings)       # the base model, fitted and scored
+    diagnosis = diagnose(base)                      # what it gets wrong (describe() in words)
+    trial = try_effect(base, "linear_drag", settings)  # one candidate, fitted and judged
+
+Modules, one concept each: :mod:`~physbench.discover.settings` (every knob),
+:mod:`~physbench.discover.results` (what the stages return), :mod:`~physbench.discover.data`
+(runs, loading, the held-out split), :mod:`~physbench.discover.model` (base scene + effects +
+nuisance parameters -> residuals), :mod:`~physbench.discover.fit` (least squares, estimators,
+uncertainty, budgets), :mod:`~physbench.discover.sensitivity` (what the data can see),
 :mod:`~physbench.discover.residuals` (per body, per event), :mod:`~physbench.discover.diagnostics`
-(statistics pointing at causes), :mod:`~physbench.discover.candidates` (which effects to try),
-:mod:`~physbench.discover.select` (candidate fits, held-out comparison, criterion, greedy addition),
-:mod:`~physbench.discover.verdict` (text and JSON) and :mod:`~physbench.discover.report` (plots and
-HTML).
+(statistics pointing at causes, as numbers), :mod:`~physbench.discover.phrasing` (those in
+words), :mod:`~physbench.discover.candidates` (which effects to try),
+:mod:`~physbench.discover.trial` (one candidate fitted on top of a model),
+:mod:`~physbench.discover.significance` (when a candidate is a cause),
+:mod:`~physbench.discover.select` (greedy addition, backward elimination),
+:mod:`~physbench.discover.pipeline` (the stages composed), :mod:`~physbench.discover.verdict`
+(text and JSON) and :mod:`~physbench.discover.report` (plots and HTML).
 """
 
 from __future__ import annotations
 
-from physbench.discover.data import DiscoverError, Run, load_runs, make_split, runs_from_cases
-from physbench.discover.select import CandidateResult, Discovery, Settings, discover
+from physbench.discover.candidates import CandidateSpec
+from physbench.discover.data import DiscoverError, Run, load_runs, make_split, runs_from_dataset
+from physbench.discover.diagnostics import diagnose
+from physbench.discover.phrasing import describe
+from physbench.discover.pipeline import (
+    candidate_specs,
+    conclude,
+    discover,
+    fit_base,
+    renderer_for,
+)
+from physbench.discover.results import (
+    CandidateResult,
+    Diagnosis,
+    Discovery,
+    Finding,
+    FitResult,
+    Scored,
+    Selection,
+    Skipped,
+)
+from physbench.discover.select import prune_causes, select_causes
+from physbench.discover.settings import Settings
+from physbench.discover.trial import try_effect
 
 __all__ = [
     "CandidateResult",
+    "CandidateSpec",
+    "Diagnosis",
     "DiscoverError",
     "Discovery",
+    "Finding",
+    "FitResult",
     "Run",
+    "Scored",
+    "Selection",
     "Settings",
+    "Skipped",
+    "candidate_specs",
+    "conclude",
+    "describe",
+    "diagnose",
     "discover",
+    "fit_base",
     "load_runs",
     "make_split",
-    "runs_from_cases",
+    "prune_causes",
+    "renderer_for",
+    "runs_from_dataset",
+    "select_causes",
+    "try_effect",
 ]

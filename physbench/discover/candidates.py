@@ -91,7 +91,8 @@ def candidates_for(
             skipped.append(
                 (
                     name,
-                    "no surface to roll on (gravity acts in the scene's plane and there is no static geometry)",
+                    "no surface to roll on (gravity acts in the scene's plane and there is no "
+                    "static geometry)",
                 )
             )
             continue
@@ -107,7 +108,8 @@ def candidates_for(
             skipped.append(
                 (
                     name,
-                    "no force of known size: a clock error would be a change of gravity and initial speeds",
+                    "no force of known size: a clock error would be a change of gravity and "
+                    "initial speeds",
                 )
             )
             continue
@@ -136,9 +138,11 @@ def start_values(effect: Effect, scene: Scene) -> dict[str, float]:
     """Parameter values at which ``effect`` leaves ``scene``'s dynamics unchanged, where they
     differ from the defaults: a velocity-dependent restitution starts at the scene's typical
     restitution (median product of the surfaces that can meet) and no speed dependence."""
-    if getattr(effect, "name", "") == "velocity_dependent_restitution":
+    from physbench.effects.contact import VelocityDependentRestitution
+
+    if isinstance(effect, VelocityDependentRestitution):
         products = [b.elasticity * s.elasticity for b in scene.bodies for s in scene.statics]
-        if not getattr(effect, "statics_only", False):
+        if not effect.statics_only:
             bs = scene.bodies
             products += [
                 bs[i].elasticity * bs[j].elasticity

@@ -2,8 +2,8 @@
 and how each run is split into the part a model is fitted on and the part it is scored on.
 
 A run's scene reproduces the setup (geometry, initial state, the base model's unknowns); its data
-are either a :class:`~physbench.recording.Recording` (tracked trajectories, trajectory-space loss) or
-observed frames ``(T, C, H, W)`` (image loss with the raster renderer).
+are either a :class:`~physbench.recording.Recording` (tracked trajectories, trajectory-space loss)
+or observed frames ``(T, C, H, W)`` (image loss with a renderer chosen by name).
 """
 
 from __future__ import annotations
@@ -52,7 +52,8 @@ class Run:
             missing = [b for b in self.recording.bodies if b not in names]
             if missing:
                 raise DiscoverError(
-                    f"run {self.name!r}: recorded bodies {missing} are not in scene {self.scene.name!r} "
+                    f"run {self.name!r}: recorded bodies {missing} are not in scene "
+                    f"{self.scene.name!r} "
                     f"(bodies: {', '.join(names)})"
                 )
             frames = self.recording.frames_for(self.scene.fps)
@@ -60,7 +61,8 @@ class Run:
             f = np.asarray(self.frames)
             if f.ndim != 4 or f.shape[0] < 2:
                 raise DiscoverError(
-                    f"run {self.name!r}: frames must be (T, C, H, W) with T >= 2, got shape {f.shape}"
+                    f"run {self.name!r}: frames must be (T, C, H, W) with T >= 2, got shape "
+                    f"{f.shape}"
                 )
             frames = int(f.shape[0])
         if self.scene.frames != frames:
@@ -80,10 +82,6 @@ class Run:
 def runs_from_dataset(runs: Iterable[DatasetRun]) -> list[Run]:
     """One discovery run per data-set run (:func:`physbench.datasets.load`)."""
     return [Run(r.name, r.scene, recording=r.recording, source=r.recording.source) for r in runs]
-
-
-#: The old name, until ``physbench/discover/__init__.py`` exports :func:`runs_from_dataset`.
-runs_from_cases = runs_from_dataset
 
 
 def load_runs(
@@ -120,7 +118,8 @@ def load_runs(
             Run(path.stem, sc, frames=np.asarray(obs.frames, dtype=np.float32), source=str(path))
         ]
     raise DiscoverError(
-        f"recording {str(path)!r}: unknown format {suffix or '(no suffix)'!r}; expected .csv (tracked "
+        f"recording {str(path)!r}: unknown format {suffix or '(no suffix)'!r}; expected .csv "
+        "(tracked "
         "trajectories t,body,x,y[,angle][,run]) or .npz (frames)"
     )
 
@@ -177,8 +176,9 @@ def _cut(run: Run, index: int, t_cut: float, what: str) -> tuple[Part, Part]:
         n_fit, n_held = a.size, b.size
     if n_fit < MIN_FIT_SAMPLES or n_held < MIN_HELD_SAMPLES:
         raise DiscoverError(
-            f"run {run.name!r}: splitting at t = {t_cut:.4g} s ({what}) leaves {n_fit} samples to fit and "
-            f"{n_held} to score; need at least {MIN_FIT_SAMPLES} and {MIN_HELD_SAMPLES}: record a longer run "
+            f"run {run.name!r}: splitting at t = {t_cut:.4g} s ({what}) leaves {n_fit} samples "
+            f"to fit and {n_held} to score; need at least {MIN_FIT_SAMPLES} and "
+            f"{MIN_HELD_SAMPLES}: record a longer run "
             "or change --holdout"
         )
     return a, b
@@ -218,7 +218,10 @@ class Split:
         if self.kind == "time":
             return f"each run's last {self.fraction:.0%} of its duration held out"
         names = ", ".join(runs[i].name for i in self.test_runs)
-        return f"runs {names} held out (their first {1 - self.fraction:.0%} fits only their initial state)"
+        return (
+            f"runs {names} held out (their first {1 - self.fraction:.0%} fits only their "
+            "initial state)"
+        )
 
 
 def make_split(
@@ -246,7 +249,8 @@ def make_split(
         kind = "runs" if len(runs) >= 3 else "time"
     if kind == "runs" and len(runs) < 2:
         raise DiscoverError(
-            f"split = 'runs' needs at least 2 runs; got {len(runs)} ({', '.join(names)}); use split='time'"
+            f"split = 'runs' needs at least 2 runs; got {len(runs)} ({', '.join(names)}); "
+            "use split='time'"
         )
     if kind == "time":
         fit, held = [], []

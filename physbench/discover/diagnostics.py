@@ -3,53 +3,34 @@ speed lost in free flight beyond the model (and how that loss scales with speed)
 impacts beyond the restitution, a uniform acceleration the model lacks, a constant offset, and the
 amplitude envelope, period and centre of oscillations.
 
-Each statistic becomes a :class:`Finding` with a sentence and the effects it suggests. They guide
-the reader; the decision is made by the candidate fits (:mod:`physbench.discover.select`).
+Each statistic becomes a :class:`~physbench.discover.results.Finding`: numbers (where it was
+measured, the statistic, its size, how it scales) and the effects it points at;
+:mod:`physbench.discover.phrasing` puts it into words. They guide the reader and the choice of
+candidates to fit in full; the decision is made by the candidate fits
+(:mod:`physbench.discover.select`).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.discover.residuals import EVENTS, Layout, breakdown, frame_events
+from physbench.discover.residuals import EVENTS, Breakdown, Layout, breakdown, frame_events
+from physbench.discover.results import Diagnosis, Finding
 from physbench.recording import Recording, Track
 
 if TYPE_CHECKING:
-    from physbench.discover.select import Discovery, Scored
+    from physbench.discover.model import Model
+    from physbench.discover.results import Scored
     from physbench.scene import Scene
     from physbench.trajectory import Trajectory
 
 #: A statistic is reported when it is this many standard errors from zero.
 Z_REPORT = 3.0
-
-
-@dataclass(frozen=True)
-class Finding:
-    """One statistic of the disagreement: ``kind`` (``free_flight``, ``impacts``, ``drift``,
-    ``offset``, ``envelope``, ``period``, ``centre``, ``growth``), the run and body, a sentence, the
-    numbers, and the effects it points at."""
-
-    kind: str
-    run: str
-    body: str
-    text: str
-    values: dict[str, float] = field(default_factory=dict)
-    suggests: tuple[str, ...] = ()
-
-    def to_dict(self) -> dict[str, object]:
-        return {
-            "kind": self.kind,
-            "run": self.run,
-            "body": self.body,
-            "text": self.text,
-            "values": {k: float(v) for k, v in self.values.items()},
-            "suggests": list(self.suggests),
-        }
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,9 +46,8 @@ class RunView:
     events: np.ndarray  # (T, N) event index per frame of ``measured``
 
 
-def views(scored: Scored) -> list[RunView]:
-    """Full-length simulations of every run with the fitted values."""
-    model = scored.model
+def views(model: Model) -> list[RunView]:
+    """Full-length simulations of every run with the model's current values."""
     out = []
     for i, run in enumerate(model.problem.runs):
         traj, measured = model.simulate(i, model.values)
@@ -81,31 +61,30 @@ def views(scored: Scored) -> list[RunView]:
     return out
 
 
-def diagnose(disc: Discovery) -> None:
-    """Fill ``disc.findings`` and ``disc.breakdowns`` for the base and (when it differs) the
-    final model."""
-    for label, scored in (("base", disc.base), ("final", disc.final)):
-        if label == "final" and not disc.causes:
-            disc.findings["final"], disc.breakdowns["final"] = (
-                disc.findings["base"],
-                disc.breakdowns["base"],
-            )
-            break
-        vs = views(scored)
-        parts = []
-        for v in vs:
-            if v.recording is None:
-                continue
-            lay = Layout.of_recording(v.recording, v.scene)
-            r = v.recording.residuals(v.measured) * lay.weight
-            k = np.clip(np.searchsorted(v.measured.times, lay.t - 1e-9), 0, v.measured.frames - 1)
-            idx = np.array([v.scene.body_index(n) for n in v.recording.bodies])
-            parts.append((lay, r, v.events[k, idx[lay.body]], list(v.recording.bodies)))
-        disc.breakdowns[label] = breakdown(parts)
-        disc.findings[label] = findings(vs)
+def diagnose(scored: Scored) -> Diagnosis:
+    """What the fitted model of ``scored`` gets wrong: its findings and its residual breakdown per
+    body, field and event, over the whole of every run."""
+    vs = views(scored.model)
+    return Diagnosis(findings(vs), residual_breakdown(vs))
+
+
+def residual_breakdown(vs: Sequence[RunView]) -> Breakdown:
+    """RMS residuals per body and field and per body and event, pooled over the runs with
+    recordings."""
+    parts = []
+    for v in vs:
+        if v.recording is None:
+            continue
+        lay = Layout.of_recording(v.recording, v.scene)
+        r = v.recording.residuals(v.measured) * lay.weight
+        k = np.clip(np.searchsorted(v.measured.times, lay.t - 1e-9), 0, v.measured.frames - 1)
+        idx = np.array([v.scene.body_index(n) for n in v.recording.bodies])
+        parts.append((lay, r, v.events[k, idx[lay.body]], list(v.recording.bodies)))
+    return breakdown(parts)
 
 
 def findings(vs: Sequence[RunView]) -> list[Finding]:
+    """Every statistic that stands out from the noise, run by run and body by body."""
     out: list[Finding] = []
     for v in vs:
         if v.recording is None or v.simulated is None:
@@ -191,44 +170,37 @@ def _free_flight(
         return []
     vbar = float(np.mean(vs[ok])) if ok.any() else math.nan
     values = {"excess_deceleration": a_ex, "stderr": se, "mean_speed": vbar}
-    if a_ex < 0:
+    if a_ex < 0:  # the model loses too much speed
         return [
-            Finding(
-                "free_flight",
-                run,
-                body,
-                f"{body}: in free flight the observed speed falls {-a_ex:.3g} m/s² slower "
-                "than simulated (the model loses too much speed)",
-                values,
-                (),
-            )
+            Finding("free_flight", run, body, "free", "excess_deceleration", a_ex, se, "", values)
         ]
-    text = (
-        f"{body}: in free flight the observed speed falls {a_ex:.3g} ± {se:.2g} m/s² faster than simulated "
-        f"({a_ex / vbar:.1%} of the mean speed per second)"
-        if vbar > 0
-        else f"{body}: observed speed falls faster"
-    )
     suggests: tuple[str, ...] = ("linear_drag", "quadratic_drag", "rolling_resistance")
+    trend = ""
     pts = [(v, a) for v, a, s in halves if a > 2 * s and v > 0]
     if len(pts) >= 3 and np.ptp([p[0] for p in pts]) > 0.2 * np.mean([p[0] for p in pts]):
         lv, la = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
         n_exp = float(np.polyfit(lv, la, 1)[0])
         values["speed_exponent"] = n_exp
         if n_exp < 0.5:
-            suggests, law = (
-                ("rolling_resistance",),
-                "about constant (a rolling-resistance-like loss)",
-            )
+            suggests, trend = ("rolling_resistance",), "constant"
         elif n_exp < 1.5:
-            suggests, law = ("linear_drag",), "about proportional to the speed (linear drag)"
+            suggests, trend = ("linear_drag",), "linear"
         else:
-            suggests, law = (
-                ("quadratic_drag",),
-                "about proportional to the squared speed (quadratic drag)",
-            )
-        text += f"; the excess grows like speed^{n_exp:.1f}: {law}"
-    return [Finding("free_flight", run, body, text, values, suggests)]
+            suggests, trend = ("quadratic_drag",), "quadratic"
+    return [
+        Finding(
+            "free_flight",
+            run,
+            body,
+            "free",
+            "excess_deceleration",
+            a_ex,
+            se,
+            trend,
+            values,
+            suggests,
+        )
+    ]
 
 
 def _impacts(
@@ -265,21 +237,27 @@ def _impacts(
     }
     if abs(mean) < max(Z_REPORT * se, 0.02):
         return []
-    text = (
-        f"{body}: across {len(short)} impacts the observed speed keeps {r[:, 0].mean():.0%} where the model keeps "
-        f"{r[:, 1].mean():.0%}"
-    )
+    trend = ""
     if len(short) >= 3 and np.ptp(speeds) > 0:
         slope, sse, _ = _line(np.asarray(speeds), short)
         values["shortfall_per_mps"] = slope
         if abs(slope) > Z_REPORT * sse:
-            text += f"; the shortfall {'grows' if slope > 0 else 'shrinks'} with the impact speed ({slope:+.2g} per m/s)"
-    text += (
-        " (energy lost beyond what restitution allows)"
-        if mean > 0
-        else " (the model loses too much at impacts)"
-    )
-    return [Finding("impacts", run, body, text, values, ("velocity_dependent_restitution",))]
+            trend = "growing" if slope > 0 else "shrinking"
+    # size > 0: energy lost beyond what restitution allows; < 0: the model loses too much
+    return [
+        Finding(
+            "impacts",
+            run,
+            body,
+            "impact",
+            "speed_ratio_shortfall",
+            mean,
+            se,
+            trend,
+            values,
+            ("velocity_dependent_restitution",),
+        )
+    ]
 
 
 def _drift(run: str, body: str, obs: Track, sim: Track, pos: Sequence[str]) -> list[Finding]:
@@ -294,17 +272,21 @@ def _drift(run: str, body: str, obs: Track, sim: Track, pos: Sequence[str]) -> l
         res = r - a @ coef
         cov = np.linalg.pinv(a.T @ a) * float(res @ res) / max(t.size - 3, 1)
         acc[f], se[f] = -float(coef[2]), float(math.sqrt(max(cov[2, 2], 0.0)))
-    z = max(abs(acc[f]) / se[f] if se[f] > 0 else 0.0 for f in pos)
-    if z < 2 * Z_REPORT:
+    zs = {f: abs(acc[f]) / se[f] if se[f] > 0 else 0.0 for f in pos}
+    top = max(pos, key=zs.__getitem__)
+    if zs[top] < 2 * Z_REPORT:
         return []
-    vec = ", ".join(f"{f} {acc[f]:+.3g}" for f in pos)
     values = {f"a{f}": acc[f] for f in pos}
     return [
         Finding(
             "drift",
             run,
             body,
-            f"{body}: the residual drifts as if the model missed a uniform acceleration ({vec} m/s²)",
+            "",
+            f"a{top}",
+            acc[top],
+            se[top],
+            "",
             values,
             ("constant_force", "table_tilt"),
         )
@@ -320,16 +302,20 @@ def _offset(run: str, body: str, obs: Track, sim: Track, fields: Sequence[str]) 
         if d.size < 8:
             continue
         mean, sd = float(d.mean()), float(d.std())
+        stderr = sd / math.sqrt(d.size)
         if abs(mean) > 0.7 * math.sqrt(mean * mean + sd * sd) and abs(
             mean
         ) > Z_REPORT * sd / math.sqrt(d.size):
-            unit = "rad" if f == "angle" else "m"
             out.append(
                 Finding(
                     "offset",
                     run,
                     body,
-                    f"{body}: observed {f} sits {mean:+.3g} {unit} from the simulated one throughout",
+                    "",
+                    f"d{f}",
+                    mean,
+                    stderr,
+                    "",
                     {f"d{f}": mean},
                     ("sensor_offset",),
                 )
@@ -338,7 +324,11 @@ def _offset(run: str, body: str, obs: Track, sim: Track, fields: Sequence[str]) 
 
 
 def _oscillation(run: str, body: str, obs: Track, sim: Track) -> list[Finding]:
-    from physbench.datasets import oscillation_centre, oscillation_periods, swing_peaks
+    from physbench.datasets.oscillation import (
+        oscillation_centre,
+        oscillation_periods,
+        swing_peaks,
+    )
 
     t = obs.t
     ao, asim = obs.values("angle"), sim.values("angle")
@@ -363,11 +353,7 @@ def _oscillation(run: str, body: str, obs: Track, sim: Track) -> list[Finding]:
             "viscous": "joint_viscous_damping",
             "quadratic": "joint_quadratic_damping",
         }[law]
-        what = {
-            "coulomb": "about constant (dry, Coulomb-like friction)",
-            "viscous": "about proportional to the amplitude (viscous)",
-            "quadratic": "about proportional to the squared amplitude (air-drag-like)",
-        }[law]
+        trend = {"coulomb": "constant", "viscous": "linear", "quadratic": "quadratic"}[law]
         values = {
             "observed_first": float(po[0]),
             "observed_last": float(po[-1]),
@@ -378,11 +364,20 @@ def _oscillation(run: str, body: str, obs: Track, sim: Track) -> list[Finding]:
         sim_loss = float(ps[0] - ps[-1]) / max(ps.size - 1, 1)
         obs_loss = float(po[0] - po[-1]) / max(po.size - 1, 1)
         if obs_loss > 1.5 * max(sim_loss, 0.0) + 1e-4:
-            text = (
-                f"{body}: the observed amplitude falls from {po[0]:.3g} to {po[-1]:.3g} rad over {po.size - 1} half swings, "
-                f"the simulated one from {ps[0]:.3g} to {ps[-1]:.3g}; the loss per swing is {what}"
+            out.append(
+                Finding(
+                    "envelope",
+                    run,
+                    body,
+                    "jointed",
+                    "loss_per_half_swing",
+                    obs_loss,
+                    math.nan,
+                    trend,
+                    values,
+                    (effect,),
+                )
             )
-            out.append(Finding("envelope", run, body, text, values, (effect,)))
     per_o, per_s = oscillation_periods(t, ao, co), oscillation_periods(t, asim, cs)
     if per_o.size >= 2 and per_s.size >= 2:
         ratio = float(np.median(per_o) / np.median(per_s))
@@ -393,7 +388,11 @@ def _oscillation(run: str, body: str, obs: Track, sim: Track) -> list[Finding]:
                     "period",
                     run,
                     body,
-                    f"{body}: the observed period is {ratio:.4f} × the simulated one",
+                    "jointed",
+                    "period_ratio",
+                    ratio,
+                    spread,
+                    "",
                     {"period_ratio": ratio},
                     ("clock_scale",),
                 )
@@ -404,7 +403,11 @@ def _oscillation(run: str, body: str, obs: Track, sim: Track) -> list[Finding]:
                 "centre",
                 run,
                 body,
-                f"{body}: the observed swing is centred {co - cs:+.3g} rad from the simulated one",
+                "jointed",
+                "dangle",
+                co - cs,
+                math.nan,
+                "",
                 {"dangle": co - cs},
                 ("sensor_offset",),
             )

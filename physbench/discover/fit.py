@@ -2,56 +2,35 @@
 vector (trust-region reflective, finite-difference Jacobian), optionally started from the best point
 of any registered black-box estimator (ask/tell, as in the correction loop).
 
-Uncertainty comes from the Jacobian at the optimum: ``cov ≈ s² (JᵀJ)⁻¹`` with ``s² = SSR / (n - p)``.
-It assumes independent residuals; tracking errors that are correlated in time, or model error,
-make it optimistic.
+Uncertainty comes from the Jacobian at the optimum: ``cov ≈ s² (JᵀJ)⁻¹`` with
+``s² = SSR / (n - p)``. It assumes independent residuals; tracking errors that are correlated in
+time, or model error, make it optimistic.
+
+:func:`fit_model` is the fit every stage uses, with the budgets, horizons and estimator of the
+:class:`~physbench.discover.settings.Settings`; :func:`score` scores a fitted model on the held-out
+data. The fits set the model's values to the optimum in place.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import replace
 
 import numpy as np
 
-from physbench.discover.data import DiscoverError
-from physbench.discover.model import Model, Param
+from physbench.discover.data import DiscoverError, Run
+from physbench.discover.model import FitParameter, Model
+from physbench.discover.residuals import rms
+from physbench.discover.results import FitResult, Scored
+from physbench.discover.settings import Settings
 from physbench.errors import SimulationError
 
 #: Residual given to every entry of a simulation that explodes, in units of the start's RMS.
 FAILED_RESIDUAL = 100.0
 
 
-@dataclass
-class FitResult:
-    """The optimum of one fit. ``values``: every parameter of the model (fitted or not)."""
-
-    values: dict[str, float]
-    free: list[str]
-    stderr: dict[str, float]
-    ssr: float
-    n: int
-    nfev: int
-    simulations: int
-    status: str
-    correlations: dict[str, dict[str, float]] = field(default_factory=dict)
-
-    @property
-    def k(self) -> int:
-        return len(self.free)
-
-    @property
-    def rms(self) -> float:
-        return math.sqrt(self.ssr / self.n) if self.n else math.nan
-
-    def bic(self, extra_k: int = 0) -> float:
-        """Bayesian information criterion with unknown noise: ``n ln(SSR/n) + k ln n``."""
-        n = max(self.n, 1)
-        return n * math.log(max(self.ssr, 1e-300) / n) + (self.k + extra_k) * math.log(n)
-
-
-def _vector(model: Model, keys: Sequence[str]) -> tuple[np.ndarray, list[Param]]:
+def _vector(model: Model, keys: Sequence[str]) -> tuple[np.ndarray, list[FitParameter]]:
     ps = [model.param(k) for k in keys]
     return np.array([model.values[k] for k in keys], dtype=float), ps
 
@@ -71,7 +50,7 @@ def least_squares(
 ) -> FitResult:
     """Fit ``free`` (keys) of ``model`` to the parts of ``role``, starting from ``model.values``;
     the model's values are set to the optimum. ``diff_step`` is the finite-difference step in units
-    of each parameter's scale (:attr:`Param.scale`). ``budget`` caps the simulations of each
+    of each parameter's scale (:attr:`FitParameter.scale`). ``budget`` caps the simulations of each
     horizon (the best point so far is kept). ``horizons``: fit the first shares of time in turn,
     each from the last optimum (continuation: a late bounce cannot pull an early fit into a wrong
     valley); unless ``final`` is False, the last horizon is 1 whatever ``horizons`` ends with."""
@@ -91,8 +70,7 @@ def least_squares(
         steps[-1],
         covariance_needed=final,
     )
-    fr.simulations = model.problem.simulations - sims0
-    return fr
+    return replace(fr, simulations=model.problem.simulations - sims0)
 
 
 class _OutOfBudget(Exception):
@@ -216,8 +194,8 @@ def probe_start(
     multiples: Sequence[float] = (2.5, 10.0, 25.0),
 ) -> float:
     """Move ``keys`` to the best of a few probe points before a local fit: each key alone at its
-    current value ± ``multiples`` of its scale (:attr:`Param.scale`), then all keys at their best
-    probes together. Local least squares on contact-rich scenes stalls in the nearest valley; a
+    current value ± ``multiples`` of its scale (:attr:`FitParameter.scale`), then all keys at their
+    best probes together. Local least squares on contact-rich scenes stalls in the nearest valley; a
     handful of probes finds a better one cheaply. Returns the SSR at the chosen start (the model's
     values are set to it)."""
 
@@ -292,23 +270,17 @@ def estimator_fit(
     from physbench.estimators.base import Step, Task
     from physbench.params import ParamSpace
     from physbench.plugins import create
-    from physbench.scene import body_unknown
 
     est = create("estimator", estimator, **(options or {}))
-    if est.per_object:
+    if type(est).per_object:
         raise DiscoverError(
-            f"estimator {estimator!r} corrects marked objects in images; discovery needs a black-box estimator "
-            "(tpe, cmaes, optuna, random) or 'lsq'"
+            f"estimator {estimator!r} corrects marked objects in images; discovery needs a "
+            "black-box estimator (tpe, cmaes, optuna, random) or 'lsq'"
         )
     if isinstance(iterations, bool) or not isinstance(iterations, int) or iterations < 1:
         raise DiscoverError(f"estimator iterations = {iterations!r}: expected a whole number >= 1")
     ps = [model.param(k) for k in free]
-    space = ParamSpace(
-        tuple(
-            body_unknown(k.rpartition(".")[0], k.rpartition(".")[2], p.low, p.high)
-            for k, p in zip(free, ps, strict=True)
-        )
-    )
+    space = ParamSpace(tuple(ps))
     current = {k: min(max(model.values[k], p.low), p.high) for k, p in zip(free, ps, strict=True)}
     r0 = model.residuals("fit", current)
     worst = FAILED_RESIDUAL**2 * max(float(np.mean(r0 * r0)), 1e-18)
@@ -336,3 +308,93 @@ def estimator_fit(
         params = dict(est.propose(Step(k, dict(params), np.zeros((0, 1, 1, 1), np.float32), loss)))
     model.values.update(best)
     return best
+
+
+# --------------------------------------------------------------------------- with the settings
+
+
+def fit_model(
+    model: Model,
+    settings: Settings,
+    *,
+    base: bool,
+    free: Sequence[str] | None = None,
+    probe: Sequence[str] = (),
+    horizons: Sequence[float] | None = None,
+) -> FitResult:
+    """Fit ``free`` (default :meth:`Model.free_keys`) of ``model`` with the budgets of
+    ``settings``: for the ``base`` fit first the black-box estimator of ``settings`` (if any),
+    then :func:`probe_start` over ``probe``, least squares over the continuation ``horizons``
+    (default :func:`fit_horizons`), and with a runs split each held-out run's own nuisance on its
+    lead-in. The model's values are set to the optimum."""
+    keys = model.free_keys() if free is None else list(free)
+    if base and settings.estimator != "lsq" and keys:
+        estimator_fit(
+            model,
+            keys,
+            settings.estimator,
+            iterations=settings.estimator_iterations,
+            seed=settings.seed,
+            options=settings.estimator_options,
+        )
+    if probe:
+        probe_start(model, probe)
+    fr = least_squares(
+        model,
+        keys,
+        max_nfev=settings.base_max_nfev if base else settings.max_nfev,
+        budget=budget(settings, len(keys)) * (2 if base else 1),
+        diff_step=settings.diff_step,
+        horizons=horizons or fit_horizons(model, settings),
+    )
+    split = model.problem.split
+    for i in split.test_runs if split.kind == "runs" else ():
+        own = [p.key for p in model.params if p.kind == "nuisance" and p.run == i]
+        if own:
+            least_squares(
+                model,
+                own,
+                role="lead",
+                runs=[i],
+                max_nfev=settings.max_nfev,
+                budget=budget(settings, len(own)),
+                diff_step=settings.diff_step,
+            )
+    return fr
+
+
+def budget(settings: Settings, free: int) -> int:
+    """Simulations per fit horizon: ``settings.budget`` for up to 7 free parameters, growing with
+    the Jacobian's cost beyond."""
+    return int(settings.budget * max(1.0, (free + 1) / 8))
+
+
+def is_rough(runs: Sequence[Run]) -> bool:
+    """Whether the fit landscape is rough: bodies can hit something (static geometry, or each
+    other when not jointed), so that impacts detected at discrete steps put a saw-tooth into the
+    residuals, or the loss is on images, which stop pulling once shapes no longer overlap."""
+    scene = runs[0].scene
+    return (
+        bool(scene.statics)
+        or (len(scene.bodies) > 1 and not scene.joints)
+        or any(r.frames is not None for r in runs)
+    )
+
+
+def fit_horizons(model: Model, settings: Settings) -> tuple[float, ...]:
+    """The continuation horizons of a fit: ``settings.horizons`` (ending at 1), else (0.5, 1) in
+    rough scenes (:func:`is_rough`) and (1,) in smooth ones."""
+    if settings.horizons is not None:
+        return (*(h for h in settings.horizons if 0 < h < 1), 1.0)
+    return (0.5, 1.0) if is_rough(model.problem.runs) else (1.0,)
+
+
+def score(label: str, causes: tuple[str, ...], model: Model, fr: FitResult) -> Scored:
+    """``model`` at its fitted values, scored on the held-out data (infinite error, with the
+    reason, when it does not simulate there)."""
+    try:
+        r = model.residuals("held")
+        held, why = rms(r), ""
+    except SimulationError as exc:
+        r, held, why = np.zeros(0), math.inf, str(exc)
+    return Scored(label, causes, model, fr, held, int(r.size), why)

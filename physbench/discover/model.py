@@ -1,7 +1,7 @@
 """The model discovery fits: the base scene, plus effects, plus nuisance parameters, simulated per
 run and compared with the data as a residual vector.
 
-Parameters (:class:`Param`) are of three kinds, all in one ``{key: value}`` dict:
+Parameters (:class:`FitParameter`) are of three kinds, all in one ``{key: value}`` dict:
 
 ``body``
     the scene's declared unknowns (``ball.mass``), shared by all runs;
@@ -25,7 +25,9 @@ import numpy as np
 from physbench.discover.data import DiscoverError, Part, Run, Split
 from physbench.discover.residuals import Layout
 from physbench.effects import apply_measurements
+from physbench.effects.measurement import ClockScale
 from physbench.errors import SimulationError
+from physbench.parameter import Parameter
 from physbench.recording import Recording, Track
 from physbench.scene import Scene
 from physbench.trajectory import Trajectory
@@ -38,22 +40,61 @@ if TYPE_CHECKING:
 NUISANCE = ("x0", "y0", "angle0", "vx0", "vy0", "omega0")
 #: Typical size of a change of each nuisance (optimiser scaling and finite-difference unit).
 _NUISANCE_SCALE = {"x0": 0.01, "y0": 0.01, "angle0": 0.01, "vx0": 0.05, "vy0": 0.05, "omega0": 0.05}
+_NUISANCE_UNIT = {
+    "x0": "m",
+    "y0": "m",
+    "angle0": "rad",
+    "vx0": "m/s",
+    "vy0": "m/s",
+    "omega0": "rad/s",
+}
 
 
 @dataclass(frozen=True)
-class Param:
-    """One parameter of a model. ``target`` is the body (``body``/``nuisance``), the effect key
-    (``effect``) or ``force<i>``; ``name`` the bare name (``mass``, ``c``, ``vy0``, ``fx``)."""
+class FitParameter(Parameter):
+    """A :class:`~physbench.parameter.Parameter` that discovery fits. ``owner`` is the body
+    (``body`` and ``nuisance`` kinds), the effect's key (``effect``) or ``force<i>`` (a scheduled
+    force's vector); ``default`` is where the fit starts. Adds ``kind``, ``scale`` (the typical
+    size of a change: the optimiser's and the finite differences' unit), ``run`` (the run a
+    nuisance parameter belongs to) and ``prefix`` (``"<run>/"`` before a nuisance key when there
+    are several runs)."""
 
-    key: str
-    kind: str
-    target: str
-    name: str
-    start: float
-    low: float
-    high: float
-    scale: float
+    default: float = 0.0
+    kind: str = "body"
+    scale: float = 1.0
     run: int | None = None
+    prefix: str = ""
+
+    @property
+    def key(self) -> str:
+        """``"<prefix><owner>.<name>"``: ``ball.mass``, ``linear_drag.c``, ``run2/ball.vy0``."""
+        return f"{self.prefix}{self.owner}.{self.name}"
+
+    @classmethod
+    def of(
+        cls,
+        p: Parameter,
+        *,
+        kind: str,
+        default: float,
+        scale: float,
+        run: int | None = None,
+        prefix: str = "",
+    ) -> FitParameter:
+        """``p`` (name, range, owner, unit, doc) as a parameter to fit from ``default``."""
+        return cls(
+            p.name,
+            p.low,
+            p.high,
+            owner=p.owner,
+            unit=p.unit,
+            default=default,
+            doc=p.doc,
+            kind=kind,
+            scale=scale,
+            run=run,
+            prefix=prefix,
+        )
 
 
 # --------------------------------------------------------------------------- initial state
@@ -155,11 +196,12 @@ def apply_initial(
 
 def nuisance_params(
     run: Run, index: int, prefix: str, names: Sequence[str] | str = "auto"
-) -> list[Param]:
-    """The nuisance parameters of one run. ``"auto"``: angle and rate of every jointed body (when the
-    joints form chains hanging from the world); position and velocity (plus angle and rate when the
-    data hold angles) of every free body moving at t = 0; the vector of every scheduled impulse.
-    ``"none"``: nothing. Or a list of ``body.x0``-style names (``force<i>.fx`` for forces)."""
+) -> list[FitParameter]:
+    """The nuisance parameters of one run. ``"auto"``: angle and rate of every jointed body (when
+    the joints form chains hanging from the world); position and velocity (plus angle and rate
+    when the data hold angles) of every free body moving at t = 0; the vector of every scheduled
+    impulse. ``"none"``: nothing. Or a list of ``body.x0``-style names (``force<i>.fx`` for
+    forces)."""
     scene = run.scene
     parents = chain_parents(scene)
     jointed = {j.a for j in scene.joints} | {j.b for j in scene.joints if j.b is not None}
@@ -188,12 +230,14 @@ def nuisance_params(
             if target.startswith("force") and target[5:].isdigit() and name in ("fx", "fy"):
                 if int(target[5:]) >= len(scene.forces):
                     raise DiscoverError(
-                        f"nuisance {item!r}: scene {scene.name!r} has {len(scene.forces)} forces (force0..force{len(scene.forces) - 1})"
+                        f"nuisance {item!r}: scene {scene.name!r} has {len(scene.forces)} "
+                        f"forces (force0..force{len(scene.forces) - 1})"
                     )
             elif target not in scene.body_names or name not in NUISANCE:
                 raise DiscoverError(
                     f"nuisance {item!r}: expected BODY.NAME with a body of scene {scene.name!r} "
-                    f"({', '.join(scene.body_names)}) and NAME one of {', '.join(NUISANCE)}, or force<i>.fx/fy"
+                    f"({', '.join(scene.body_names)}) and NAME one of {', '.join(NUISANCE)}, "
+                    "or force<i>.fx/fy"
                 )
             elif target in jointed and name not in ("angle0", "omega0"):
                 raise DiscoverError(
@@ -201,7 +245,8 @@ def nuisance_params(
                 )
             elif target in jointed and (parents is None or target not in parents):
                 raise DiscoverError(
-                    f"nuisance {item!r}: the joints of scene {scene.name!r} do not form chains from the world"
+                    f"nuisance {item!r}: the joints of scene {scene.name!r} do not form chains "
+                    "from the world"
                 )
             wanted.append((target, name))
     out = []
@@ -233,64 +278,44 @@ def nuisance_params(
             else:
                 half = max(2.0, abs(start)) if name != "omega0" else max(3.0, abs(start))
                 low, high = start - half, start + half
-        key = f"{prefix}{target}.{name}"
         out.append(
-            Param(
-                key,
-                "nuisance",
-                target,
+            FitParameter(
                 name,
-                float(start),
                 float(low),
                 float(high),
-                float(scale),
+                owner=target,
+                unit=_NUISANCE_UNIT.get(name, ""),
+                default=float(start),
+                kind="nuisance",
+                scale=float(scale),
                 run=index,
+                prefix=prefix,
             )
         )
     return out
 
 
-def body_params(scene: Scene) -> list[Param]:
+def body_params(scene: Scene) -> list[FitParameter]:
     """The scene's declared unknowns, starting from the scene's values (clipped into range)."""
     out = []
     for u in scene.unknowns:
         b = scene.bodies[scene.body_index(u.owner)]
-        v = getattr(b, u.name)
+        v = getattr(b, u.name)  # a body field, named by the validated unknown
         if v is None:  # moment from the shape
             v = b.inertia()
-        out.append(
-            Param(
-                u.key,
-                "body",
-                u.owner,
-                u.name,
-                float(min(max(v, u.low), u.high)),
-                u.low,
-                u.high,
-                0.02 * (u.high - u.low),
-            )
-        )
+        start = float(min(max(v, u.low), u.high))
+        out.append(FitParameter.of(u, kind="body", default=start, scale=0.02 * (u.high - u.low)))
     return out
 
 
-def effect_params(effect: Effect, starts: Mapping[str, float] | None = None) -> list[Param]:
+def effect_params(effect: Effect, starts: Mapping[str, float] | None = None) -> list[FitParameter]:
     """All parameters of ``effect`` under its key, starting at ``starts`` or its current values."""
-    key = str(getattr(effect, "key", effect.name))
-    values = dict(getattr(effect, "values", {}) or {})
     out = []
-    for p in effect.params:
-        v = (starts or {}).get(p.name, values.get(p.name, p.default))
+    for p in effect.parameters():
+        v = (starts or {}).get(p.name, effect.values.get(p.name, p.default))
+        assert v is not None  # every effect parameter has a default
         out.append(
-            Param(
-                f"{key}.{p.name}",
-                "effect",
-                key,
-                p.name,
-                float(v),
-                p.low,
-                p.high,
-                0.01 * (p.high - p.low),
-            )
+            FitParameter.of(p, kind="effect", default=float(v), scale=0.01 * (p.high - p.low))
         )
     return out
 
@@ -350,7 +375,8 @@ class Problem:
             raise DiscoverError("runs with frames need a renderer for the image loss")
 
     def truncated(self, role: str, part: Part, horizon: float) -> tuple[Part, np.ndarray]:
-        """``part`` cut to the first ``horizon`` share of its time span, and its residual weights."""
+        """``part`` cut to the first ``horizon`` share of its time span, and its residual
+        weights."""
         layout = self.layouts[(role, part.run)]
         if horizon >= 1.0:
             return part, layout.weight
@@ -393,7 +419,7 @@ class Model:
     value; :meth:`residuals` simulates the parts of one role with some values overridden."""
 
     def __init__(
-        self, problem: Problem, effects: Sequence[Effect], params: Sequence[Param]
+        self, problem: Problem, effects: Sequence[Effect], params: Sequence[FitParameter]
     ) -> None:
         self.problem = problem
         self.effects = list(effects)
@@ -404,10 +430,10 @@ class Model:
             raise DiscoverError(
                 f"parameter keys {dup} appear twice; give effects of one kind distinct labels"
             )
-        self.values: dict[str, float] = {p.key: p.start for p in self.params}
+        self.values: dict[str, float] = {p.key: p.default for p in self.params}
         self._cache: dict[tuple[Any, ...], np.ndarray] = {}
 
-    def param(self, key: str) -> Param:
+    def param(self, key: str) -> FitParameter:
         for p in self.params:
             if p.key == key:
                 return p
@@ -416,7 +442,8 @@ class Model:
         raise UnknownNameError("model parameter", key, [p.key for p in self.params])
 
     def extended(self, effect: Effect, starts: Mapping[str, float] | None = None) -> Model:
-        """This model plus ``effect`` (its parameters starting at ``starts``), values carried over."""
+        """This model plus ``effect`` (its parameters starting at ``starts``), values carried
+        over."""
         m = Model(
             self.problem, [*self.effects, effect], [*self.params, *effect_params(effect, starts)]
         )
@@ -427,13 +454,13 @@ class Model:
         """How much longer than the data the simulation must run (clock effects)."""
         s = 1.0
         for e in self.effects:
-            if getattr(e, "name", "") == "clock_scale":
-                key = f"{getattr(e, 'key', e.name)}.scale"
-                s = max(s, float(values.get(key, getattr(e, "values", {}).get("scale", 1.0))))
+            if isinstance(e, ClockScale):
+                s = max(s, float(values.get(f"{e.key}.scale", e.values.get("scale", 1.0))))
         return s
 
     def run_scene(self, run: int, values: Mapping[str, float]) -> tuple[Scene, dict[str, float]]:
-        """The run's scene with its nuisance applied, and the body + effect parameters to simulate."""
+        """The run's scene with its nuisance applied, and the body + effect parameters to
+        simulate."""
         state: dict[str, dict[str, float]] = {}
         forces: dict[int, dict[str, float]] = {}
         sim: dict[str, float] = {}
@@ -442,10 +469,10 @@ class Model:
             if p.kind == "nuisance":
                 if p.run != run:
                     continue
-                if p.target.startswith("force") and p.target[5:].isdigit():
-                    forces.setdefault(int(p.target[5:]), {})[p.name] = v
+                if p.owner.startswith("force") and p.owner[5:].isdigit():
+                    forces.setdefault(int(p.owner[5:]), {})[p.name] = v
                 else:
-                    state.setdefault(p.target, {})[p.name] = v
+                    state.setdefault(p.owner, {})[p.name] = v
             else:
                 sim[p.key] = v
         return apply_initial(self.problem.runs[run].scene, state, forces), sim
@@ -518,6 +545,15 @@ class Model:
         train = set(self.problem.split.train_runs)
         return [p.key for p in self.params if p.kind != "nuisance" or p.run in train]
 
+    def without(self, key: str) -> Model:
+        """This model without the effect of ``key`` (and its parameters), at the current values of
+        the others."""
+        effects = [e for e in self.effects if e.key != key]
+        params = [p for p in self.params if not (p.kind == "effect" and p.owner == key)]
+        out = Model(self.problem, effects, params)
+        out.values.update({k: v for k, v in self.values.items() if k in out.values})
+        return out
+
     def copy(self) -> Model:
         m = Model(self.problem, self.effects, self.params)
         m.values = dict(self.values)
@@ -539,8 +575,8 @@ def safe_residuals(
 
 __all__ = [
     "NUISANCE",
+    "FitParameter",
     "Model",
-    "Param",
     "Problem",
     "apply_initial",
     "body_params",

@@ -13,12 +13,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from physbench.discover.phrasing import describe
 from physbench.discover.residuals import EVENTS
 from physbench.discover.verdict import params_text, text
 
 if TYPE_CHECKING:
     from physbench.discover.diagnostics import RunView
-    from physbench.discover.select import Discovery
+    from physbench.discover.results import Discovery
 
 #: Runs and bodies drawn at most (the JSON holds every number).
 MAX_RUNS, MAX_BODIES = 3, 3
@@ -48,8 +49,8 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
 
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
-    base_v = views(disc.base)
-    final_v = views(disc.final) if disc.causes else base_v
+    base_v = views(disc.base.model)
+    final_v = views(disc.final.model) if disc.causes else base_v
     split = disc.split
     cut = (
         {p.run: p.t_end for p in split.fit}
@@ -204,14 +205,17 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
 def _html(disc: Discovery, figures: list[tuple[str, str]]) -> str:
     e = html.escape
     rows = [
-        "<tr><th>round</th><th>effect</th><th>parameters</th><th>held-out error</th><th>gain</th><th>ΔBIC</th><th>verdict</th><th>note</th></tr>",
-        f"<tr><td>0</td><td>base</td><td></td><td>{disc.base.heldout:.5g}</td><td></td><td></td><td></td><td></td></tr>",
+        "<tr><th>round</th><th>effect</th><th>parameters</th><th>held-out error</th>"
+        "<th>gain</th><th>ΔBIC</th><th>verdict</th><th>note</th></tr>",
+        f"<tr><td>0</td><td>base</td><td></td><td>{disc.base.heldout:.5g}</td>"
+        "<td></td><td></td><td></td><td></td></tr>",
     ]
     for c in disc.candidates:
         verdict = "chosen" if c.chosen else ("significant" if c.significant else "")
         rows.append(
-            f"<tr{' class=chosen' if c.chosen else ''}><td>{c.round}</td><td>{e(c.effect)}</td><td>{e(params_text(c))}</td>"
-            f"<td>{c.heldout_error:.5g}</td><td>{c.gain:+.1%}</td><td>{c.delta_criterion:+.1f}</td><td>{verdict}</td><td>{e(c.note)}</td></tr>"
+            f"<tr{' class=chosen' if c.chosen else ''}><td>{c.round}</td><td>{e(c.effect)}</td>"
+            f"<td>{e(params_text(c))}</td><td>{c.heldout_error:.5g}</td><td>{c.gain:+.1%}</td>"
+            f"<td>{c.delta_criterion:+.1f}</td><td>{verdict}</td><td>{e(c.note)}</td></tr>"
         )
     figs = "\n".join(
         f'<figure><img src="{f}" alt="{e(cap)}"><figcaption>{e(cap)}</figcaption></figure>'
@@ -219,19 +223,29 @@ def _html(disc: Discovery, figures: list[tuple[str, str]]) -> str:
     )
     findings: dict[str, Any] = disc.findings
     items = "".join(
-        f"<li>{e(f.text)}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>"
+        f"<li>{e(describe(f))}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>"
         for f in findings.get("base", [])
     )
     title = "physbench discover: " + (", ".join(disc.causes) if disc.causes else "no cause found")
+    style = (
+        "body{font-family:sans-serif;max-width:1100px;margin:1em auto;} "
+        "pre{background:#f6f6f6;padding:.6em;overflow-x:auto;font-size:12px}\n"
+        "table{border-collapse:collapse;font-size:13px} td,th{border:1px solid #ccc;"
+        "padding:2px 6px} tr.chosen{background:#fde2e2}\n"
+        "img{max-width:100%} figcaption{font-size:12px;color:#555}"
+    )
+    gain = (
+        f"Gain on held-out data: <b>{disc.gain:.1%}</b> (held-out error "
+        f"{disc.base.heldout:.5g} → {disc.final.heldout:.5g} {e(disc.unit)})."
+    )
+    none = "<li>no summary statistic stands out from the noise</li>"
     return f"""<!doctype html>
 <html><head><meta charset="utf-8"><title>{e(title)}</title>
-<style>body{{font-family:sans-serif;max-width:1100px;margin:1em auto;}} pre{{background:#f6f6f6;padding:.6em;overflow-x:auto;font-size:12px}}
-table{{border-collapse:collapse;font-size:13px}} td,th{{border:1px solid #ccc;padding:2px 6px}} tr.chosen{{background:#fde2e2}}
-img{{max-width:100%}} figcaption{{font-size:12px;color:#555}}</style></head><body>
+<style>{style}</style></head><body>
 <h1>{e(title)}</h1>
-<p>Gain on held-out data: <b>{disc.gain:.1%}</b> (held-out error {disc.base.heldout:.5g} → {disc.final.heldout:.5g} {e(disc.unit)}).
+<p>{gain}
 Engine {e(disc.engine)}; {e(disc.split.describe(disc.runs))}.</p>
-<h2>What is wrong with the base model</h2><ul>{items or "<li>no summary statistic stands out from the noise</li>"}</ul>
+<h2>What is wrong with the base model</h2><ul>{items or none}</ul>
 <h2>Candidates</h2><table>{"".join(rows)}</table>
 <h2>Figures</h2>{figs}
 <h2>Verdict</h2><pre>{e(text(disc))}</pre>

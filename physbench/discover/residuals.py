@@ -30,7 +30,8 @@ def recording_fields(rec: Recording) -> tuple[str, ...]:
 
 @dataclass(frozen=True, eq=False)
 class Layout:
-    """Per residual entry: body name index, field index (0 x, 1 y, 2 angle, -1 pixel), time, weight."""
+    """Per residual entry: body name index, field index (0 x, 1 y, 2 angle, -1 pixel), time,
+    weight."""
 
     bodies: tuple[str, ...]
     body: np.ndarray

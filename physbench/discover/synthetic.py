@@ -29,7 +29,7 @@ IMPACT_SCENES = ("bouncer", "drops")
 
 
 @dataclass(frozen=True)
-class Case:
+class SyntheticRun:
     """A synthetic run and what is hidden in it (``effect`` None for a control)."""
 
     name: str
@@ -402,7 +402,7 @@ def _record(
     return Recording(tracks, run=scene_kind, fields=fields, source="synthetic")
 
 
-def make_case(effect: str | None, scene_kind: str, seed: int, engine: Any) -> Case:
+def make_case(effect: str | None, scene_kind: str, seed: int, engine: Any) -> SyntheticRun:
     """One synthetic run of ``scene_kind`` (see :data:`SCENES`) with ``effect`` hidden at a random
     magnitude (None: a control), simulated by ``engine`` (a simulator instance)."""
     from physbench.effects import apply_measurements
@@ -423,7 +423,7 @@ def make_case(effect: str | None, scene_kind: str, seed: int, engine: Any) -> Ca
     traj = apply_measurements(engine.simulate(sim_scene, effects=effects), effects)
     rec = _record(scene_kind, scene, traj, t_end, rng)
     name = f"{effect or 'control'}/{scene_kind}/{seed}"
-    return Case(
+    return SyntheticRun(
         name,
         scene_kind,
         Run(name, _blur(scene, rng), recording=rec, source="synthetic"),

@@ -13,24 +13,24 @@ import math
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
+from physbench.discover.phrasing import describe
+
 if TYPE_CHECKING:
-    from physbench.discover.select import CandidateResult, Discovery
+    from physbench.discover.results import CandidateResult, Discovery, Finding
 
 #: Findings shown in the text verdict.
 MAX_FINDINGS = 8
 
 
 def _unit(name: str, param: str) -> str:
-    try:
-        from physbench.plugins import get_registry
+    """The unit of parameter ``param`` of the registered effect ``name`` ("" when unknown)."""
+    from physbench.errors import UnknownNameError
+    from physbench.plugins import get_registry
 
-        cls = get_registry().get("effect", name)
-        for p in cls.params:
-            if p.name == param:
-                return p.unit
-    except Exception:
-        pass
-    return ""
+    try:
+        return get_registry().get("effect", name).param(param).unit
+    except UnknownNameError:
+        return ""
 
 
 def format_value(value: float, err: float | None) -> str:
@@ -57,7 +57,8 @@ def text(disc: Discovery) -> str:
     lines = []
     runs = ", ".join(r.name for r in disc.runs[:6]) + (" ..." if len(disc.runs) > 6 else "")
     lines.append(
-        f"discovery on {len(disc.runs)} run(s) [{runs}] with {disc.engine}; {disc.split.describe(disc.runs)}"
+        f"discovery on {len(disc.runs)} run(s) [{runs}] with {disc.engine}; "
+        f"{disc.split.describe(disc.runs)}"
     )
     b = disc.base
     lines.append(
@@ -76,7 +77,7 @@ def text(disc: Discovery) -> str:
     if fs:
         for f in fs[:MAX_FINDINGS]:
             hint = f"  [-> {', '.join(f.suggests)}]" if f.suggests else ""
-            lines.append(f"  - {f.text}{hint}")
+            lines.append(f"  - {describe(f)}{hint}")
         if len(fs) > MAX_FINDINGS:
             lines.append(f"  - ... {len(fs) - MAX_FINDINGS} more in the JSON")
     else:
@@ -93,13 +94,15 @@ def text(disc: Discovery) -> str:
         )
         for i, c in enumerate(disc.cause_results, 1):
             lines.append(
-                f"  {i}. {c.effect}: {params_text(c)}  (held-out gain {c.gain:+.1%} over the model before it, "
+                f"  {i}. {c.effect}: {params_text(c)}  (held-out gain {c.gain:+.1%} over the "
+                "model before it, "
                 f"ΔBIC {c.delta_criterion:+.1f})"
             )
             alts = disc.alternatives.get(c.effect, [])
             if alts:
                 lines.append(
-                    f"     about as good on held-out data: {', '.join(alts)} (the data hardly tell them apart)"
+                    f"     about as good on held-out data: {', '.join(alts)} (the data hardly "
+                    "tell them apart)"
                 )
             if c.fixed:
                 lines.append(
@@ -108,18 +111,21 @@ def text(disc: Discovery) -> str:
                 )
         f = disc.final
         lines.append(
-            f"extended model: held-out error {f.heldout:.4g} {u} (base {b.heldout:.4g}); gain = 1 - extended/base = {disc.gain:.1%}"
+            f"extended model: held-out error {f.heldout:.4g} {u} (base {b.heldout:.4g}); "
+            f"gain = 1 - extended/base = {disc.gain:.1%}"
         )
     else:
         best = min(disc.candidates, key=lambda c: c.heldout_error, default=None)
         why = (
-            f"; best was {best.effect} with held-out gain {best.gain:+.1%}, ΔBIC {best.delta_criterion:+.1f}"
+            f"; best was {best.effect} with held-out gain {best.gain:+.1%}, "
+            f"ΔBIC {best.delta_criterion:+.1f}"
             if best is not None
             else ""
         )
         lines.append(
-            f"no cause found: no candidate improves the held-out error by >= {disc.settings.min_gain:.0%} with "
-            f"ΔBIC <= -{disc.settings.min_delta_bic:g}{why}. The base model explains the data as well as any extension."
+            "no cause found: no candidate improves the held-out error by >= "
+            f"{disc.settings.min_gain:.0%} with ΔBIC <= -{disc.settings.min_delta_bic:g}{why}. "
+            "The base model explains the data as well as any extension."
         )
     lines.append("")
     lines.append(table(disc))
@@ -131,13 +137,17 @@ def text(disc: Discovery) -> str:
 def table(disc: Discovery) -> str:
     """Every candidate fit, one row each."""
     u = disc.unit
-    head = f"{'round':>5}  {'effect':<32} {'held-out (' + u + ')':>18} {'gain':>8} {'ΔBIC':>9}  verdict   parameters"
+    head = (
+        f"{'round':>5}  {'effect':<32} {'held-out (' + u + ')':>18} {'gain':>8} {'ΔBIC':>9}  "
+        "verdict   parameters"
+    )
     rows = [head, "-" * len(head)]
     rows.append(f"{0:>5}  {'base':<32} {disc.base.heldout:>18.5g} {'':>8} {'':>9}")
     for c in disc.candidates:
         verdict = "CHOSEN" if c.chosen else ("signif." if c.significant else "-")
         rows.append(
-            f"{c.round:>5}  {c.effect:<32} {c.heldout_error:>18.5g} {c.gain:>+8.1%} {c.delta_criterion:>+9.1f}  "
+            f"{c.round:>5}  {c.effect:<32} {c.heldout_error:>18.5g} {c.gain:>+8.1%} "
+            f"{c.delta_criterion:>+9.1f}  "
             f"{verdict:<8}  {params_text(c, units=False)}"
         )
     return "\n".join(rows)
@@ -182,7 +192,7 @@ def to_dict(disc: Discovery) -> dict[str, Any]:
                 "train_runs": [disc.runs[i].name for i in disc.split.train_runs],
                 "test_runs": [disc.runs[i].name for i in disc.split.test_runs],
             },
-            "findings": {k: [f.to_dict() for f in v] for k, v in disc.findings.items()},
+            "findings": {k: [finding_dict(f) for f in v] for k, v in disc.findings.items()},
             "residuals": {k: v.to_dict() for k, v in disc.breakdowns.items()},
             "skipped": [{"effect": n, "reason": r} for n, r in disc.skipped],
             "settings": {
@@ -192,6 +202,18 @@ def to_dict(disc: Discovery) -> dict[str, Any]:
             "seconds": disc.seconds,
         }
     )
+
+
+def finding_dict(f: Finding) -> dict[str, Any]:
+    """One finding in the JSON: where, the sentence, the numbers and the effects it points at."""
+    return {
+        "kind": f.kind,
+        "run": f.run,
+        "body": f.body,
+        "text": describe(f),
+        "values": {k: float(v) for k, v in f.values.items()},
+        "suggests": list(f.suggests),
+    }
 
 
 def to_json(disc: Discovery, **kwargs: Any) -> str:

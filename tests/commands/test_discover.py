@@ -1,14 +1,22 @@
-"""Bad recordings, scenes and options given to ``physbench discover`` fail with named errors: exit
-code 2 and a message that names the bad value and what would be accepted."""
+"""``physbench discover``: the verdict it prints and writes, frames input with a renderer chosen by
+name, and bad recordings, scenes and options failing with named errors (exit code 2 and a message
+that names the bad value and what would be accepted)."""
 
 from __future__ import annotations
 
+import json
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from physbench.cli import main as cli
+from physbench.effects import LinearDrag
+from physbench.recording import Recording, Track, write_recordings
+from physbench.scene import Body, Circle, Scene
+from physbench.scene_toml import save_scene
+from physbench.simulators.pymunk_sim import PymunkSimulator
 
 SCENE = """
 name = "slide"
@@ -164,8 +172,6 @@ def test_bad_input_gives_a_named_error(tmp_path, monkeypatch, capsys, files, arg
     assert cli(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("physbench discover: error: ")
-    import re
-
     assert re.search(message, err, re.S), err
 
 
@@ -175,7 +181,92 @@ def test_bad_input_gives_a_named_error(tmp_path, monkeypatch, capsys, files, arg
 def test_bad_frames_give_a_named_error(tmp_path, capsys, arrays, message):
     write(tmp_path, "s.toml", GOOD_SCENE)
     assert cli(["discover", npz(tmp_path, **arrays), "--scene", str(tmp_path / "s.toml")]) == 2
-    import re
-
     err = capsys.readouterr().err
     assert re.search(message, err, re.S), err
+
+
+RENDERER_CASES = [
+    ("unknown renderer", ["--renderer", "nope"], r"unknown renderer 'nope'.*raster"),
+    ("option it does not take", ["-R", "nope=1"], r"renderer 'raster' does not take options"),
+    (
+        "mode against the channels",
+        ["--render-mode", "mark"],
+        r"\(C, H, W\) = \(1, 36, 48\) but the 'raster' renderer in 'mark' mode gives \(2, 36, 48\)",
+    ),
+    ("width against the frames", ["--resolution", "24"], r"gives \(1, 18, 24\)"),
+]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"), [c[1:] for c in RENDERER_CASES], ids=[c[0] for c in RENDERER_CASES]
+)
+def test_the_renderer_of_frames_is_checked_against_them(tmp_path, capsys, args, message):
+    write(tmp_path, "s.toml", GOOD_SCENE)
+    frames = npz(tmp_path, frames=np.zeros((21, 1, 36, 48), np.float32))
+    assert cli(["discover", frames, "--scene", str(tmp_path / "s.toml"), *args]) == 2
+    err = capsys.readouterr().err
+    assert re.search(message, err, re.S), err
+
+
+def slide() -> Scene:
+    return Scene(
+        "slide",
+        (Body("ball", Circle(0.05), (1.0, 1.0), velocity=(2.0, 0.5), mass=1.0),),
+        bounds=(-3, -3, 9, 6),
+        gravity=(0.0, 0.0),
+        fps=20.0,
+        frames=41,
+        substeps=4,
+    ).validate()
+
+
+def noisy(traj, sigma=0.002, seed=0) -> Recording:
+    rng = np.random.default_rng(seed)
+    rec = Recording.from_trajectory(traj)
+    tracks = {
+        b: Track(t.t, t.x + rng.normal(0, sigma, len(t)), t.y + rng.normal(0, sigma, len(t)))
+        for b, t in rec.tracks.items()
+    }
+    return Recording(tracks, fields=("x", "y"))
+
+
+def test_frames_input_uses_the_image_loss(tmp_path):
+    from physbench.observation import Observation, save_observation
+    from physbench.render.raster import RasterRenderer
+
+    scene = Scene(
+        "frames",
+        (Body("ball", Circle(0.3), (1.0, 2.0), velocity=(2.5, 0.3), mass=1.0),),
+        bounds=(0, 0, 6, 4),
+        gravity=(0.0, 0.0),
+        fps=10.0,
+        frames=21,
+        substeps=4,
+    ).validate()
+    r = RasterRenderer(resolution=32, mode="mask")
+    frames = r.render(scene, PymunkSimulator().simulate(scene, effects=[LinearDrag(c=0.5)]))
+    save_observation(tmp_path / "obs.npz", Observation(frames))
+    save_scene(scene, tmp_path / "scene.toml")
+    out = tmp_path / "v.json"
+    argv = ["discover", str(tmp_path / "obs.npz"), "--scene", str(tmp_path / "scene.toml")]
+    rc = cli([*argv, "--effects", "linear_drag", "rolling_resistance", "--json", str(out), "-q"])
+    assert rc == 0
+    d = json.loads(out.read_text())
+    assert d["causes"] == ["linear_drag"] and d["unit"] == "pixel intensity"
+    c = next(c for c in d["candidates"] if c["chosen"])
+    assert c["params"]["c"] == pytest.approx(0.5, rel=0.15)
+
+
+def test_cli_prints_the_verdict_and_the_table(tmp_path, capsys):
+    scene = slide()
+    rec = noisy(PymunkSimulator().simulate(scene))
+    write_recordings(tmp_path / "r.csv", rec)
+    save_scene(scene, tmp_path / "s.toml")
+    argv = ["discover", str(tmp_path / "r.csv"), "--scene", str(tmp_path / "s.toml")]
+    rc = cli(
+        [*argv, "--effects", "linear_drag", "constant_force", "--report", str(tmp_path / "rep")]
+    )
+    out = capsys.readouterr().out
+    assert rc == 0
+    assert "no cause found" in out and "linear_drag" in out and "held-out" in out
+    assert (tmp_path / "rep" / "index.html").is_file()

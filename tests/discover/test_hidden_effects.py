@@ -1,12 +1,12 @@
-"""Hidden-effect tests: for every effect in the library, synthetic recordings made with that effect at
-a random magnitude plus tracking noise, in two scenes each and in both engines, must be diagnosed
-with that effect named first and its magnitude within 15 %; control recordings without a hidden
-effect must produce no cause.
+"""Hidden-effect tests: for every effect in the library, synthetic recordings made with that effect
+at a random magnitude plus tracking noise, in two scenes each and in both engines, must be
+diagnosed with that effect named first and its magnitude within 15 %; control recordings without a
+hidden effect must produce no cause.
 
-Cases come from seeds (:func:`physbench.discover.synthetic.make_case`). ``PHYSBENCH_DISCOVERY_SEEDS``
-(e.g. ``0,1,2,3``) runs more seeds; the default, one seed, keeps the suite within its CI budget.
-``PHYSBENCH_DISCOVERY_LOG=FILE`` appends one JSON line per case (causes, magnitude error, gain) to
-``FILE``, for the table in docs/discover.md.
+Synthetic runs come from seeds (:func:`physbench.discover.synthetic.make_case`).
+``PHYSBENCH_DISCOVERY_SEEDS`` (e.g. ``0,1,2,3``) runs more seeds; the default, one seed, keeps the
+suite within its CI budget. ``PHYSBENCH_DISCOVERY_LOG=FILE`` appends one JSON line per case
+(causes, magnitude error, gain) to ``FILE``, for the table in docs/discover.md.
 """
 
 from __future__ import annotations
@@ -73,10 +73,10 @@ def test_every_effect_in_the_library_has_hidden_effect_scenes():
 )
 def test_hidden_effect_is_named_with_its_magnitude(effect, scene, engine, seed):
     sim = ENGINES[engine]()
-    case = make_case(effect, scene, seed, sim)
-    disc = discover([case.run], sim, diagnose=False)
+    synthetic = make_case(effect, scene, seed, sim)
+    disc = discover([synthetic.run], sim, diagnose=False)
     found = disc.cause_results[0] if disc.causes[:1] == [effect] else None
-    err = magnitude_error(effect, case.truth, found.params) if found is not None else None
+    err = magnitude_error(effect, synthetic.truth, found.params) if found is not None else None
     _log(
         effect=effect,
         scene=scene,
@@ -85,16 +85,17 @@ def test_hidden_effect_is_named_with_its_magnitude(effect, scene, engine, seed):
         causes=disc.causes,
         error=err,
         gain=disc.gain,
-        truth=case.truth,
+        truth=synthetic.truth,
         fitted=found.params if found is not None else None,
         seconds=disc.seconds,
     )
     assert disc.causes[:1] == [effect], (
-        f"{case.name} [{engine}]: causes {disc.causes}, truth {case.truth}"
+        f"{synthetic.name} [{engine}]: causes {disc.causes}, truth {synthetic.truth}"
     )
     assert found is not None and err is not None
     assert err <= TOLERANCE, (
-        f"{case.name} [{engine}]: fitted {found.params}, truth {case.truth} ({err:.1%} off)"
+        f"{synthetic.name} [{engine}]: fitted {found.params}, truth {synthetic.truth} "
+        f"({err:.1%} off)"
     )
     assert disc.gain > 0.5
 
@@ -104,8 +105,8 @@ def test_hidden_effect_is_named_with_its_magnitude(effect, scene, engine, seed):
 )
 def test_control_without_a_hidden_effect_produces_no_cause(scene, engine, seed):
     sim = ENGINES[engine]()
-    case = make_case(None, scene, seed, sim)
-    disc = discover([case.run], sim, diagnose=False)
+    synthetic = make_case(None, scene, seed, sim)
+    disc = discover([synthetic.run], sim, diagnose=False)
     _log(
         effect=None,
         scene=scene,
@@ -115,6 +116,10 @@ def test_control_without_a_hidden_effect_produces_no_cause(scene, engine, seed):
         gain=disc.gain,
         seconds=disc.seconds,
     )
-    assert disc.causes == [], f"{case.name} [{engine}]: false alarm {disc.causes} " + ", ".join(
-        f"{c.effect} gain {c.gain:+.1%} ΔBIC {c.delta_criterion:+.1f}" for c in disc.cause_results
+    assert disc.causes == [], (
+        f"{synthetic.name} [{engine}]: false alarm {disc.causes} "
+        + ", ".join(
+            f"{c.effect} gain {c.gain:+.1%} ΔBIC {c.delta_criterion:+.1f}"
+            for c in disc.cause_results
+        )
     )

@@ -1,0 +1,69 @@
+"""Every knob of a discovery, in one frozen value that each stage takes.
+
+The defaults are the calibrated ones: the significance thresholds (``min_gain``,
+``min_delta_bic``) were set on control recordings (no hidden effect, both engines), see
+``docs/discover.md``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from physbench.discover.data import DiscoverError
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Every knob of a discovery (defaults are the calibrated ones)."""
+
+    effects: Sequence[str] | None = None  # candidate effect names (None: every registered one)
+    holdout: float = 0.3  # share of the data held out
+    split: str = "auto"  # time | runs | auto
+    lead: float = 0.25  # share of a held-out run that fits its initial state
+    nuisance: Sequence[str] | str = "auto"
+    estimator: str = "lsq"  # base fit: lsq, or a registered estimator followed by lsq
+    estimator_iterations: int = 60
+    estimator_options: dict[str, Any] | None = None
+    seed: int = 0
+    min_gain: float = 0.1
+    min_delta_bic: float = 10.0
+    max_causes: int = 3
+    shortlist: int = 4
+    max_nfev: int = 30
+    base_max_nfev: int = 60
+    #: Most simulations of one candidate fit per continuation horizon (the base fit gets twice).
+    budget: int = 120
+    #: Contact scenes: simulations of a candidate's quick screening fit, and how many candidates
+    #: per round then get the full fit.
+    quick_budget: int = 40
+    screen: int = 3
+    #: Finite-difference step in units of each parameter's scale: large enough to step over the
+    #: saw-tooth that contact detection at discrete steps puts into the residuals.
+    diff_step: float = 0.3
+    #: Continuation horizons (shares of each fitted part, fitted in turn); None: (0.5, 1) for
+    #: scenes with contacts, where late bounces make the fit multimodal, else (1,).
+    horizons: Sequence[float] | None = None
+    #: Candidates whose held-out error is within this factor of the chosen one's are reported as
+    #: explaining the data about as well.
+    ambiguity: float = 0.05
+
+    def __post_init__(self) -> None:
+        for name, v in (("min_gain", self.min_gain), ("ambiguity", self.ambiguity)):
+            if isinstance(v, bool) or not isinstance(v, int | float) or not 0 <= v < 1:
+                raise DiscoverError(f"{name} = {v!r}: expected a number in [0, 1)")
+        counts = {
+            "max_causes": self.max_causes,
+            "shortlist": self.shortlist,
+            "max_nfev": self.max_nfev,
+            "base_max_nfev": self.base_max_nfev,
+            "budget": self.budget,
+            "quick_budget": self.quick_budget,
+            "screen": self.screen,
+        }
+        for name, n in counts.items():
+            if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+                raise DiscoverError(f"{name} = {n!r}: expected a whole number >= 1")
+        if not isinstance(self.min_delta_bic, int | float) or self.min_delta_bic < 0:
+            raise DiscoverError(f"min_delta_bic = {self.min_delta_bic!r}: expected a number >= 0")

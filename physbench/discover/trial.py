@@ -1,0 +1,230 @@
+"""Trying one candidate effect on top of a fitted model: extend the model, fit the extension, score
+it on the held-out data and judge it against the model it extends (:func:`try_effect`).
+
+The heuristics that make local fits of an extended model reliable live here too: new effect
+parameters get steps sized from their sensitivity (:func:`rescale`), a fit in a contact scene
+restarts the initial state from the data before the first impact (:func:`restart_nuisance`), and
+:func:`refit` checks whether a model fits better from another model's optimum. These update a
+model's values and scales in place, like the least-squares fit itself.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import replace
+
+import numpy as np
+
+from physbench.discover.candidates import CandidateSpec, start_values
+from physbench.discover.fit import (
+    budget,
+    fit_model,
+    is_rough,
+    least_squares,
+    probe_start,
+    score,
+)
+from physbench.discover.model import Model
+from physbench.discover.residuals import EVENTS, frame_events
+from physbench.discover.results import CandidateResult, FitResult, Scored, Skipped
+from physbench.discover.sensitivity import unit_sensitivity, visible
+from physbench.discover.settings import Settings
+from physbench.discover.significance import judge
+from physbench.errors import SimulationError
+
+
+def try_effect(
+    current: Scored,
+    effect: CandidateSpec | str,
+    settings: Settings | None = None,
+    *,
+    base: Scored | None = None,
+    round: int = 1,
+    quick: bool = False,
+) -> CandidateResult | Skipped:
+    """Fit ``current``'s model plus ``effect`` (a registered name or a :class:`CandidateSpec`)
+    jointly, score it on the held-out data and judge it against ``current`` (gains against
+    ``base`` too; default ``current``). Returns :class:`Skipped` when the effect does not simulate
+    or the data cannot see any of its parameters. ``quick``: one horizon from the current optimum
+    with a small budget (the screening fit of contact scenes)."""
+    settings = settings or Settings()
+    spec = effect if isinstance(effect, CandidateSpec) else CandidateSpec(effect)
+    base = current if base is None else base
+    eff = spec.make()
+    scene = current.model.problem.runs[0].scene
+    fitted = scene.with_params(
+        {p.key: current.model.values[p.key] for p in current.model.params if p.kind == "body"}
+    )
+    model = current.model.extended(eff, start_values(eff, fitted))
+    key = eff.key
+    own = [p.key for p in model.params if p.kind == "effect" and p.owner == key]
+    try:
+        seen = [k for k in own if visible(model, k)]
+    except SimulationError as exc:
+        return Skipped(spec.label, f"does not simulate: {exc}")
+    if not seen:
+        return Skipped(spec.label, "none of its parameters changes the fitted data")
+    fixed = {k.rpartition(".")[2]: model.values[k] for k in own if k not in seen}
+    free = [*current.fit.free, *seen]
+    rough = is_rough(current.model.problem.runs)
+    # The causes already in the model were scaled against the misfit of the model they extended;
+    # near the current, better optimum those steps are far too large for finite differences (the
+    # cause would not move and the new effect could not trade off against it): rescale them too.
+    # Not in rough scenes, whose large steps are meant to average over the contact saw-tooth.
+    earlier = (
+        []
+        if rough
+        else [
+            p.key
+            for p in model.params
+            if p.kind == "effect" and p.owner != key and p.key in current.fit.free
+        ]
+    )
+    rescale(
+        model,
+        {k: unit_sensitivity(model, k, rough) for k in [*seen, *earlier]},
+        current.fit.rms,
+    )
+    for k in seen:  # off the bound: a bounded least-squares step from a bound can stall there
+        p = model.param(k)
+        v = model.values[k]
+        if v <= p.low:
+            model.values[k] = min(p.low + p.scale, p.high)
+        elif v >= p.high:
+            model.values[k] = max(p.high - p.scale, p.low)
+    if quick:
+        probe_start(model, seen)
+        fr = least_squares(
+            model,
+            free,
+            max_nfev=settings.max_nfev,
+            budget=max(settings.quick_budget, 3 * (len(free) + 1)),
+            diff_step=settings.diff_step,
+        )
+    else:
+        fr = _full_fit(model, current, settings, free, seen, earlier)
+    if fr.ssr > current.fit.ssr:
+        # Worse than the model it extends (the fit stalled away from the effect's neutral start):
+        # the extended model can always do at least as well with the effect switched off.
+        model.values = {**current.model.values, **{k: model.param(k).default for k in own}}
+        fr = FitResult(
+            dict(model.values),
+            list(free),
+            {k: current.fit.stderr.get(k, math.nan) for k in free},
+            current.fit.ssr,
+            current.fit.n,
+            fr.nfev,
+            fr.simulations,
+            "no better than the current model",
+        )
+    scored = score(f"{current.label} + {key}", (*current.causes, key), model, fr)
+    c = CandidateResult(
+        round=round,
+        effect=key,
+        name=eff.name,
+        params={k.rpartition(".")[2]: model.values[k] for k in seen},
+        stderr={k.rpartition(".")[2]: fr.stderr.get(k, math.nan) for k in seen},
+        fixed=fixed,
+        heldout_error=scored.heldout,
+        gain=0.0,
+        gain_vs_base=0.0,
+        criterion=scored.bic,
+        delta_criterion=0.0,
+        significant=False,
+        scored=scored,
+        quick=quick,
+    )
+    return judge(c, current, base, settings)
+
+
+def _full_fit(
+    model: Model,
+    current: Scored,
+    settings: Settings,
+    free: list[str],
+    seen: list[str],
+    earlier: list[str],
+) -> FitResult:
+    """The full fit of an extended model, restarted in contact scenes, and retried once from
+    further in when it stays stuck at its start on top of earlier causes."""
+    if is_rough(current.model.problem.runs):
+        # The current optimum's initial state was bent to make up for what the current model
+        # lacks; in a contact scene that start traps the extended fit. Start it afresh.
+        restart_nuisance(model, settings)
+    before = dict(model.values)
+    fr = fit_model(model, settings, base=False, free=free, probe=seen)
+    if (
+        fr.ssr > current.fit.ssr
+        and earlier
+        and all(abs(model.values[k] - before[k]) < 1e-3 * model.param(k).scale for k in seen)
+    ):
+        # Stuck where it started, on top of earlier causes: the step to where the new effect
+        # trades off against them can be too long for a local fit. Once more, from further in.
+        model.values = {
+            **before,
+            **{k: min(before[k] + 3.0 * model.param(k).scale, model.param(k).high) for k in seen},
+        }
+        again = fit_model(model, settings, base=False, free=free)
+        if again.ssr < fr.ssr:
+            fr = again
+    return fr
+
+
+def rescale(model: Model, sens: Mapping[str, float], target: float) -> None:
+    """Give each parameter in ``sens`` the scale (optimiser unit, finite-difference unit and probe
+    unit) whose change moves the residuals by about ``target`` RMS, from its sensitivity per unit
+    (:func:`~physbench.discover.sensitivity.unit_sensitivity`): effect ranges are generous and say
+    little about the size that matters, and a step that is too small only sees the saw-tooth of
+    contact detection. Replaces ``model.params`` in place (its residual cache stays valid)."""
+    out = []
+    for p in model.params:
+        s = sens.get(p.key, math.nan)
+        if math.isfinite(s) and s > 0 and target > 0:
+            span = p.high - p.low
+            p = replace(p, scale=float(min(max(target / s, 1e-5 * span), 0.2 * span)))
+        out.append(p)
+    model.params = out
+
+
+def restart_nuisance(model: Model, settings: Settings) -> None:
+    """Reset the nuisance to the scene's values and fit it alone on the data before the first
+    impact, where the effects at stake barely act yet (in place)."""
+    nuis = [p for p in model.params if p.kind == "nuisance"]
+    model.values.update({p.key: p.default for p in nuis})
+    train = set(model.problem.split.train_runs)
+    keys = [p.key for p in nuis if p.run in train]
+    if not keys:
+        return
+    share = 1.0
+    for part in model.problem.split.fit:
+        try:
+            _traj, measured = model.simulate(part.run, model.values, part.t_end)
+        except SimulationError:
+            continue
+        ev = frame_events(model.run_scene(part.run, model.values)[0], measured)
+        hits = np.nonzero((ev == EVENTS.index("impact")).any(axis=1))[0]
+        t0 = float(model.problem.layouts[("fit", part.run)].t.min())
+        if hits.size and part.t_end > t0:
+            share = min(share, (float(measured.times[hits[0]]) - t0) / (part.t_end - t0))
+    share = min(max(share * 0.9, 0.15), 0.5)
+    least_squares(
+        model,
+        keys,
+        max_nfev=settings.max_nfev,
+        budget=budget(settings, len(keys)),
+        diff_step=settings.diff_step,
+        horizons=(share,),
+        final=False,
+    )
+
+
+def refit(current: Scored, other: Model, settings: Settings) -> Scored | None:
+    """``current``'s model refitted from ``other``'s values of the parameters they share; the
+    refit when it fits better than ``current``, else None."""
+    m = current.model.copy()
+    m.values.update({k: v for k, v in other.values.items() if k in m.values})
+    fr = fit_model(m, settings, base=False, free=current.fit.free)
+    if fr.ssr >= current.fit.ssr * (1 - 1e-6):
+        return None
+    return score(current.label, current.causes, m, fr)
