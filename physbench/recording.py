@@ -29,9 +29,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from physbench.errors import PhysbenchError
+from physbench.scene import Scene
 
 if TYPE_CHECKING:
-    from physbench.scene import Scene
     from physbench.trajectory import Trajectory
 
 REQUIRED_COLUMNS = ("t", "body", "x", "y")
@@ -313,8 +313,7 @@ def _interpolate(
 def _known_bodies(bodies: Scene | Iterable[str] | None) -> tuple[str, ...] | None:
     if bodies is None:
         return None
-    names = getattr(bodies, "body_names", None)
-    return tuple(names) if names is not None else tuple(bodies)  # type: ignore[arg-type]
+    return bodies.body_names if isinstance(bodies, Scene) else tuple(bodies)
 
 
 def parse_recordings(

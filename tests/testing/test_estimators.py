@@ -84,13 +84,19 @@ class Nameless(Base):
     name: ClassVar[str] = ""
 
 
-class NoPerObject:
-    name: ClassVar[str] = "no_per_object"
+class OutsideTheContract:
+    """Duck-typed: the right methods, but not a CorrectionEstimator."""
+
+    name: ClassVar[str] = "outside"
 
     def start(self, task: Task, *, seed: int) -> None: ...
 
     def propose(self, step: Step) -> Params:
         return {}
+
+
+class PerObjectNotABool(Base):
+    per_object: ClassVar[bool] = "yes"  # type: ignore[assignment]
 
 
 class SwallowsOptions(Base):
@@ -170,8 +176,10 @@ def test_classes_the_child_cannot_import_are_explained() -> None:
 def test_protocol_shape() -> None:
     with pytest.raises(ConformanceError, match="'name' must be a non-empty string"):
         check_protocol(Nameless)
+    with pytest.raises(ConformanceError, match=r"does not subclass .*CorrectionEstimator"):
+        check_protocol(OutsideTheContract)
     with pytest.raises(ConformanceError, match="'per_object' must be True or False"):
-        check_protocol(NoPerObject)
+        check_protocol(PerObjectNotABool)
     with pytest.raises(ConformanceError, match=r"Base\(\*\*\{'width': 5\}\) raised PhysbenchError"):
         check_protocol(Base, width=5)
 
