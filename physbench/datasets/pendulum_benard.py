@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from physbench.datasets._arms import Arm, chain, chain_tracks
+from physbench.datasets.arms import Arm, chain, chain_tracks
 from physbench.datasets.files import DatasetError, data_dir
 from physbench.datasets.run import DatasetRun
 from physbench.recording import Recording
