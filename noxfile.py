@@ -1,4 +1,5 @@
-"""Developer sessions: ``nox -s tests``, ``nox -s lint``, ``nox -s bench``, ``nox -s regression``."""
+"""Developer sessions: ``nox -s tests``, ``nox -s lint``, ``nox -s bench``,
+``nox -s regression``."""
 
 from __future__ import annotations
 
@@ -21,7 +22,8 @@ def tests(session: nox.Session) -> None:
 @nox.session
 def lint(session: nox.Session) -> None:
     session.install("ruff>=0.5")
-    session.run("ruff", "check", "physbench", "tests", "benchmarks", "plugins")
+    session.run("ruff", "check", ".")
+    session.run("ruff", "format", "--check", ".")
 
 
 @nox.session
@@ -35,7 +37,8 @@ def bench(session: nox.Session) -> None:
 def regression(session: nox.Session) -> None:
     """Rerun benchmarks/smoke.toml from scratch and compare it with results/baseline; fails when an
     estimator x scene x unknown set got significantly worse (see `physbench compare --help`).
-    In an environment where physbench is already installed (CI): nox --no-venv --no-install -s regression."""
+    In an environment where physbench is already installed (CI):
+    nox --no-venv --no-install -s regression."""
     session.install("-e", ".")
     out = Path(session.create_tmp()) / "smoke"
     # --fresh: resuming would reuse the cells of the last session instead of testing this code

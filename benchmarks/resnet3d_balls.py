@@ -29,7 +29,8 @@ def main(seeds: int = 10) -> int:
         )
         a2, a11 = (np.array([r[n] for r in rows]) for n in (2, 11))
         print(
-            f"| {k} | {a2.mean():.2e} ± {a2.std(ddof=1):.1e} | {a11.mean():.2e} ± {a11.std(ddof=1):.1e} | "
+            f"| {k} | {a2.mean():.2e} ± {a2.std(ddof=1):.1e} | "
+            f"{a11.mean():.2e} ± {a11.std(ddof=1):.1e} | "
             f"{a2.mean() / a11.mean():.2f} | {seeds} |",
             flush=True,
         )

@@ -1,8 +1,8 @@
 """Train every shipped resnet3d model (the rows of the paper's Table 1), in parallel.
 
     python benchmarks/train_resnet3d.py --device cuda --minutes 18 --workers 2 --parallel 8
-    python benchmarks/train_resnet3d.py --install          # copy finished weights into the package
-    python benchmarks/train_resnet3d.py --only three_circles__mass --minutes 45   # one row, on a CPU
+    python benchmarks/train_resnet3d.py --install     # copy finished weights into the package
+    python benchmarks/train_resnet3d.py --only three_circles__mass --minutes 45  # one row, CPU
 
 Each row runs ``physbench train`` in its own process (logs in ``runs/train/NAME/log.txt``);
 ``--pack DIR`` writes int8 copies of the best weights so far (finished or not) into tar files of

@@ -1,4 +1,5 @@
-"""The committed held-out evaluation of ``resnet3d`` (``results/resnet3d``) and the claims drawn from it.
+"""The committed held-out evaluation of ``resnet3d`` (``results/resnet3d``) and the claims drawn
+from it.
 
 The sweep itself (``physbench bench benchmarks/resnet3d.toml``, minutes on 2 cores) is a benchmark,
 not a test; these tests check that the committed table is generated from the committed results and
@@ -42,7 +43,8 @@ def _resnet3d_after_11(
 def test_committed_table_is_generated_from_the_committed_results() -> None:
     expected = table(RESULTS) + "\n"
     assert (RESULTS / "table.md").read_text() == expected, (
-        "results/resnet3d/table.md is stale: python benchmarks/resnet3d_table.py results/resnet3d > results/resnet3d/table.md"
+        "results/resnet3d/table.md is stale: python benchmarks/resnet3d_table.py results/resnet3d "
+        "> results/resnet3d/table.md"
     )
 
 
