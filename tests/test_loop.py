@@ -125,6 +125,10 @@ def test_history_round_trips_through_json_and_pandas() -> None:
     frame = h.to_frame()
     assert list(frame.index) == list(range(5))
     assert {"loss", "nmse", "best_nmse", "t_simulate", *h.keys} <= set(frame.columns)
+    # JSON written before the renames: "records" and "min_nmse" (0.1)
+    old = {k: v for k, v in d.items() if k not in ("iterations", "best_nmse")}
+    old.update(records=d["iterations"], min_nmse=d["best_nmse"])
+    assert History.from_dict(old).to_dict() == h.to_dict()
 
 
 def test_seeds_are_derived_from_one_seed_sequence() -> None:
