@@ -196,7 +196,7 @@ def run_config(
     from physbench.observation import load_observation, simulate_observation
     from physbench.observation import save_observation as save_obs
     from physbench.plugins import create
-    from physbench.render.base import ObservationModel
+    from physbench.render.observe import ObservationModel
     from physbench.scenes import resolve_scene
 
     scene = resolve_scene(config.scene, config.seed)

@@ -28,7 +28,8 @@ from physbench.errors import PhysbenchError
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
     from physbench.params import Params
-    from physbench.render.base import ObservationModel, Renderer
+    from physbench.render.base import Renderer
+    from physbench.render.observe import ObservationModel
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
 

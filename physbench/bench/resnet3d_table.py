@@ -1,4 +1,4 @@
-"""The tables of the learned estimator's evaluation sweep (``benchmarks/resnet3d.toml``, issue 4).
+"""The tables of the learned estimator's evaluation sweep (``benchmarks/resnet3d.toml``).
 
 1. The criteria, for ``resnet3d`` per Table 1 row: the paper's NN value, normalized min MSE after
    2 and after 11 iterations, their ratio, and the ratio of blurred to sharp after 11 iterations.

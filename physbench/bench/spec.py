@@ -416,7 +416,7 @@ def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
     before anything runs; errors name the spec file and the key."""
     from physbench.experiment import config_space, make_estimator, make_renderer
     from physbench.plugins import get_registry
-    from physbench.render.base import ObservationModel
+    from physbench.render.observe import ObservationModel
     from physbench.scenes import resolve_scene
 
     reg = get_registry()

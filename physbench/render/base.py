@@ -7,14 +7,13 @@ pose, a background, ...) is its own keyword option, given on the command line wi
 ``--renderer-option KEY=VALUE`` and in a sweep spec as ``renderer = {name = ..., options = {...}}``.
 
 An observation model (camera blur, pixel noise) is not part of a renderer: the framework applies
-:class:`ObservationModel` to the observed frames only, whatever renderer made them.
+:class:`~physbench.render.observe.ObservationModel` to the observed frames only, whatever renderer
+made them.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
@@ -99,52 +98,3 @@ class Renderer:
             states[0, i, :3] = (*b.position, b.angle)
         frame = self.render(scene, Trajectory(scene.body_names, np.zeros(1), states))
         return (scene.frames if frames is None else frames, *frame.shape[1:])  # type: ignore[return-value]
-
-
-def _nonneg(name: str, value: object) -> float:
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, int | float)
-        or not math.isfinite(value)
-        or value < 0
-    ):
-        raise RenderError(f"{name} = {value!r}: expected a finite number >= 0")
-    return float(value)
-
-
-@dataclass(frozen=True)
-class ObservationModel:
-    """How a camera degrades what a renderer draws: Gaussian blur of ``blur`` pixels, then
-    Gaussian pixel noise of standard deviation ``noise`` (drawn from ``seed`` afresh for every
-    call, so an observation is a pure function of its inputs), clipped to [0, 1]. Applied to
-    observed frames only; the model's frames stay sharp."""
-
-    blur: float = 0.0
-    noise: float = 0.0
-    seed: int = 0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "blur", _nonneg("blur", self.blur))
-        object.__setattr__(self, "noise", _nonneg("noise", self.noise))
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int | np.integer):
-            raise RenderError(f"seed = {self.seed!r}: expected a whole number")
-
-    @property
-    def identity(self) -> bool:
-        return self.blur == 0 and self.noise == 0
-
-    def apply(self, frames: np.ndarray) -> np.ndarray:
-        """Called on every observed view: ``frames`` degraded (in place when float32)."""
-        if self.identity:
-            return frames
-        from physbench.render.observe import add_noise, gaussian_blur
-
-        out = np.asarray(frames, dtype=np.float32)
-        if self.blur > 0:
-            out[...] = gaussian_blur(out, self.blur)
-        if self.noise > 0:
-            out[...] = add_noise(out, self.noise, np.random.default_rng(int(self.seed)))
-        return out
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"blur": self.blur, "noise": self.noise, "seed": int(self.seed)}

@@ -1,5 +1,4 @@
-"""The renderer contract's defaults (resolution and mode checks, ``shape`` from a still) and the
-observation model (blur, noise) that the framework applies to observed frames of any renderer."""
+"""The renderer contract's defaults: resolution and mode checks, ``shape`` from a still."""
 
 from __future__ import annotations
 
@@ -10,13 +9,10 @@ import pytest
 
 from physbench.render.base import (
     MODES,
-    ObservationModel,
     Renderer,
     RenderError,
     check_resolution,
 )
-from physbench.render.observe import gaussian_blur
-from physbench.render.raster import RasterRenderer
 from physbench.scene import Body, Box, Circle, Scene
 from physbench.trajectory import Trajectory
 
@@ -59,38 +55,3 @@ def test_modes_and_resolution_are_checked_for_every_renderer() -> None:
     for bad in (0, True, 2.5, (64,), "64"):
         with pytest.raises(RenderError, match="resolution = "):
             check_resolution(bad)
-
-
-def test_blur_preserves_the_mass_of_a_centred_body() -> None:
-    scene = make_scene(Body("c", Circle(0.4), (2.0, 2.0)))
-    sharp = RasterRenderer(mode="mask").render(scene, still(scene))
-    blurred = ObservationModel(blur=2.0).apply(sharp.copy())
-    assert blurred.sum() == pytest.approx(sharp.sum(), rel=1e-4)
-    assert blurred.max() < sharp.max() and (blurred > 0).sum() > (sharp > 0).sum()
-    np.testing.assert_allclose(gaussian_blur(sharp, 2.0), blurred)
-
-
-def test_noise_is_a_pure_function_of_the_seed() -> None:
-    scene = make_scene(Body("test", Circle(0.3), (0.8, 2.5)), Body("a", Circle(0.3), (2.0, 1.0)))
-    clean = RasterRenderer().render(scene, still(scene), focus="a")
-    model = ObservationModel(noise=0.1, seed=3)
-    a, b = model.apply(clean.copy()), model.apply(clean.copy())
-    c = ObservationModel(noise=0.1, seed=4).apply(clean.copy())
-    np.testing.assert_array_equal(a, b)
-    assert not np.array_equal(a, c)
-    assert a.min() >= 0 and a.max() <= 1 and a.dtype == np.float32
-    assert 0.002 < float(((a - clean) ** 2).mean()) < 0.01
-    assert ObservationModel().identity and ObservationModel().apply(clean) is clean
-
-
-@pytest.mark.parametrize(
-    ("kwargs", "match"),
-    [
-        ({"blur": -1.0}, "blur = -1.0"),
-        ({"noise": float("nan")}, "noise = nan"),
-        ({"seed": "x"}, "seed = 'x'"),
-    ],
-)
-def test_bad_observation_models_are_refused(kwargs: dict[str, object], match: str) -> None:
-    with pytest.raises(RenderError, match=match):
-        ObservationModel(**kwargs)  # type: ignore[arg-type]

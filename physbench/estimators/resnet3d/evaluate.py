@@ -32,7 +32,7 @@ def evaluate_weights(
     from physbench.observation import simulate_observation
     from physbench.params import ParamSpace
     from physbench.plugins import create, get_registry
-    from physbench.render.base import ObservationModel
+    from physbench.render.observe import ObservationModel
 
     _, meta = weights.load(path)
     spec = DataSpec.from_dict(meta["data"])
