@@ -29,6 +29,7 @@ from physbench.discover.select import prune_causes, select_causes
 from physbench.discover.sensitivity import prune_nuisance
 from physbench.discover.settings import Settings
 from physbench.errors import SimulationError
+from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
     from physbench.discover.residuals import Breakdown
@@ -40,7 +41,7 @@ if TYPE_CHECKING:
 
 def discover(
     runs: Sequence[Run],
-    simulator: Simulator | str = "pymunk",
+    simulator: Simulator | str = DEFAULT_SIMULATOR,
     *,
     settings: Settings | None = None,
     renderer: Renderer | None = None,
@@ -103,7 +104,7 @@ def start_model(problem: Problem, settings: Settings) -> Model:
 
 def fit_base(
     runs: Sequence[Run],
-    simulator: Simulator | str = "pymunk",
+    simulator: Simulator | str = DEFAULT_SIMULATOR,
     settings: Settings | None = None,
     *,
     renderer: Renderer | None = None,

@@ -6,13 +6,15 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from physbench.simulators.base import DEFAULT_SIMULATOR
+
 
 def evaluate_weights(
     path: str | Path,
     seeds: Iterable[int],
     *,
     iterations: int = 11,
-    engine: str = "pymunk",
+    engine: str = DEFAULT_SIMULATOR,
     blur: float = 0.0,
     resolution: int = 64,
     scene_options: Mapping[str, Any] | None = None,
