@@ -94,23 +94,29 @@ def _accepted(cls: type) -> str:
     return ", ".join(names) or "none"
 
 
-def make_estimator(name: str, options: Mapping[str, Any]) -> CorrectionEstimator:
-    """Instantiate the registered estimator ``name``; options it does not take are refused with
-    the list of those it does."""
+def _build(kind: str, name: str, options: Mapping[str, Any], **standard: Any) -> Any:
+    """The registered ``kind`` ``name`` built with ``options`` (and the kind's ``standard``
+    keywords); a constructor that refuses them becomes one sentence naming the options."""
     from physbench.plugins import get_registry
 
-    cls = get_registry().get("estimator", name)
+    cls = get_registry().get(kind, name)
     try:
-        return cls(**dict(options))
+        return cls(**standard, **dict(options))
     except PhysbenchError:
         raise
     except TypeError as exc:
         raise PhysbenchError(
-            f"estimator {name!r} does not take options {dict(options)}: {exc}; "
+            f"{kind} {name!r} does not take options {dict(options)}: {exc}; "
             f"its options: {_accepted(cls)}"
         ) from None
     except ValueError as exc:  # a plugin's own check, not phrased as a PhysbenchError
-        raise PhysbenchError(f"estimator {name!r} refused options {dict(options)}: {exc}") from None
+        raise PhysbenchError(f"{kind} {name!r} refused options {dict(options)}: {exc}") from None
+
+
+def make_estimator(name: str, options: Mapping[str, Any]) -> CorrectionEstimator:
+    """Instantiate the registered estimator ``name``; options it does not take are refused with
+    the list of those it does."""
+    return _build("estimator", name, options)
 
 
 def make_renderer(
@@ -119,26 +125,13 @@ def make_renderer(
     """Instantiate the registered renderer ``name`` with its ``options`` and the standard
     ``resolution`` and ``mode``; options it does not take are refused with the list of those it
     does."""
-    from physbench.plugins import get_registry
-
-    cls = get_registry().get("renderer", name)
     clash = sorted({"resolution", "mode"} & set(options))
     if clash:
         raise PhysbenchError(
             f"renderer option {clash[0]!r}: set it with --resolution / --render-mode (in a sweep "
             "spec: the resolution and render_mode axes), not as a renderer option"
         )
-    try:
-        return cls(resolution=resolution, mode=mode, **dict(options))
-    except PhysbenchError:
-        raise
-    except TypeError as exc:
-        raise PhysbenchError(
-            f"renderer {name!r} does not take options {dict(options)}: {exc}; "
-            f"its options: {_accepted(cls)}"
-        ) from None
-    except ValueError as exc:  # a plugin's own check, not phrased as a PhysbenchError
-        raise PhysbenchError(f"renderer {name!r} refused options {dict(options)}: {exc}") from None
+    return _build("renderer", name, options, resolution=resolution, mode=mode)
 
 
 def _check_observation(config: RunConfig) -> None:

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from physbench.bench import tables
 from physbench.bench.tables import (
     final_rows,
     paper_value,
@@ -37,18 +38,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 #: Settings that split figures (everything in a configuration but unknowns and estimator).
-SETTINGS = (
-    "scene",
-    "bodies",
-    "engine",
-    "observe_engine",
-    "renderer",
-    "blur",
-    "noise",
-    "resolution",
-    "render_mode",
-    "iterations",
-)
+SETTINGS = ("scene", *tables.SETTINGS)
 DPI = 90
 
 

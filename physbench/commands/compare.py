@@ -58,7 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from physbench.bench.compare import compare
     from physbench.bench.runner import read_table
-    from physbench.bench.tables import markdown
+    from physbench.bench.tables import SETTINGS, markdown
 
     res = compare(
         read_table(args.new), read_table(args.baseline), alpha=args.alpha, min_ratio=args.min_ratio
@@ -84,21 +84,7 @@ def main(args: argparse.Namespace) -> int:
                 "verdict",
             ]
         ].copy()
-        extra = [
-            c
-            for c in (
-                "bodies",
-                "engine",
-                "observe_engine",
-                "renderer",
-                "blur",
-                "noise",
-                "resolution",
-                "render_mode",
-                "iterations",
-            )
-            if t[c].nunique() > 1
-        ]
+        extra = [c for c in SETTINGS if t[c].nunique() > 1]
         for c in reversed(extra):
             view.insert(3, c, shown[c])
         for c in ("mean_base", "mean_new"):
