@@ -1,0 +1,223 @@
+"""Reading a camera's video: frames streamed one at a time with their times from the container.
+
+Video files (mp4, mov, avi, mkv, webm, gif, ...) are decoded by PyAV, which ships FFmpeg inside
+its wheel (``pip install physbench[video]``). A frame's time is its presentation timestamp in the
+container (``pts * time_base``, relative to the first frame), not ``index / rate``: phones record
+at a variable frame rate and drop frames, and the timestamps say so. A folder of images (png, jpg,
+bmp, tif) is a video too, in file-name order, at the frame rate the caller gives.
+
+Frames are yielded one by one (:meth:`VideoReader.frames`), so a long 1080p video never sits in
+memory whole; ``start`` and ``end`` (seconds) trim it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from physbench.errors import PhysbenchError
+
+#: Image files a folder may hold, as frames.
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+
+
+class VideoError(PhysbenchError, ValueError):
+    """A video that cannot be read: names the file and what is wrong with it."""
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One decoded frame: its index in the (trimmed) video, its time in seconds from the first
+    frame of the file, and the image ``(H, W, 3)`` uint8 RGB."""
+
+    index: int
+    time: float
+    image: np.ndarray
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    """What the container says: size, the average frame rate, the frame count and duration when
+    it knows them (``None`` otherwise), and the codec."""
+
+    width: int
+    height: int
+    rate: float
+    frames: int | None
+    duration: float | None
+    codec: str
+
+
+def _av() -> Any:
+    try:
+        import av
+    except ImportError:
+        raise VideoError(
+            "reading video needs PyAV: pip install 'physbench[video]' (or pip install av)"
+        ) from None
+    return av
+
+
+def _number(name: str, value: float | None, *, low: float = 0.0) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise VideoError(f"{name} = {value!r}: expected a finite number of seconds")
+    if value < low:
+        raise VideoError(f"{name} = {value!r}: expected a number >= {low:g}")
+    return float(value)
+
+
+class VideoReader:
+    """A video file or a folder of images, opened lazily: :meth:`info` reads the header, and
+    :meth:`frames` decodes as it is iterated. ``fps`` is needed for a folder of images (and
+    ignored for a file, whose timestamps rule); ``start``/``end`` trim to ``[start, end]`` s."""
+
+    def __init__(
+        self,
+        path: str | Path,
+        *,
+        start: float | None = None,
+        end: float | None = None,
+        fps: float | None = None,
+    ) -> None:
+        self.path = Path(path)
+        self.start = _number("start", start) or 0.0
+        self.end = _number("end", end)
+        if self.end is not None and self.end <= self.start:
+            raise VideoError(f"end = {end!r}: must come after start = {self.start:g} s")
+        if not self.path.exists():
+            raise VideoError(f"video {str(self.path)!r} does not exist")
+        self.images: list[Path] = []
+        if self.path.is_dir():
+            self.images = sorted(
+                p for p in self.path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES
+            )
+            if not self.images:
+                raise VideoError(
+                    f"folder {str(self.path)!r} holds no images ({', '.join(IMAGE_SUFFIXES)})"
+                )
+            rate = _number("fps", fps)
+            if not rate:
+                raise VideoError(
+                    f"folder {str(self.path)!r} is a sequence of images: give its frame rate "
+                    "(fps > 0)"
+                )
+            self.fps: float | None = rate
+        else:
+            self.fps = None
+
+    def __repr__(self) -> str:
+        return f"VideoReader({str(self.path)!r}, start={self.start:g}, end={self.end})"
+
+    # ----------------------------------------------------------------- header
+
+    def info(self) -> VideoInfo:
+        """Size, rate, frame count and duration, from the header (no decoding)."""
+        if self.images:
+            h, w = self._image(self.images[0]).shape[:2]
+            n, rate = len(self.images), float(self.fps or 0.0)
+            return VideoInfo(w, h, rate, n, n / rate, "images")
+        with self._open() as container:
+            stream = self._stream(container)
+            rate = float(stream.average_rate or stream.guessed_rate or 0.0)
+            frames = int(stream.frames) or None
+            duration = None
+            if stream.duration is not None and stream.time_base is not None:
+                duration = float(stream.duration * stream.time_base)
+            elif container.duration is not None:
+                duration = container.duration / 1_000_000  # microseconds
+            return VideoInfo(
+                stream.codec_context.width,
+                stream.codec_context.height,
+                rate,
+                frames,
+                duration,
+                stream.codec_context.name,
+            )
+
+    # ----------------------------------------------------------------- frames
+
+    def frames(self) -> Iterator[Frame]:
+        """The frames inside ``[start, end]``, decoded one at a time, with their times (s from the
+        first frame of the file). Raises :class:`VideoError` for a file that cannot be decoded,
+        and when no frame lies inside the trim."""
+        count = 0
+        for frame in self._images() if self.images else self._decode():
+            count += 1
+            yield frame
+        if count == 0:
+            span = f" between {self.start:g} and {self.end:g} s" if self.end else ""
+            after = f" after {self.start:g} s" if self.start and not self.end else ""
+            raise VideoError(f"video {str(self.path)!r} has no frames{span}{after}")
+
+    def _images(self) -> Iterator[Frame]:
+        assert self.fps is not None
+        k = 0
+        for i, p in enumerate(self.images):
+            t = i / self.fps
+            if t < self.start - 1e-9:
+                continue
+            if self.end is not None and t > self.end + 1e-9:
+                break
+            yield Frame(k, t, self._image(p))
+            k += 1
+
+    def _image(self, p: Path) -> np.ndarray:
+        from PIL import Image, UnidentifiedImageError
+
+        try:
+            with Image.open(p) as im:
+                return np.asarray(im.convert("RGB"))
+        except (OSError, UnidentifiedImageError) as exc:
+            raise VideoError(f"image {str(p)!r} cannot be read: {exc}") from None
+
+    def _open(self) -> Any:
+        av = _av()
+        try:
+            return av.open(str(self.path))
+        except av.error.FFmpegError as exc:
+            raise VideoError(
+                f"{str(self.path)!r} is not a video FFmpeg can read ({exc.strerror or exc})"
+            ) from None
+
+    def _stream(self, container: Any) -> Any:
+        if not container.streams.video:
+            raise VideoError(f"{str(self.path)!r} has no video stream")
+        stream = container.streams.video[0]
+        if stream.codec_context is None or not stream.codec_context.name:
+            raise VideoError(f"{str(self.path)!r}: its video codec is not supported")
+        return stream
+
+    def _decode(self) -> Iterator[Frame]:
+        av = _av()
+        with self._open() as container:
+            stream = self._stream(container)
+            stream.thread_type = "AUTO"
+            t0: float | None = None
+            k = 0
+            try:
+                for frame in container.decode(stream):
+                    if frame.pts is None or frame.time_base is None:
+                        raise VideoError(
+                            f"{str(self.path)!r}: frame {k} carries no timestamp; physbench reads "
+                            "times from the container, not from an assumed rate"
+                        )
+                    t_abs = float(frame.pts * frame.time_base)
+                    t0 = t_abs if t0 is None else t0
+                    t = t_abs - t0
+                    if t < self.start - 1e-9:
+                        continue
+                    if self.end is not None and t > self.end + 1e-9:
+                        break
+                    yield Frame(k, t, frame.to_ndarray(format="rgb24"))
+                    k += 1
+            except av.error.FFmpegError as exc:
+                raise VideoError(
+                    f"{str(self.path)!r} is damaged after {k} frames ({exc.strerror or exc})"
+                ) from None

@@ -1,0 +1,94 @@
+"""Reading video: timestamps from the container (a variable frame rate survives), streaming,
+trimming, GIFs and folders of images, and clear errors for files that are not usable."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("av")
+
+from physbench.video.reader import VideoError, VideoReader
+from physbench.video.writer import write_video
+
+
+def frame(i: int, h: int = 48, w: int = 64) -> np.ndarray:
+    """A frame whose bright square's column encodes its index."""
+    img = np.zeros((h, w, 3), np.uint8)
+    img[10:30, 2 + 3 * i : 12 + 3 * i] = 255
+    return img
+
+
+def column(img: np.ndarray) -> float:
+    cols = img[:, :, 0].astype(float).sum(axis=0)
+    return float((cols * np.arange(img.shape[1])).sum() / cols.sum())
+
+
+def test_a_variable_frame_rate_clip_reads_back_with_its_own_times(tmp_path: Path) -> None:
+    times = [0.0, 0.033, 0.067, 0.150, 0.183, 0.300]  # two dropped-frame gaps
+    clip = write_video(tmp_path / "vfr.mp4", (frame(i) for i in range(6)), fps=30, times=times)
+    got = list(VideoReader(clip).frames())
+    assert [f.index for f in got] == list(range(6))
+    np.testing.assert_allclose([f.time for f in got], times, atol=1e-4)
+    assert all(f.image.shape == (48, 64, 3) and f.image.dtype == np.uint8 for f in got)
+    # lossy, but the content is in the right frame: the square moved 3 px a frame
+    np.testing.assert_allclose(
+        [column(f.image) for f in got], [6.5 + 3 * i for i in range(6)], atol=0.5
+    )
+    info = VideoReader(clip).info()
+    assert (info.width, info.height, info.codec) == (64, 48, "h264")
+
+
+def test_trimming_keeps_the_file_times_and_streams(tmp_path: Path) -> None:
+    clip = write_video(tmp_path / "c.mp4", (frame(i) for i in range(10)), fps=10)
+    reader = VideoReader(clip, start=0.25, end=0.6)
+    frames = reader.frames()
+    first = next(frames)  # a generator: nothing is decoded ahead of use
+    assert first.index == 0 and first.time == pytest.approx(0.3)
+    assert [round(f.time, 3) for f in frames] == [0.4, 0.5, 0.6]
+    with pytest.raises(VideoError, match="no frames between 5 and 6 s"):
+        list(VideoReader(clip, start=5, end=6).frames())
+    with pytest.raises(VideoError, match=r"end = 0\.1: must come after start = 0\.2"):
+        VideoReader(clip, start=0.2, end=0.1)
+
+
+def test_gifs_and_folders_of_images(tmp_path: Path) -> None:
+    from PIL import Image
+
+    imgs = [Image.fromarray(frame(i)) for i in range(4)]
+    imgs[0].save(tmp_path / "a.gif", save_all=True, append_images=imgs[1:], duration=100)
+    got = list(VideoReader(tmp_path / "a.gif").frames())
+    assert len(got) == 4 and got[3].time == pytest.approx(0.3)
+    folder = tmp_path / "shots"
+    folder.mkdir()
+    for i, im in enumerate(imgs):
+        im.save(folder / f"img_{i:03d}.png")
+    (folder / "notes.txt").write_text("not a frame")
+    seq = list(VideoReader(folder, fps=20).frames())
+    assert [f.time for f in seq] == [0.0, 0.05, 0.1, 0.15]
+    assert np.array_equal(seq[2].image, frame(2))
+    with pytest.raises(VideoError, match="give its frame rate"):
+        VideoReader(folder)
+    (tmp_path / "empty_dir").mkdir()
+    with pytest.raises(VideoError, match="holds no images"):
+        VideoReader(tmp_path / "empty_dir")
+
+
+def test_unusable_files_are_named_and_left_untouched(tmp_path: Path) -> None:
+    clip = write_video(tmp_path / "c.mp4", (frame(i) for i in range(10)), fps=10)
+    data = clip.read_bytes()
+    (tmp_path / "cut.mp4").write_bytes(data[: len(data) // 3])
+    (tmp_path / "text.mp4").write_text("hello")
+    (tmp_path / "empty.mp4").write_bytes(b"")
+    for name in ("cut.mp4", "text.mp4", "empty.mp4"):
+        with pytest.raises(VideoError, match=name):
+            list(VideoReader(tmp_path / name).frames())
+    with pytest.raises(VideoError, match="does not exist"):
+        VideoReader(tmp_path / "missing.mp4")
+    assert clip.read_bytes() == data and (tmp_path / "text.mp4").read_text() == "hello"
+    with pytest.raises(VideoError, match="no frames to write"):
+        write_video(tmp_path / "none.mp4", [], fps=10)
+    with pytest.raises(VideoError, match="strictly increasing"):
+        write_video(tmp_path / "t.mp4", [frame(0), frame(1)], fps=10, times=[0.1, 0.1])
