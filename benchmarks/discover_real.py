@@ -10,7 +10,7 @@
     python benchmarks/discover_real.py pendulum_benard    # 3 free swings
     python benchmarks/discover_real.py pendulum_peaks     # both pendulums' loss laws from peaks
     python benchmarks/discover_real.py hidden_table       # tabulate hidden_effects.jsonl
-    python benchmarks/discover_real.py billiards --out /tmp/discover   # elsewhere
+    python benchmarks/discover_real.py billiards --out out/discover    # elsewhere
 
 Each discovery writes ``<dataset>/verdict.json`` (the ``--json`` layout), ``verdict.txt`` and a
 ``report/`` folder (PNGs + index.html); ball drops writes one folder per ball and a summary table.
