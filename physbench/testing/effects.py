@@ -36,6 +36,7 @@ from physbench.testing.kit import (
     Check,
     ConformanceError,
     Subject,
+    construct,
     label,
     require_contract,
     run_checks,
@@ -129,15 +130,7 @@ def active_values(cls: type[Effect], given: Mapping[str, float] | None = None) -
 
 
 def _build(cls: type, options: Mapping[str, Any], **values: Any) -> Effect:
-    kw = {**options, **values}
-    try:
-        eff = cls(**kw)
-    except Exception as exc:
-        raise ConformanceError(
-            f"{label(cls)}: {cls.__name__}(**{kw!r}) raised {type(exc).__name__}: {exc}"
-        ) from exc
-    if not isinstance(eff, Effect):
-        raise ConformanceError(f"{label(cls)}: instances are not physbench Effects")
+    eff: Effect = construct(cls, {**options, **values}, Effect)
     return eff
 
 

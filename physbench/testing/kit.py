@@ -47,6 +47,20 @@ def require_contract(cls: object, base: type) -> None:
         )
 
 
+def construct(cls: type, kwargs: Mapping[str, Any], base: type) -> Any:
+    """``cls(**kwargs)``, as a kit check builds its component: a constructor that raises, or an
+    instance that is not a ``base``, is a :class:`ConformanceError` naming the component."""
+    try:
+        obj = cls(**kwargs)
+    except Exception as exc:
+        raise ConformanceError(
+            f"{label(cls)}: {cls.__name__}(**{dict(kwargs)!r}) raised {type(exc).__name__}: {exc}"
+        ) from exc
+    if not isinstance(obj, base):
+        raise ConformanceError(f"{label(cls)}: instances are not physbench {base.__name__}s")
+    return obj
+
+
 @dataclass(frozen=True)
 class Subject:
     """A component class under test: ``cls(**options)`` builds it; ``kit`` holds settings of its

@@ -21,6 +21,7 @@ from physbench.testing.kit import (
     Check,
     ConformanceError,
     Subject,
+    construct,
     label,
     require_contract,
     run_checks,
@@ -76,14 +77,7 @@ def alone(scene: Scene, body: str) -> Scene:
 
 def _build(cls: type, options: Mapping[str, Any], mode: str, **override: Any) -> Renderer:
     kw = {"resolution": RESOLUTION, **options, "mode": mode, **override}
-    try:
-        ren = cls(**kw)
-    except Exception as exc:
-        raise ConformanceError(
-            f"{label(cls)}: {cls.__name__}(**{kw!r}) raised {type(exc).__name__}: {exc}"
-        ) from exc
-    if not isinstance(ren, Renderer):
-        raise ConformanceError(f"{label(cls)}: instances are not physbench Renderers")
+    ren: Renderer = construct(cls, kw, Renderer)
     return ren
 
 

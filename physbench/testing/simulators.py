@@ -26,6 +26,7 @@ from physbench.testing.kit import (
     Check,
     ConformanceError,
     Subject,
+    construct,
     import_path,
     label,
     load,
@@ -115,14 +116,7 @@ class KitPush(Effect):
 
 
 def _build(cls: type, options: Mapping[str, Any]) -> Simulator:
-    try:
-        sim = cls(**options)
-    except Exception as exc:
-        raise ConformanceError(
-            f"{label(cls)}: {cls.__name__}(**{dict(options)!r}) raised {type(exc).__name__}: {exc}"
-        ) from exc
-    if not isinstance(sim, Simulator):
-        raise ConformanceError(f"{label(cls)}: instances are not physbench Simulators")
+    sim: Simulator = construct(cls, options, Simulator)
     return sim
 
 
