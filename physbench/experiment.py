@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from physbench.observation import Observation
     from physbench.params import ParamSpace
     from physbench.render.base import Renderer
+    from physbench.render.camera import CameraRenderer
     from physbench.scene import Scene
 
 
@@ -37,7 +38,12 @@ class RunConfig:
     ``observe_engine``: the engine that makes the observation (``None``: ``engine``);
     ``renderer`` and ``renderer_options``: the renderer of the model and of the observation,
     built with ``resolution`` and ``render_mode`` besides its options; ``blur`` and ``noise``:
-    the observation model applied to the observed frames only."""
+    the observation model applied to the observed frames only; ``observer`` and
+    ``observer_options``: a camera renderer that films the simulated observation as a video,
+    which is then tracked and segmented back into the model renderer's frames (the visual gap;
+    ``None``: the model renderer draws the observation); ``video``, ``calibration``,
+    ``background``, ``video_start`` and ``video_end``: observe a video file instead (a camera's
+    footage, tracked and segmented the same way; no truth then)."""
 
     scene: str = "three_circles"
     params: tuple[str, ...] = ("mass",)
@@ -55,14 +61,27 @@ class RunConfig:
     render_mode: str = "mark"
     bodies: tuple[str, ...] | None = None
     observation: str | None = None
+    observer: str | None = None
+    observer_options: Mapping[str, Any] = field(default_factory=dict)
+    video: str | None = None
+    calibration: str | None = None
+    background: str | None = None
+    video_start: float | None = None
+    video_end: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready settings (tuples as lists); :meth:`from_dict` inverts it."""
+        """JSON-ready settings (tuples as lists); :meth:`from_dict` inverts it. Settings added
+        after a sweep format existed are left out while at their defaults, so the cell keys of
+        earlier sweeps (hashes of this dict) stay valid."""
         d = asdict(self)
         d["params"] = list(self.params)
         d["bodies"] = None if self.bodies is None else list(self.bodies)
         d["options"] = dict(self.options)
         d["renderer_options"] = dict(self.renderer_options)
+        d["observer_options"] = dict(self.observer_options)
+        for key in _LATER:
+            if not d[key]:
+                del d[key]
         return d
 
     @classmethod
@@ -82,6 +101,19 @@ class RunConfig:
     @property
     def observer_engine(self) -> str:
         return self.observe_engine or self.engine
+
+
+#: Settings added after sweeps were first stored: omitted from :meth:`RunConfig.to_dict` while
+#: unset (``None`` or empty).
+_LATER = (
+    "observer",
+    "observer_options",
+    "video",
+    "calibration",
+    "background",
+    "video_start",
+    "video_end",
+)
 
 
 def _accepted(cls: type) -> str:
@@ -134,11 +166,59 @@ def make_renderer(
     return _build("renderer", name, options, resolution=resolution, mode=mode)
 
 
-def _check_observation(config: RunConfig) -> None:
-    if config.observation and (config.observe_engine or config.blur or config.noise):
+#: Image width of an observer camera whose options name no ``resolution``.
+OBSERVER_RESOLUTION = 640
+
+
+def make_observer(name: str, options: Mapping[str, Any]) -> CameraRenderer:
+    """The camera renderer ``name`` that films a simulated observation: its ``options`` may hold
+    ``resolution`` (default :data:`OBSERVER_RESOLUTION`); it draws ``rgb`` frames and must be a
+    :class:`~physbench.render.camera.CameraRenderer` (the video path needs its plate)."""
+    from physbench.render.camera import CameraRenderer
+
+    opts = dict(options)
+    resolution = opts.pop("resolution", OBSERVER_RESOLUTION)
+    cam = _build("renderer", name, opts, resolution=resolution, mode="rgb")
+    if not isinstance(cam, CameraRenderer):
         raise PhysbenchError(
-            "--observe-engine, --blur and --noise shape a simulated observation; they cannot "
-            "apply to --observation frames"
+            f"observer {name!r} is a {type(cam).__name__}; an observer films the observation as "
+            "a video, so it must be a camera renderer (e.g. 'camera')"
+        )
+    return cam
+
+
+def _check_observation(config: RunConfig) -> None:
+    given = {"--observation frames": config.observation, "--video": config.video}
+    sources = [k for k, v in given.items() if v]
+    if config.observer:
+        sources.append("an observer camera")
+    if len(sources) > 1:
+        raise PhysbenchError(
+            f"{' and '.join(sources)}: give one source of the observation (frames, a video, or a "
+            "simulation filmed by an observer camera)"
+        )
+    if (
+        sources
+        and sources[0] != "an observer camera"
+        and (config.observe_engine or config.blur or config.noise)
+    ):
+        raise PhysbenchError(
+            f"--observe-engine, --blur and --noise shape a simulated observation; they cannot "
+            f"apply to {sources[0]}"
+        )
+    video_only = {
+        "--calibration": config.calibration,
+        "--background": config.background,
+        "--start": config.video_start,
+        "--end": config.video_end,
+    }
+    stray = [k for k, v in video_only.items() if v is not None]
+    if stray and not config.video:
+        raise PhysbenchError(f"{', '.join(stray)} apply to a --video only; no --video was given")
+    if (config.video or config.observer) and config.render_mode not in ("mark", "instance", "mask"):
+        raise PhysbenchError(
+            f"render mode {config.render_mode!r}: frames segmented from a video come as masks "
+            "(mark, instance or mask)"
         )
 
 
@@ -166,6 +246,8 @@ def check_config(config: RunConfig) -> ParamSpace:
     except UnknownNameError as exc:
         raise PhysbenchError(str(exc)) from None
     make_estimator(config.estimator, config.options)
+    if config.observer:
+        make_observer(config.observer, config.observer_options)
     make_renderer(
         config.renderer,
         config.renderer_options,
@@ -209,15 +291,40 @@ def run_config(
     per_object = type(estimator).per_object
     truth, initial = draw_problem(space, config.seed)
     obs: Observation
+    marked = space.bodies if per_object else ()
     if config.observation:
         obs = load_observation(config.observation)
+    elif config.video:
+        from physbench.video.observe import video_observation
+
+        obs = video_observation(
+            config.video,
+            scene,
+            model_renderer,
+            calibration=config.calibration,
+            background=config.background,
+            start=config.video_start,
+            end=config.video_end,
+            marked=marked,
+        )
+    elif config.observer:
+        from physbench.video.observe import filmed_observation
+
+        obs = filmed_observation(
+            scene,
+            truth,
+            create("simulator", config.observer_engine),
+            make_observer(config.observer, config.observer_options),
+            model_renderer,
+            marked=marked,
+        )
     else:
         obs = simulate_observation(
             scene,
             truth,
             create("simulator", config.observer_engine),
             renderer(),
-            marked=space.bodies if per_object else (),
+            marked=marked,
             camera=ObservationModel(blur=config.blur, noise=config.noise, seed=config.seed),
         )
     if save_observation:
@@ -235,7 +342,7 @@ def run_config(
         callback=callback,
     )
     history.meta.update(
-        observe_engine=None if config.observation else config.observer_engine,
+        observe_engine=None if config.observation or config.video else config.observer_engine,
         renderer=config.renderer,
         renderer_options=dict(config.renderer_options),
         blur=config.blur,
@@ -243,4 +350,10 @@ def run_config(
         resolution=config.resolution,
         render_mode=config.render_mode,
     )
+    if config.observer:
+        history.meta.update(
+            observer=config.observer, observer_options=dict(config.observer_options)
+        )
+    if config.video:
+        history.meta.update(video=config.video, calibration=config.calibration)
     return history

@@ -111,6 +111,7 @@ def assemble(cells: list[Cell], store: CellStore) -> pd.DataFrame:
                 "scene": c.scene,
                 "label": c.label,
                 "renderer_label": c.renderer_label,
+                "observer_label": c.observer_label,
             }
             rows += cell_rows(identity, data)
     return to_frame(rows)

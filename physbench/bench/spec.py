@@ -1,7 +1,7 @@
 """Sweep specs: a TOML file naming the axes of a benchmark, expanded into cells.
 
 A cell is one :class:`~physbench.experiment.RunConfig` (one seed of one configuration). The
-product is ``Σ_scenes (scene's unknown sets) × renderer × engine × observe_engine × blur × noise ×
+product is ``Σ_scenes (scene's unknown sets) × renderer × observer × engine × observe_engine × blur × noise ×
 resolution × render_mode × iterations × estimators × seeds``; each scene lists its own unknown
 sets because the paper's Table 1 is not a full product. Every axis takes one value or a list::
 
@@ -17,6 +17,10 @@ sets because the paper's Table 1 is not a full product. Every axis takes one val
     render_mode = "mark"
     renderer = {name = "mycam", label = "cam-wide", options = {fov = 60}}
                                      # or a name, or a list (default: DEFAULT_RENDERER, no options)
+    observer = ["sharp", {name = "camera", label = "phone", options = {bitrate = 2000000}}]
+                                     # "sharp": the renderer draws the observation (default); a
+                                     # camera renderer: the observation is filmed as an encoded
+                                     # video, then tracked and segmented (the visual gap)
     unknowns = ["mass"]              # default for scenes that list none; each item is one set
 
     [[scenes]]
@@ -48,7 +52,17 @@ from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
 AXES = ("engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
-TOP_KEYS = ("name", "description", "scenes", "unknowns", "estimators", "renderer", "seeds", *AXES)
+TOP_KEYS = (
+    "name",
+    "description",
+    "scenes",
+    "unknowns",
+    "estimators",
+    "renderer",
+    "observer",
+    "seeds",
+    *AXES,
+)
 SCENE_KEYS = ("name", "unknowns", "bodies")
 #: Keys of an estimator or renderer table: ``{name = "...", label = "...", options = {...}}``.
 COMPONENT_KEYS = ("name", "label", "options")
@@ -82,6 +96,9 @@ EstimatorSpec = ComponentSpec
 RendererSpec = ComponentSpec
 #: The renderer axis of a spec that names none.
 DEFAULT_RENDERERS = (RendererSpec(DEFAULT_RENDERER, DEFAULT_RENDERER),)
+#: The observer that is no camera: the renderer draws the observation itself.
+SHARP = "sharp"
+DEFAULT_OBSERVERS = (ComponentSpec(SHARP, SHARP),)
 
 
 @dataclass(frozen=True)
@@ -103,6 +120,7 @@ class Cell:
     scene: str
     label: str  # the estimator's label
     renderer_label: str = DEFAULT_RENDERER
+    observer_label: str = SHARP
 
     @functools.cached_property
     def key(self) -> str:
@@ -126,14 +144,15 @@ class Spec:
     renderers: tuple[RendererSpec, ...] = DEFAULT_RENDERERS
     source: str = ""  # the TOML text
     path: str = ""
+    observers: tuple[ComponentSpec, ...] = DEFAULT_OBSERVERS
 
     def cells(self) -> list[Cell]:
-        """Every cell in product order: scene, unknowns, renderer, axes, estimator, seed (seed
-        innermost)."""
+        """Every cell in product order: scene, unknowns, renderer, observer, axes, estimator,
+        seed (seed innermost)."""
         out: list[Cell] = []
         for sc in self.scenes:
             for unknowns in sc.unknowns:
-                for ren in self.renderers:
+                for ren, obs in itertools.product(self.renderers, self.observers):
                     for values in itertools.product(*(self.axes[a] for a in AXES)):
                         ax = dict(zip(AXES, values, strict=True))
                         for est in self.estimators:
@@ -147,9 +166,20 @@ class Spec:
                                     bodies=sc.bodies,
                                     renderer=ren.name,
                                     renderer_options=dict(ren.options),
+                                    observer=None if obs.name == SHARP else obs.name,
+                                    observer_options=dict(obs.options),
                                     **ax,
                                 )
-                                out.append(Cell(len(out), config, sc.name, est.label, ren.label))
+                                out.append(
+                                    Cell(
+                                        len(out),
+                                        config,
+                                        sc.name,
+                                        est.label,
+                                        ren.label,
+                                        obs.label,
+                                    )
+                                )
         return out
 
 
@@ -343,6 +373,10 @@ def parse_spec(
     renderers = _components(
         data.get("renderer", DEFAULT_RENDERER), _where(path, "renderer"), "renderer"
     )
+    observers = _components(data.get("observer", SHARP), _where(path, "observer"), "observer")
+    bad = next((o for o in observers if o.name == SHARP and o.options), None)
+    if bad is not None:
+        raise SpecError(f"{_where(path, 'observer')}: {SHARP!r} takes no options")
     seeds = _seeds(data["seeds"], _where(path, "seeds"))
     axes = {a: _check_axis(a, _as_list(data.get(a, DEFAULTS[a])), _where(path, a)) for a in AXES}
     empty = [
@@ -351,6 +385,7 @@ def parse_spec(
             ("scenes", scenes),
             ("estimators", estimators),
             ("renderer", renderers),
+            ("observer", observers),
             ("seeds", seeds),
             *axes.items(),
         )
@@ -360,7 +395,9 @@ def parse_spec(
         raise SpecError(
             f"{_where(path, empty[0])}: empty product: the axis {empty[0]!r} has no values"
         )
-    spec = Spec(name, description, scenes, estimators, seeds, axes, renderers, source, path)
+    spec = Spec(
+        name, description, scenes, estimators, seeds, axes, renderers, source, path, observers
+    )
     _check_names(spec)
     check_unique(spec.cells())
     return spec
@@ -414,7 +451,7 @@ def load_spec(path: str | Path) -> Spec:
 def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
     """Build every estimator and renderer once and look up every name, so a bad spec fails
     before anything runs; errors name the spec file and the key."""
-    from physbench.experiment import config_space, make_estimator, make_renderer
+    from physbench.experiment import config_space, make_estimator, make_observer, make_renderer
     from physbench.plugins import get_registry
     from physbench.render.observe import ObservationModel
     from physbench.scenes import resolve_scene
@@ -435,6 +472,22 @@ def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
                     make_renderer(ren.name, ren.options, resolution=res, mode=mode)
             except PhysbenchError as exc:
                 raise SpecError(f"{where}: {at} = {ren.name!r}: {exc}") from None
+        for i, obs in enumerate(spec.observers):
+            if obs.name == SHARP:
+                continue
+            at = f"observer[{i}]" if len(spec.observers) > 1 else "observer"
+            try:
+                make_observer(obs.name, obs.options)
+            except PhysbenchError as exc:
+                raise SpecError(f"{where}: {at} = {obs.name!r}: {exc}") from None
+            bad_mode = [
+                m for m in spec.axes["render_mode"] if m not in ("mark", "instance", "mask")
+            ]
+            if bad_mode:
+                raise SpecError(
+                    f"{where}: {at}: render_mode {bad_mode[0]!r}: a filmed observation is "
+                    "segmented into masks (mark, instance or mask)"
+                )
         for blur, noise in itertools.product(spec.axes["blur"], spec.axes["noise"]):
             ObservationModel(blur=blur, noise=noise)
         for sc in spec.scenes:

@@ -42,6 +42,8 @@ SCHEMA: dict[str, str] = {
     "renderer": "string",
     "renderer_name": "string",
     "renderer_options": "string",
+    "observer": "string",
+    "observer_options": "string",
     "blur": "float64",
     "noise": "float64",
     "resolution": "int64",
@@ -77,6 +79,8 @@ CONFIG = (
     "observe_engine",
     "renderer",
     "renderer_options",
+    "observer",
+    "observer_options",
     "blur",
     "noise",
     "resolution",
@@ -92,6 +96,8 @@ ADDED: dict[str, str] = {
     "renderer": DEFAULT_RENDERER,
     "renderer_name": DEFAULT_RENDERER,
     "renderer_options": "{}",
+    "observer": "sharp",
+    "observer_options": "{}",
 }
 #: Configuration columns shown only when they vary within a sweep.
 SETTINGS = (
@@ -99,6 +105,7 @@ SETTINGS = (
     "engine",
     "observe_engine",
     "renderer",
+    "observer",
     "blur",
     "noise",
     "resolution",
@@ -137,7 +144,7 @@ def dumps(obj: Any) -> str:
 
 def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str, Any]]:
     """Long-table rows of one cell: ``cell`` holds its identity in the spec (key, index, scene,
-    estimator ``label``, ``renderer_label``); ``data`` is the stored cell
+    estimator ``label``, ``renderer_label``, ``observer_label``); ``data`` is the stored cell
     (:func:`physbench.bench.runner.run_cell`)."""
     from physbench.experiment import RunConfig
 
@@ -157,6 +164,8 @@ def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str
         "renderer": cell["renderer_label"],
         "renderer_name": case["renderer"],
         "renderer_options": dumps(case["renderer_options"]),
+        "observer": cell.get("observer_label", "sharp"),
+        "observer_options": dumps(case.get("observer_options", {})),
         "blur": case["blur"],
         "noise": case["noise"],
         "resolution": case["resolution"],

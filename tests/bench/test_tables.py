@@ -1,5 +1,5 @@
-"""The long table's schema: tables written before the renderer columns existed (the committed
-ones among them) read with the default renderer and no options."""
+"""The long table's schema: tables written before the renderer and observer columns existed (the
+committed ones among them) read with the default renderer, the sharp observer and no options."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from physbench.bench.tables import ADDED, CONFIG, MATCH, SCHEMA, stats, upgrade,
 from physbench.render.base import DEFAULT_RENDERER
 
 RESULTS = Path(__file__).resolve().parents[2] / "results"
-OLD = ["renderer", "renderer_name", "renderer_options"]
+OLD = ["renderer", "renderer_name", "renderer_options", "observer", "observer_options"]
 
 
 @pytest.mark.parametrize("name", ["baseline", "table1", "resnet3d"])
@@ -26,8 +26,11 @@ def test_committed_tables_read_with_the_default_renderer(name: str) -> None:
     assert (df["renderer"] == DEFAULT_RENDERER).all()
     assert (df["renderer_name"] == DEFAULT_RENDERER).all()
     assert (df["renderer_options"] == "{}").all()
+    assert (df["observer"] == "sharp").all()
+    assert (df["observer_options"] == "{}").all()
     pd.testing.assert_frame_equal(df.drop(columns=OLD), raw[df.drop(columns=OLD).columns])
-    assert {"renderer", "renderer_options"} <= set(CONFIG) <= set(MATCH)
+    assert {"renderer", "renderer_options", "observer", "observer_options"} <= set(CONFIG)
+    assert set(CONFIG) <= set(MATCH)
 
 
 def test_an_old_table_equals_a_new_one_but_for_its_renderer_columns(tmp_path: Path) -> None:

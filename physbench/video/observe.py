@@ -1,0 +1,173 @@
+"""Observations from video: what the correction loop compares when it watches a camera.
+
+:func:`video_observation` turns a video file into an
+:class:`~physbench.observation.Observation`: track the scene's bodies
+(:func:`~physbench.video.track.track_video`), then for each of the scene's frame times take the
+nearest video frame and segment it into the model renderer's frames
+(:class:`~physbench.video.segment.Segmenter`), once unmarked and once per marked body.
+:func:`filmed_observation` does the same to a simulated observation filmed by a camera renderer
+and encoded as a real video file: the visual gap between a camera and sharp renders.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Iterable, Iterator, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from physbench.video.segment import SegmentError
+
+if TYPE_CHECKING:
+    from physbench.observation import Observation
+    from physbench.recording import Recording
+    from physbench.render.base import Renderer
+    from physbench.render.camera import CameraRenderer
+    from physbench.scene import Scene
+    from physbench.simulators.base import Simulator
+    from physbench.video.calibration import Calibration
+    from physbench.video.reader import Frame
+
+
+def scene_frames(
+    frames: Iterable[Frame], times: np.ndarray, *, what: str = "video"
+) -> Iterator[tuple[int, Frame, float]]:
+    """For each of ``times`` (s, increasing, from the first frame given), the frame of
+    ``frames`` nearest to it, as ``(index into times, frame, frame time from the first frame)``;
+    reads the frames once, holding two. A video that ends before the last time is a
+    :class:`SegmentError`."""
+    k, prev, base, prev_t = 0, None, None, 0.0
+    for fr in frames:
+        if base is None:
+            base = fr.time
+        t = fr.time - base
+        while k < len(times) and t >= times[k]:
+            if prev is None or t - times[k] <= times[k] - prev_t:
+                yield k, fr, t
+            else:
+                yield k, prev, prev_t
+            k += 1
+        if k == len(times):
+            return
+        prev, prev_t = fr, t
+    # The last frame stands for a time up to half a frame interval after it.
+    step = float(np.median(np.diff(times))) if len(times) > 1 else 0.0
+    while prev is not None and k < len(times) and times[k] - prev_t <= 0.5 * step + 1e-9:
+        yield k, prev, prev_t
+        k += 1
+    if k < len(times):
+        have = "no frames" if prev is None else f"{prev_t:.3f} s of frames"
+        raise SegmentError(
+            f"{what}: has {have}, but the scene needs {len(times)} frames up to "
+            f"t = {times[-1]:.3f} s; give a longer video, an earlier --start, or a scene with "
+            "fewer frames"
+        )
+
+
+def poses_at(recording: Recording, scene: Scene, t: float) -> np.ndarray:
+    """``(N, 3)`` poses of the scene's bodies at time ``t`` from the tracks (linear in time between
+    samples, held at the ends); a body without a measured angle keeps its initial angle."""
+    out = np.zeros((len(scene.bodies), 3))
+    for i, body in enumerate(scene.bodies):
+        tr = recording.track(body.name)
+        out[i, 0] = np.interp(t, tr.t, tr.x)
+        out[i, 1] = np.interp(t, tr.t, tr.y)
+        out[i, 2] = body.angle if tr.angle is None else np.interp(t, tr.t, tr.angle)
+    return out
+
+
+def video_observation(
+    path: str | Path,
+    scene: Scene,
+    renderer: Renderer,
+    *,
+    calibration: Calibration | str | Path | None = None,
+    background: np.ndarray | str | Path | None = None,
+    start: float | None = None,
+    end: float | None = None,
+    marked: Iterable[str] = (),
+) -> Observation:
+    """The observation of a video file in ``renderer``'s frames (see the module docstring).
+    ``calibration``: a :class:`~physbench.video.calibration.Calibration` or a TOML file (default:
+    ``scene.bounds`` fill the frame); ``background``: an image of the empty scene (array or file;
+    default: the video's median)."""
+    from physbench.observation import Observation
+    from physbench.video.background import load_plate, median_background
+    from physbench.video.calibration import load_calibration
+    from physbench.video.reader import VideoReader
+    from physbench.video.segment import Segmenter, foreground, noise_threshold
+    from physbench.video.track import default_calibration, track_video
+
+    reader = VideoReader(path, start=start, end=end)
+    info = reader.info()
+    if isinstance(calibration, str | Path):
+        calibration = load_calibration(calibration)
+    if calibration is None:
+        calibration = default_calibration(scene, (info.height, info.width))
+    if isinstance(background, str | Path):
+        background = load_plate(background)
+    tracked = track_video(path, scene, calibration, start=start, end=end, background=background)
+    recording = tracked.recording
+    if background is None:
+        background = median_background(VideoReader(path, start=start, end=end))
+    expected = tuple(renderer.shape(scene))
+    seg = Segmenter(
+        scene,
+        calibration,
+        (info.height, info.width),
+        resolution=renderer.resolution,
+        mode=renderer.mode,
+    )
+    if (seg.h, seg.w) != expected[2:]:
+        raise SegmentError(
+            f"renderer {renderer.name!r} draws {expected[3]}x{expected[2]} px frames; a video is "
+            f"segmented into the scene-filling geometry ({seg.w}x{seg.h} px at this resolution)"
+        )
+    marked = tuple(marked)
+    times = np.arange(scene.frames) / scene.fps
+    views: dict[str | None, np.ndarray] = {
+        b: np.zeros(expected, np.float32) for b in (None, *marked)
+    }
+    threshold = None
+    for k, fr, t in scene_frames(reader.frames(), times, what=str(path)):
+        if threshold is None:
+            threshold = noise_threshold(fr.image, background)
+        cov = seg.coverage(
+            foreground(fr.image, background, threshold), poses_at(recording, scene, t)
+        )
+        for b, arr in views.items():
+            arr[k] = seg.frame(cov, b)
+    frames = views.pop(None)
+    return Observation(frames, None, views, source=f"video {path}")  # type: ignore[arg-type]
+
+
+def filmed_observation(
+    scene: Scene,
+    truth: Mapping[str, float],
+    simulator: Simulator,
+    camera: CameraRenderer,
+    renderer: Renderer,
+    *,
+    marked: Iterable[str] = (),
+) -> Observation:
+    """Simulate ``scene`` with the true parameters, film it with ``camera`` into an encoded video
+    file, and read that back with :func:`video_observation`: calibrated from the four corners of
+    ``scene.bounds`` as a user would click them, with the camera's plate as the background."""
+    from physbench.video.calibration import Calibration
+
+    traj = simulator.simulate(scene, dict(truth))
+    xmin, ymin, xmax, ymax = scene.bounds
+    corners = np.array([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
+    true = camera.calibration(scene)
+    cal = Calibration.from_points(camera.image_points(scene, corners), corners, lens=true.lens)
+    with tempfile.TemporaryDirectory(prefix="physbench-film-") as tmp:
+        clip = Path(tmp) / "observation.mp4"
+        camera.write(clip, scene, traj)
+        obs = video_observation(
+            clip, scene, renderer, calibration=cal, background=camera.plate(scene), marked=marked
+        )
+    obs.truth = dict(truth)
+    obs.source = f"simulated ({type(simulator).name}), filmed by {camera.name}"
+    return obs
