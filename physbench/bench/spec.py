@@ -1,9 +1,10 @@
 """Sweep specs: a TOML file naming the axes of a benchmark, expanded into cells.
 
 A cell is one :class:`~physbench.experiment.RunConfig` (one seed of one configuration). The
-product is ``Σ_scenes (scene's unknown sets) × renderer × observer × engine × observe_engine × blur × noise ×
-resolution × render_mode × iterations × estimators × seeds``; each scene lists its own unknown
-sets because the paper's Table 1 is not a full product. Every axis takes one value or a list::
+product is ``Σ_scenes (scene's unknown sets) × renderer × observer × engine × observe_engine ×
+blur × noise × resolution × render_mode × iterations × estimators × seeds``; each scene lists its
+own unknown sets because the paper's Table 1 is not a full product. Every axis takes one value or
+a list::
 
     name = "example"
     estimators = ["tpe", "random", {name = "tpe", label = "tpe-20", options = {startup = 20}}]
