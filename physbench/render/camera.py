@@ -64,7 +64,7 @@ PALETTE = (
 STATIC_COLOUR = (0.32, 0.30, 0.28)
 #: Unit vector towards the light that shades bodies: upper left, in front of the plane.
 _LIGHT = np.array([-0.45, 0.55, 0.70]) / np.linalg.norm([-0.45, 0.55, 0.70])
-_HALF = (_LIGHT + (0.0, 0.0, 1.0)) / np.linalg.norm(_LIGHT + (0.0, 0.0, 1.0))
+_HALF = (_LIGHT + np.array([0.0, 0.0, 1.0])) / np.linalg.norm(_LIGHT + np.array([0.0, 0.0, 1.0]))
 #: Views (pixel geometry, background, light) kept per renderer instance.
 _CACHE_SIZE = 4
 #: The view must not look along the plane: largest angle between the optical axis and the
@@ -72,15 +72,15 @@ _CACHE_SIZE = 4
 MAX_OBLIQUE = 85.0
 #: CRF of :meth:`CameraRenderer.write` when neither ``bitrate`` nor ``crf`` is set.
 WRITE_CRF = 20
+#: Codec of :meth:`CameraRenderer.write` by file suffix (others: H.264).
+VIDEO_CODECS = {".webm": "libvpx-vp9"}
 
 
 def _number(name: str, value: object, low: float, high: float, *, open_: bool = False) -> float:
     bad = isinstance(value, bool) or not isinstance(value, int | float | np.number)
     if not bad:
         v = float(value)  # type: ignore[arg-type]
-        bad = not math.isfinite(v) or (
-            not (low < v < high) if open_ else not (low <= v <= high)
-        )
+        bad = not math.isfinite(v) or (not (low < v < high) if open_ else not (low <= v <= high))
     if bad:
         span = f"({low:g}, {high:g})" if open_ else f"[{low:g}, {high:g}]"
         raise RenderError(f"{name} = {value!r}: expected a number in {span}")
@@ -88,7 +88,11 @@ def _number(name: str, value: object, low: float, high: float, *, open_: bool = 
 
 
 def _whole(name: str, value: object, low: int, high: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or not low <= value <= high:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | np.integer)
+        or not low <= value <= high
+    ):
         raise RenderError(f"{name} = {value!r}: expected a whole number in [{low}, {high}]")
     return int(value)
 
@@ -342,9 +346,7 @@ def _background(cam: CameraRenderer, scene: Scene, view: _View) -> np.ndarray:
         img[..., 0] += 0.05 * (hue - 0.5)
         img[..., 2] -= 0.05 * (hue - 0.5)
         fy = y / bh - row
-        d = np.minimum(
-            bw * np.minimum(fx - col, col + 1 - fx), bh * np.minimum(fy, 1 - fy)
-        )
+        d = np.minimum(bw * np.minimum(fx - col, col + 1 - fx), bh * np.minimum(fy, 1 - fy))
         mortar = 0.012 * size
         _paint(img, _coverage(d - mortar / 2, foot), np.array([0.80, 0.79, 0.75]))
         stain = 0.6 * _value_noise(x, y, size / 3, seed, 3) + 0.4 * _value_noise(
@@ -546,17 +548,23 @@ class CameraRenderer(Renderer):
         return frames
 
     def write(self, path: str | Path, scene: Scene, traj: Trajectory) -> None:
-        """Film the clip and encode it to the video file ``path`` (H.264, each frame at its
-        trajectory time; ``bitrate`` or ``crf``, else CRF :data:`WRITE_CRF`)."""
+        """Film the clip and encode it to the video file ``path``, each frame at its trajectory
+        time: H.264 (VP9 for ``.webm``) at ``bitrate`` or ``crf``, else CRF :data:`WRITE_CRF`;
+        ``.gif`` is an animated GIF (256 colours, times rounded to 10 ms)."""
+        frames = self._expose(scene, traj)
+        times = np.asarray(traj.times, dtype=float)
+        if Path(path).suffix.lower() == ".gif":
+            _write_gif(Path(path), frames, times, scene.dt)
+            return
         from physbench.video.writer import write_video
 
-        frames = self._expose(scene, traj)
         crf = self.crf if self.crf is not None or self.bitrate > 0 else WRITE_CRF
         write_video(
             path,
             _even(frames),
             fps=scene.fps,
-            times=np.asarray(traj.times, dtype=float),
+            times=times,
+            codec=VIDEO_CODECS.get(Path(path).suffix.lower(), "libx264"),
             bitrate=int(self.bitrate) if self.bitrate > 0 else None,
             crf=crf,
         )
@@ -578,7 +586,7 @@ class CameraRenderer(Renderer):
             )
         if out is None:
             out = np.empty(shape, np.float32)
-        np.multiply(frames.transpose(0, 3, 1, 2), np.float32(1 / 255), out=out)
+        np.divide(frames.transpose(0, 3, 1, 2), np.float32(255), out=out)
         return out
 
     # ------------------------------------------------------------------ the exposure
@@ -595,8 +603,10 @@ class CameraRenderer(Renderer):
     def _expose(self, scene: Scene, traj: Trajectory) -> np.ndarray:
         states = np.asarray(traj.states, dtype=float)
         n = len(scene.bodies)
-        if states.ndim != 3 or states.shape[1] != n or (
-            traj.bodies and tuple(traj.bodies) != scene.body_names
+        if (
+            states.ndim != 3
+            or states.shape[1] != n
+            or (traj.bodies and tuple(traj.bodies) != scene.body_names)
         ):
             raise RenderError(
                 f"trajectory bodies {list(traj.bodies)} do not match the scene's bodies "
@@ -684,6 +694,15 @@ def _draw_body(
     part += premult
 
 
+def _write_gif(path: Path, frames: np.ndarray, times: np.ndarray, dt: float) -> None:
+    from PIL import Image
+
+    ends = np.append(times[1:], times[-1] + (times[-1] - times[-2] if len(times) > 1 else dt))
+    ms = [max(10, round(d * 100) * 10) for d in ends - times]
+    images = [Image.fromarray(f) for f in frames]
+    images[0].save(path, save_all=True, append_images=images[1:], duration=ms, loop=0)
+
+
 def _quantise(img: np.ndarray) -> np.ndarray:
     return np.rint(np.clip(img, 0.0, 1.0) * np.float32(255)).astype(np.uint8)
 
@@ -696,9 +715,7 @@ def _even(frames: np.ndarray) -> np.ndarray:
     return np.pad(frames, ((0, 0), (0, h % 2), (0, w % 2), (0, 0)), mode="edge")
 
 
-def _h264_round_trip(
-    frames: np.ndarray, fps: float, bitrate: float, crf: int | None
-) -> np.ndarray:
+def _h264_round_trip(frames: np.ndarray, fps: float, bitrate: float, crf: int | None) -> np.ndarray:
     """``frames`` (T, H, W, 3) uint8 encoded with H.264 (yuv420p) and decoded again in memory."""
     from physbench.video.reader import _av
 

@@ -206,7 +206,7 @@ class SquareOnlyWithoutRenderError(BlobRenderer):
 
 
 class UnknownMode(BlobRenderer):
-    modes: ClassVar[tuple[str, ...]] = ("mark", "rgb")
+    modes: ClassVar[tuple[str, ...]] = ("mark", "sepia")
 
 
 class MaskOnly(BlobRenderer):
@@ -317,7 +317,7 @@ def test_checks_follow_the_declared_modes() -> None:
         (
             UnknownMode,
             check_protocol,
-            r"'modes' must be a non-empty tuple of mark, instance, mask",
+            r"'modes' must be a non-empty tuple of mark, instance, mask, rgb",
             (),
         ),
     ],
