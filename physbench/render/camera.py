@@ -8,7 +8,8 @@ Model, in the order light goes through it:
   distinct saturated colour each (a lit sphere for circles, a gentle gradient for polygons).
 - **Pose**: a pinhole camera aimed at the centre of ``scene.bounds``, turned by ``tilt``, ``yaw``
   and ``roll``, at the distance where the bounds plus a ``margin`` just fill the view. The scene
-  maps to the undistorted image by the homography ``K [r1 r2 t]``.
+  maps to the undistorted image by the homography ``K [r1 r2 t]``. A steep view may see past
+  the plane's horizon: those pixels are dark (and textures alias near it, as they would).
 - **Lens**: Brown's radial distortion ``k1``, ``k2`` about the image centre, normalised by the
   focal length in pixels (:class:`physbench.video.calibration.Lens`).
 - **Exposure**: the shutter is open for ``shutter`` of the frame interval, centred on the frame
@@ -147,6 +148,7 @@ class _View:
 
     def __init__(self, cam: CameraRenderer, scene: Scene, hw: tuple[int, int]) -> None:
         self.h, self.w = h, w = hw
+        self.fov_deg = cam.fov
         self.f = (w / 2) / math.tan(math.radians(cam.fov) / 2)
         self.centre = ((w - 1) / 2, (h - 1) / 2)
         self.k = np.array([[self.f, 0, self.centre[0]], [0, self.f, self.centre[1]], [0, 0, 1]])
@@ -166,13 +168,18 @@ class _View:
     def _check_lens(self) -> None:
         if self.lens is None:
             return
-        # Distortion must stay monotone out to the image corners, or pixels would fold over.
-        r2 = np.linspace(0.0, (self.centre[0] ** 2 + self.centre[1] ** 2) / self.f**2 * 1.5, 200)
+        # Distortion r -> r (1 + k1 r^2 + k2 r^4) must grow (no folding) until it reaches the
+        # image's corners: every pixel then sees exactly one point of the plane.
+        corner = math.hypot(*self.centre) / self.f + 1 / self.f
+        r = np.linspace(0.0, 4 * corner, 4001)
         k1, k2 = self.lens.k1, self.lens.k2
-        if (1 + 3 * k1 * r2 + 5 * k2 * r2 * r2).min() <= 0.05:
+        grows = 1 + 3 * k1 * r**2 + 5 * k2 * r**4 > 0.05
+        reach = r * (1 + k1 * r**2 + k2 * r**4) >= corner
+        folds = np.argmin(grows) if not grows.all() else len(r)
+        if not reach[:folds].any():
             raise RenderError(
-                f"k1 = {k1!r}, k2 = {k2!r}: the distortion folds the image over before its "
-                "corners; real lenses have |k1|, |k2| of a few tenths at most"
+                f"k1 = {k1!r}, k2 = {k2!r}: with fov = {self.fov_deg:g} the distortion folds the "
+                "image over before its corners; use a smaller |k1|, |k2| or field of view"
             )
 
     def project(self, xy: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
@@ -213,7 +220,7 @@ class _View:
             ]
         )
         q = (np.column_stack([edge, np.zeros(len(edge))]) - target) @ r_cw.T
-        hw, hh = self.w / 2 - 0.5, self.h / 2 - 0.5
+        hw, hh = self.w / 2, self.h / 2  # from the centre to the image's edge, u = -0.5 or W - 0.5
         # The closest distance with every outline point inside the undistorted image:
         # f |q_x| / (q_z + d) <= half width, and the same for y.
         size = max(x1 - x0, y1 - y0)
@@ -224,6 +231,7 @@ class _View:
                 (1e-3 * size - q[:, 2]).max(),
             )
         )
+        d *= 1 + 1e-9  # the outline exactly on the edge could round out of it
         for _ in range(400):
             centre = target - d * axis
             t = -r_cw @ centre
