@@ -65,6 +65,7 @@ PALETTE = (
 STATIC_COLOUR = (0.32, 0.30, 0.28)
 #: Unit vector towards the light that shades bodies: upper left, in front of the plane.
 _LIGHT = np.array([-0.45, 0.55, 0.70]) / np.linalg.norm([-0.45, 0.55, 0.70])
+#: Half-way between the light and the viewer (straight out of the plane): the highlight's normal.
 _HALF = (_LIGHT + np.array([0.0, 0.0, 1.0])) / np.linalg.norm(_LIGHT + np.array([0.0, 0.0, 1.0]))
 #: Views (pixel geometry, background, light) kept per renderer instance.
 _CACHE_SIZE = 4
@@ -301,7 +302,10 @@ def _coverage(sd: np.ndarray, foot: np.ndarray) -> np.ndarray:
     return np.clip(np.float32(0.5) - sd / foot, 0.0, 1.0)
 
 
-def _segment_distance(x: np.ndarray, y: np.ndarray, a: Sequence[float], b: Sequence[float]):  # type: ignore[no-untyped-def]
+def _segment_distance(
+    x: np.ndarray, y: np.ndarray, a: Sequence[float], b: Sequence[float]
+) -> np.ndarray:
+    """Distance (metres) from scene points to the segment ``a``-``b``."""
     ax, ay = a
     ex, ey = b[0] - ax, b[1] - ay
     ll = ex * ex + ey * ey
