@@ -151,18 +151,36 @@ def make_estimator(name: str, options: Mapping[str, Any]) -> CorrectionEstimator
     return _build("estimator", name, options)
 
 
+def default_render_mode(name: str) -> str:
+    """The channel layout of the registered renderer ``name`` when none is asked for: the first
+    it declares (``mark`` for raster, ``rgb`` for camera)."""
+    from physbench.plugins import get_registry
+
+    try:
+        cls = get_registry().get("renderer", name)
+    except UnknownNameError as exc:
+        raise PhysbenchError(str(exc)) from None
+    return str(cls.modes[0])
+
+
 def make_renderer(
-    name: str, options: Mapping[str, Any], *, resolution: int | tuple[int, int], mode: str
+    name: str,
+    options: Mapping[str, Any],
+    *,
+    resolution: int | tuple[int, int],
+    mode: str | None,
 ) -> Renderer:
     """Instantiate the registered renderer ``name`` with its ``options`` and the standard
-    ``resolution`` and ``mode``; options it does not take are refused with the list of those it
-    does."""
+    ``resolution`` and ``mode`` (``None``: :func:`default_render_mode`); options it does not take
+    are refused with the list of those it does."""
     clash = sorted({"resolution", "mode"} & set(options))
     if clash:
         raise PhysbenchError(
             f"renderer option {clash[0]!r}: set it with --resolution / --render-mode (in a sweep "
             "spec: the resolution and render_mode axes), not as a renderer option"
         )
+    if mode is None:
+        mode = default_render_mode(name)
     return _build("renderer", name, options, resolution=resolution, mode=mode)
 
 

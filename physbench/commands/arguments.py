@@ -9,7 +9,7 @@ import json
 from typing import Any
 
 #: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
-RENDER_MODES = ("mark", "instance", "mask")
+RENDER_MODES = ("mark", "instance", "mask", "rgb")
 
 
 def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
@@ -52,8 +52,10 @@ def add_renderer_arguments(
     p: argparse.ArgumentParser, *, resolution: int = 64, from_frames: bool = False
 ) -> None:
     """:func:`add_renderer_choice` plus ``--resolution PX`` and ``--render-mode MODE``.
-    ``from_frames``: for commands that fit observed frames, the resolution and the mode default to
-    ``None``, read from the frames (width, channel count)."""
+    The mode defaults to ``None``: the renderer's first declared layout
+    (:func:`~physbench.experiment.default_render_mode`). ``from_frames``: for commands that fit
+    observed frames, the resolution defaults to ``None`` too, and both are read from the frames
+    (width, channel count)."""
     add_renderer_choice(p)
     p.add_argument(
         "--resolution",
@@ -68,13 +70,13 @@ def add_renderer_arguments(
         "--render-mode",
         "--mode",
         dest="render_mode",
-        default=None if from_frames else "mark",
+        default=None,
         choices=RENDER_MODES,
         help="channel layout of the frames (default: "
         + (
             "from the frames' channels: 1 mask, 2 mark, one per body instance"
             if from_frames
-            else "mark"
+            else "the renderer's first layout: mark for raster, rgb for camera"
         )
         + ")",
     )

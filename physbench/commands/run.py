@@ -169,7 +169,7 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(f"--seed {args.seed}: expected a whole number >= 0")
 
     from physbench.commands.arguments import parse_key_values, renderer_choice
-    from physbench.experiment import RunConfig, check_config, run_config
+    from physbench.experiment import RunConfig, check_config, default_render_mode, run_config
 
     params = tuple(q for item in args.params for q in item.split(",") if q)
     bodies = (
@@ -192,7 +192,7 @@ def main(args: argparse.Namespace) -> int:
         blur=args.blur,
         noise=args.noise,
         resolution=args.resolution,
-        render_mode=args.render_mode,
+        render_mode=args.render_mode or default_render_mode(renderer),
         bodies=bodies,
         observation=args.observation,
     )

@@ -1,10 +1,16 @@
-"""``physbench simulate``: one scene instance -> trajectory + frames (.npz) and a preview."""
+"""``physbench simulate``: one scene instance -> trajectory + frames (.npz) or, filmed by the
+camera renderer, a video file, and a preview."""
 
 from __future__ import annotations
 
 import argparse
 
 from physbench.commands.arguments import add_renderer_arguments, make_renderer_from
+
+#: ``--out`` suffixes written as a video file (camera renderer only).
+VIDEO_SUFFIXES = (".mp4", ".mkv", ".avi", ".mov", ".webm", ".gif")
+#: ``--plate`` suffixes.
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -21,7 +27,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="override a body parameter, e.g. --set a.mass=3 (repeatable)",
     )
     add_renderer_arguments(p)
-    p.add_argument("--out", metavar="FILE.npz", help="write trajectory and frames here")
+    p.add_argument(
+        "--out",
+        metavar="FILE",
+        help="write trajectory and frames here: FILE.npz (any renderer), or with --renderer "
+        f"camera a video file ({', '.join(VIDEO_SUFFIXES)}) of the clip at the frames' times",
+    )
+    p.add_argument(
+        "--plate",
+        metavar="FILE.png",
+        help="with --renderer camera: write the empty scene (background, no bodies, no noise) as "
+        "an image, the clean plate a tracker takes as background",
+    )
     p.add_argument("--preview", metavar="FILE.gif|png", help="write a picture of the run")
 
 
@@ -49,31 +66,66 @@ def main(args: argparse.Namespace) -> int:
 
     from physbench.errors import PhysbenchError
     from physbench.plugins import create
+    from physbench.render.camera import CameraRenderer
     from physbench.scenes import resolve_scene
 
-    if args.out and not args.out.endswith(".npz"):
-        raise PhysbenchError(f"--out {args.out!r}: the output is an .npz file")
+    suffix = Path(args.out).suffix.lower() if args.out else ""
+    video = suffix in VIDEO_SUFFIXES
+    if args.out and suffix != ".npz" and not video:
+        raise PhysbenchError(
+            f"--out {args.out!r}: expected an .npz file, or a video file "
+            f"({', '.join(VIDEO_SUFFIXES)}) with --renderer camera"
+        )
+    if args.plate and Path(args.plate).suffix.lower() not in IMAGE_SUFFIXES:
+        raise PhysbenchError(
+            f"--plate {args.plate!r}: expected an image file ({', '.join(IMAGE_SUFFIXES)})"
+        )
     scene = resolve_scene(args.scene, args.seed)
     scene = scene.with_params(parse_overrides(args.set)).validate()
     renderer = make_renderer_from(args)  # a bad renderer or option fails before simulating
+    camera = renderer if isinstance(renderer, CameraRenderer) else None
+    for flag, value, wants in (
+        ("--out", args.out if video else None, "a video"),
+        ("--plate", args.plate, "a plate"),
+    ):
+        if value and camera is None:
+            raise PhysbenchError(
+                f"{flag} {value!r}: {wants} is filmed by --renderer camera; renderer "
+                f"{renderer.name!r} makes {renderer.mode!r} channels, not a colour image "
+                "(write its frames to an .npz file)"
+            )
     traj = create("simulator", args.engine).simulate(scene)
-    frames = renderer.render(scene, traj)
+    # A video is filmed by write() below: no separate render of the frames.
+    frames_shape = renderer.shape(scene, traj.frames) if video else None
+    frames = None if video else renderer.render(scene, traj)
     print(
         f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies "
         f"{', '.join(traj.bodies)}, "
-        f"frames {frames.shape}"
+        f"frames {frames_shape if frames is None else frames.shape}"
     )
     for i, name in enumerate(traj.bodies):
         (x0, y0), (x1, y1) = traj.states[0, i, :2], traj.states[-1, i, :2]
         print(f"  {name:>8}: ({x0:6.3f}, {y0:6.3f}) -> ({x1:6.3f}, {y1:6.3f}) m")
     if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    if args.out and video:
+        assert camera is not None
+        camera.write(args.out, scene, traj)
+        print(f"wrote {args.out}")
+    elif args.out:
         from physbench.scene_toml import dumps_scene
 
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(
             args.out, frames=frames, scene_toml=np.array(dumps_scene(scene)), **traj.to_npz_dict()
         )
         print(f"wrote {args.out}")
+    if args.plate:
+        from PIL import Image
+
+        assert camera is not None
+        Path(args.plate).parent.mkdir(parents=True, exist_ok=True)
+        Image.fromarray(camera.plate(scene)).save(args.plate)
+        print(f"wrote {args.plate}")
     if args.preview:
         from physbench.render.preview import save_preview
 

@@ -27,8 +27,9 @@ if TYPE_CHECKING:
 DEFAULT_RENDERER = "raster"
 #: Channel layouts: ``mark`` (the paper's: channel 0 every body but the focus body, channel 1 the
 #: focus body, empty without a focus), ``instance`` (one channel per body, ``scene.bodies`` order),
-#: ``mask`` (one channel, every body).
-MODES = ("mark", "instance", "mask")
+#: ``mask`` (one channel, every body), ``rgb`` (the three colour channels of a camera image, values
+#: in [0, 1]; no body is marked, a focus changes nothing).
+MODES = ("mark", "instance", "mask", "rgb")
 
 
 class RenderError(PhysbenchError, ValueError):
@@ -54,15 +55,16 @@ def check_resolution(resolution: object) -> int | tuple[int, int]:
 class Renderer:
     """Base class of every renderer (plugin contract).
 
-    Subclasses set :attr:`name` (and :attr:`modes` when they support fewer layouts), call
+    Subclasses set :attr:`name` and :attr:`modes` (the layouts they can produce), call
     ``super().__init__(resolution, mode)`` and implement :meth:`render`.
     """
 
     #: Registered name (unique among renderers).
     name: ClassVar[str] = ""
-    #: The channel layouts (:data:`MODES`) this renderer can produce. Estimators that correct one
-    #: marked object at a time need ``mark``.
-    modes: ClassVar[tuple[str, ...]] = MODES
+    #: The channel layouts (:data:`MODES`) this renderer can produce; by default the three
+    #: segmentation layouts (a camera-like renderer declares ``("rgb",)``). Estimators that
+    #: correct one marked object at a time need ``mark``.
+    modes: ClassVar[tuple[str, ...]] = ("mark", "instance", "mask")
 
     def __init__(self, resolution: int | tuple[int, int] = 64, mode: str = "mark") -> None:
         self.resolution = check_resolution(resolution)

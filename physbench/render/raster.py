@@ -170,6 +170,7 @@ class RasterRenderer(Renderer):
     """
 
     name: ClassVar[str] = "raster"
+    modes: ClassVar[tuple[str, ...]] = ("mark", "instance", "mask")
 
     def __init__(self, resolution: int | tuple[int, int] = 64, mode: str = "mark") -> None:
         super().__init__(resolution, mode)

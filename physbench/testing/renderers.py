@@ -105,7 +105,9 @@ def _modes(cls: type[Renderer]) -> tuple[str, ...]:
 
 
 #: Channels ``C`` of each mode for a scene of ``n`` bodies (see :data:`MODES`).
-CHANNELS = {"mark": lambda n: 2, "instance": lambda n: n, "mask": lambda n: 1}
+CHANNELS = {"mark": lambda n: 2, "instance": lambda n: n, "mask": lambda n: 1, "rgb": lambda n: 3}
+#: Smallest largest change a body makes to an ``rgb`` image (sensor noise stays well below).
+SHOWS_TOL = 0.1
 
 
 # --------------------------------------------------------------------------- checks
@@ -176,7 +178,9 @@ def check_shape(cls: type[Renderer], **options: Any) -> None:
 
 
 def check_frames(cls: type[Renderer], **options: Any) -> None:
-    """In every mode the frames are float32, finite, inside [0, 1] and show the bodies."""
+    """In every mode the frames are float32, finite, inside [0, 1] and show the bodies. An
+    ``rgb`` image is never empty, so there each body must change some pixel by at least
+    :data:`SHOWS_TOL` (the frames of the scene without it differ), and a focus changes nothing."""
     scene = probe_scene()
     for mode in _modes(cls):
         frames = np.asarray(_render(cls, _build(cls, options, mode), scene))
@@ -196,6 +200,27 @@ def check_frames(cls: type[Renderer], **options: Any) -> None:
                 f"{label(cls)}: mode {mode!r}: every frame is empty; the probe scene's two "
                 "bodies lie inside its bounds"
             )
+        if mode == "rgb":
+            _check_rgb(cls, options, frames)
+
+
+def _check_rgb(cls: type[Renderer], options: Mapping[str, Any], frames: np.ndarray) -> None:
+    scene = probe_scene()
+    ren = _build(cls, options, "rgb")
+    for name in scene.body_names:
+        (other,) = (n for n in scene.body_names if n != name)
+        without = np.asarray(_render(cls, ren, alone(scene, other)))
+        if _far(frames, without) < SHOWS_TOL:
+            raise ConformanceError(
+                f"{label(cls)}: mode 'rgb': body {name!r} does not show (the frames without it "
+                f"differ by {_far(frames, without):.3g} at most)"
+            )
+    focused = np.asarray(_render(cls, ren, scene, focus=scene.body_names[0]))
+    if not np.array_equal(focused, frames):
+        raise ConformanceError(
+            f"{label(cls)}: mode 'rgb': focus={scene.body_names[0]!r} changes the frames "
+            f"(by up to {_far(focused, frames):.3g}); an rgb image marks no body"
+        )
 
 
 def check_deterministic(cls: type[Renderer], **options: Any) -> None:

@@ -56,7 +56,7 @@ def test_an_item_without_a_key_names_the_flag(item: str) -> None:
 def test_renderer_choice_defaults_to_the_default_renderer_without_options() -> None:
     args = _parse()
     assert renderer_choice(args) == (DEFAULT_RENDERER, {})
-    assert (args.resolution, args.render_mode) == (64, "mark")
+    assert (args.resolution, args.render_mode) == (64, None)  # None: the renderer's first mode
     assert _parse(resolution=32).resolution == 32
 
 
@@ -84,3 +84,11 @@ def test_render_modes_are_the_renderers_and_mode_is_an_alias() -> None:
 def test_make_renderer_from_uses_the_resolution_and_mode() -> None:
     ren = make_renderer_from(_parse("--resolution", "24", "--render-mode", "instance"))
     assert (ren.name, ren.resolution, ren.mode) == (DEFAULT_RENDERER, 24, "instance")
+
+
+def test_without_a_mode_each_renderer_gets_its_first_layout() -> None:
+    assert make_renderer_from(_parse("--resolution", "24")).mode == "mark"
+    camera = make_renderer_from(_parse("--renderer", "camera", "--resolution", "24"))
+    assert (camera.name, camera.mode) == ("camera", "rgb")
+    with pytest.raises(PhysbenchError, match="renderer 'camera' supports modes rgb"):
+        make_renderer_from(_parse("--renderer", "camera", "--render-mode", "mark"))

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from physbench.cli import main
 
@@ -86,3 +87,35 @@ def test_the_renderer_is_a_choice(tmp_path: Path, capsys, squares_renderer) -> N
     assert "renderer 'squares' refused options {'size': '0.5.1'}" in capsys.readouterr().err
     assert main(["simulate", "--scene", "three_circles", "--renderer", "nope"]) == 2
     assert "unknown renderer 'nope'" in capsys.readouterr().err
+
+
+def test_the_camera_films_a_video_file_and_its_plate(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    pytest.importorskip("av")
+    from PIL import Image
+
+    from physbench.scenes import resolve_scene
+    from physbench.video.reader import VideoReader
+
+    clip, plate = tmp_path / "clip.mp4", tmp_path / "plate.png"
+    argv = ["simulate", "--scene", "three_circles", "--renderer", "camera", "--resolution", "96"]
+    assert main([*argv, "--out", str(clip), "--plate", str(plate)]) == 0
+    assert f"wrote {clip}" in capsys.readouterr().out
+    scene = resolve_scene("three_circles", 0)
+    frames = list(VideoReader(clip).frames())
+    assert len(frames) == scene.frames and frames[0].image.shape == (72, 96, 3)
+    np.testing.assert_allclose(
+        [f.time for f in frames], np.arange(scene.frames) * scene.dt, atol=1e-3
+    )
+    assert np.asarray(Image.open(plate)).shape == (72, 96, 3)
+
+
+def test_video_and_plate_outputs_need_the_camera(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    base = ["simulate", "--scene", "three_circles", "--resolution", "16"]
+    assert main([*base, "--out", str(tmp_path / "a.mp4")]) == 2
+    err = capsys.readouterr().err
+    assert "a video is filmed by --renderer camera; renderer 'raster' makes 'mark'" in err
+    assert main([*base, "--plate", str(tmp_path / "p.png")]) == 2
+    assert "a plate is filmed by --renderer camera" in capsys.readouterr().err
+    assert main([*base, "--out", str(tmp_path / "a.txt")]) == 2
+    assert "expected an .npz file, or a video file (.mp4, .mkv" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())

@@ -48,7 +48,7 @@ def test_shape_defaults_to_a_rendered_still() -> None:
 
 
 def test_modes_and_resolution_are_checked_for_every_renderer() -> None:
-    assert MODES == ("mark", "instance", "mask")
+    assert MODES == ("mark", "instance", "mask", "rgb")
     with pytest.raises(RenderError, match="renderer 'dots' supports modes mask"):
         Dots(mode="mark")
     assert check_resolution(32) == 32 and check_resolution([48, 64]) == (48, 64)

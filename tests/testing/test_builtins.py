@@ -48,7 +48,10 @@ BUILTINS = builtins()
 def test_every_kind_has_builtins() -> None:
     # Guards the parametrized test below against an empty registry (it would pass vacuously).
     by_kind = {kind: {s.cls.name for s in BUILTINS if kind_of(s.cls) == kind} for kind in KINDS}
-    assert by_kind["simulator"] == {"pymunk", "box2d"} and by_kind["renderer"] == {"raster"}
+    assert by_kind["simulator"] == {"pymunk", "box2d"} and by_kind["renderer"] == {
+        "raster",
+        "camera",
+    }
     assert by_kind["effect"] == {cls.name for cls in BUILTIN_EFFECTS}
     assert {"random", "tpe", "cmaes", "optuna", "resnet3d"} <= by_kind["estimator"]
     assert "scipy" not in by_kind["estimator"]  # the example plugin tests itself

@@ -206,11 +206,47 @@ class SquareOnlyWithoutRenderError(BlobRenderer):
 
 
 class UnknownMode(BlobRenderer):
-    modes: ClassVar[tuple[str, ...]] = ("mark", "rgb")
+    modes: ClassVar[tuple[str, ...]] = ("mark", "sepia")
 
 
 class MaskOnly(BlobRenderer):
     modes: ClassVar[tuple[str, ...]] = ("mask",)
+
+
+class RgbBlobs(BlobRenderer):
+    """A correct ``rgb`` renderer: coloured blobs on a grey image; a focus changes nothing."""
+
+    modes: ClassVar[tuple[str, ...]] = ("rgb",)
+    colours: ClassVar[dict[str, np.ndarray]] = {
+        "disc": np.array([0.9, 0.1, 0.1], np.float32),
+        "block": np.array([0.1, 0.2, 0.9], np.float32),
+    }
+
+    def channels(self, scene: Scene) -> int:
+        return 3
+
+    def draw(self, scene: Scene, traj: Trajectory, focus: str | None) -> np.ndarray:
+        mask = BlobRenderer(self.resolution, "instance").draw(scene, traj, None)
+        frames = np.full((traj.frames, 3, *self.hw), 0.5, np.float32)
+        for i, name in enumerate(scene.body_names):
+            colour = self.colour(scene, name, focus)[None, :, None, None]
+            frames += mask[:, i : i + 1] * (colour - frames)
+        return frames
+
+    def colour(self, scene: Scene, name: str, focus: str | None) -> np.ndarray:
+        return self.colours[name]
+
+
+class RgbHidesBlock(RgbBlobs):
+    def colour(self, scene: Scene, name: str, focus: str | None) -> np.ndarray:
+        return (
+            np.full(3, 0.5, np.float32) if name == "block" else super().colour(scene, name, focus)
+        )
+
+
+class RgbMarksFocus(RgbBlobs):
+    def colour(self, scene: Scene, name: str, focus: str | None) -> np.ndarray:
+        return np.ones(3, np.float32) if name == focus else super().colour(scene, name, focus)
 
 
 def failing_checks(cls: type) -> list[str]:
@@ -227,9 +263,10 @@ def test_correct_renderers_pass() -> None:
     check_renderer(BlobRenderer, resolution=24)
     check_renderer(ToyRenderer)  # mark only, square images (refuses (height, width) clearly)
     check_renderer(MaskOnly)
+    check_renderer(RgbBlobs)
 
 
-@parametrize_with_checks([BlobRenderer, ToyRenderer, MaskOnly])
+@parametrize_with_checks([BlobRenderer, ToyRenderer, MaskOnly, RgbBlobs])
 def test_correct_renderers_pass_every_parametrized_check(component: Subject, check: Check) -> None:
     check(component)
 
@@ -314,10 +351,17 @@ def test_checks_follow_the_declared_modes() -> None:
             r"resolution=\(20, 28\) raised TypeError: .*raise physbench.render.base.RenderError",
             (),
         ),
+        (RgbHidesBlock, check_frames, "mode 'rgb': body 'block' does not show", ()),
+        (
+            RgbMarksFocus,
+            check_frames,
+            "mode 'rgb': focus='disc' changes the frames .* an rgb image marks no body",
+            (),
+        ),
         (
             UnknownMode,
             check_protocol,
-            r"'modes' must be a non-empty tuple of mark, instance, mask",
+            r"'modes' must be a non-empty tuple of mark, instance, mask, rgb",
             (),
         ),
     ],
