@@ -157,7 +157,8 @@ class _View:
             Lens(cam.k1, cam.k2, self.centre, self.f) if cam.k1 != 0 or cam.k2 != 0 else None
         )
         self._check_lens()
-        self.to_image_h = self._pose(cam, scene.bounds)  # scene -> undistorted pixels
+        # scene -> undistorted pixels
+        self.to_image_h = self._pose(cam, scene.bounds if cam.view is None else cam.view)
         self.to_scene_h = np.linalg.inv(self.to_image_h)
         self.to_scene_h /= self.to_scene_h[2, 2]
         self._pixels()
@@ -422,6 +423,24 @@ def _light(cam: CameraRenderer, view: _View) -> np.ndarray:
     return ((1 - cam.light) + cam.light * s).astype(np.float32)
 
 
+def _region(view: object) -> tuple[float, float, float, float]:
+    """``view`` as ``(xmin, ymin, xmax, ymax)`` with ``xmin < xmax`` and ``ymin < ymax``."""
+    try:
+        vals = tuple(float(v) for v in view)  # type: ignore[attr-defined]
+    except (TypeError, ValueError):
+        vals = ()
+    if (
+        len(vals) != 4
+        or not all(map(math.isfinite, vals))
+        or not (vals[0] < vals[2] and vals[1] < vals[3])
+    ):
+        raise RenderError(
+            f"view = {view!r}: expected [xmin, ymin, xmax, ymax] in metres with xmin < xmax and "
+            "ymin < ymax"
+        )
+    return vals  # type: ignore[return-value]
+
+
 class CameraRenderer(Renderer):
     """A camera filming the scene: ``rgb`` frames with perspective, lens distortion, motion blur,
     a textured background, shaded bodies, uneven and flickering light, sensor noise and
@@ -440,6 +459,8 @@ class CameraRenderer(Renderer):
     - ``fov`` (deg, default 50): horizontal field of view, in [5, 150].
     - ``margin`` (fraction of the bounds' width and height, default 0.08): space around
       ``scene.bounds`` in the view, in [0, 2].
+    - ``view`` (``[xmin, ymin, xmax, ymax]`` in metres, default ``scene.bounds``): the part of
+      the plane to frame, e.g. where the motion happens in a large world.
     - ``k1``, ``k2`` (default 0): Brown radial lens distortion about the image centre, normalised
       by the focal length in pixels (< 0 barrel, > 0 pincushion); each in [-1, 1].
     - ``shutter`` (fraction of the frame interval, default 0.5): exposure time, in [0, 1].
@@ -482,8 +503,10 @@ class CameraRenderer(Renderer):
         seed: int = 0,
         bitrate: float = 0,
         crf: int | None = None,
+        view: Sequence[float] | None = None,
     ) -> None:
         super().__init__(resolution, mode)
+        self.view = None if view is None else _region(view)
         self.tilt = _number("tilt", tilt, -90, 90, open_=True)
         self.yaw = _number("yaw", yaw, -90, 90, open_=True)
         self.roll = _number("roll", roll, -360, 360)
@@ -524,7 +547,7 @@ class CameraRenderer(Renderer):
         return (scene.frames if frames is None else frames, 3, *self.image_size())
 
     def _view(self, scene: Scene) -> _View:
-        key = (scene.bounds, scene.statics)
+        key = (scene.bounds, scene.statics, self.view)
         view = self._views.get(key)
         if view is None:
             if len(self._views) >= _CACHE_SIZE:

@@ -97,7 +97,12 @@ def video_observation(
     from physbench.video.background import load_plate, median_background
     from physbench.video.calibration import load_calibration
     from physbench.video.reader import VideoReader
-    from physbench.video.segment import Segmenter, foreground, noise_threshold
+    from physbench.video.segment import (
+        Segmenter,
+        body_threshold,
+        difference,
+        noise_threshold,
+    )
     from physbench.video.track import default_calibration, track_video
 
     reader = VideoReader(path, start=start, end=end)
@@ -130,13 +135,14 @@ def video_observation(
     views: dict[str | None, np.ndarray] = {
         b: np.zeros(expected, np.float32) for b in (None, *marked)
     }
-    threshold = None
+    floor = None
     for k, fr, t in scene_frames(reader.frames(), times, what=str(path)):
-        if threshold is None:
-            threshold = noise_threshold(fr.image, background)
-        cov = seg.coverage(
-            foreground(fr.image, background, threshold), poses_at(recording, scene, t)
-        )
+        if floor is None:
+            floor = noise_threshold(fr.image, background)
+        poses = poses_at(recording, scene, t)
+        diff = difference(fr.image, background)
+        threshold = body_threshold(diff, calibration.to_image(poses[:, :2]), floor)
+        cov = seg.coverage((diff > threshold).astype(np.float32), poses)
         for b, arr in views.items():
             arr[k] = seg.frame(cov, b)
     frames = views.pop(None)

@@ -98,6 +98,18 @@ def test_four_image_points_give_the_true_calibration() -> None:
     assert (uv > 2).all() and (uv[:, 0] < 317).all() and (uv[:, 1] < 237).all()
 
 
+def test_a_view_frames_part_of_the_plane() -> None:
+    scene = one_body((1.0, 1.0))
+    whole, part = CameraRenderer(320), CameraRenderer(320, view=(0.5, 0.5, 1.5, 1.25))
+    centre = np.array([[1.0, 0.875]])
+    np.testing.assert_allclose(part.image_points(scene, centre)[0], (159.5, 119.5), atol=1e-6)
+    # A quarter of the world's width fills the image: four times the pixels per metre.
+    ratio = whole.calibration(scene).metres_per_pixel((160, 120)) / part.calibration(
+        scene
+    ).metres_per_pixel((160, 120))
+    assert ratio == pytest.approx(4.0, rel=1e-6)
+
+
 def test_a_tilted_camera_sees_parallel_lines_converge() -> None:
     scene = one_body((2.0, 1.5))
     corners = np.array([(0.0, 0.0), (4.0, 0.0), (4.0, 3.0), (0.0, 3.0)])
@@ -184,6 +196,8 @@ def test_noise_light_and_flicker_change_the_picture_as_asked() -> None:
         ("noise", -0.1, r"noise = -0.1: expected a number in \[0, 1\]"),
         ("crf", 60, r"crf = 60"),
         ("shutter", 1.5, r"shutter = 1.5"),
+        ("view", [0, 0, 1], r"view = \[0, 0, 1\]: expected \[xmin, ymin, xmax, ymax\]"),
+        ("view", [2, 0, 1, 1], r"with xmin < xmax"),
     ],
 )
 def test_bad_options_are_named(option: str, value: object, message: str) -> None:
