@@ -230,6 +230,11 @@ def _check_observation(config: RunConfig) -> None:
         "--start": config.video_start,
         "--end": config.video_end,
     }
+    if config.observer_options and not config.observer:
+        raise PhysbenchError(
+            f"observer options {dict(config.observer_options)} but no observer: name the camera "
+            "renderer that films the observation (--observer camera)"
+        )
     stray = [k for k, v in video_only.items() if v is not None]
     if stray and not config.video:
         raise PhysbenchError(f"{', '.join(stray)} apply to a --video only; no --video was given")

@@ -99,6 +99,46 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="observed frames (.npz with key 'frames', (T, C, H, W) in [0, 1])",
     )
+    video = p.add_argument_group(
+        "video",
+        "observe a camera's video (tracked, then segmented into per-body masks in the scene's "
+        "frame), or film the simulated observation with a camera renderer",
+    )
+    video.add_argument(
+        "--video", default=None, metavar="FILE", help="a video file or a folder of images"
+    )
+    video.add_argument(
+        "--calibration",
+        default=None,
+        metavar="C.toml",
+        help="pixels to metres (default: the scene's bounds fill the frame; docs/video.md)",
+    )
+    video.add_argument(
+        "--background",
+        default=None,
+        metavar="IMAGE",
+        help="a picture of the empty scene (default: the video's median)",
+    )
+    video.add_argument(
+        "--start", type=float, default=None, metavar="S", help="skip the video's first S seconds"
+    )
+    video.add_argument(
+        "--end", type=float, default=None, metavar="S", help="stop at S seconds into the video"
+    )
+    video.add_argument(
+        "--observer",
+        default=None,
+        metavar="NAME",
+        help="film the simulated observation with this camera renderer (e.g. camera), then track "
+        "and segment it: the visual gap",
+    )
+    video.add_argument(
+        "--observer-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an option of --observer, repeatable (e.g. tilt=15, bitrate=2000000, resolution=640)",
+    )
     p.add_argument(
         "--save-observation",
         default=None,
@@ -195,6 +235,13 @@ def main(args: argparse.Namespace) -> int:
         render_mode=args.render_mode or default_render_mode(renderer),
         bodies=bodies,
         observation=args.observation,
+        observer=args.observer,
+        observer_options=parse_key_values(args.observer_option, "--observer-option"),
+        video=args.video,
+        calibration=args.calibration,
+        background=args.background,
+        video_start=args.start,
+        video_end=args.end,
     )
     space = check_config(config)  # a bad name or option: fail before the progress bar appears
 
@@ -257,6 +304,6 @@ def main(args: argparse.Namespace) -> int:
     else:
         print(
             f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation "
-            f"from {args.observation})"
+            f"from {args.observation or args.video})"
         )
     return 0
