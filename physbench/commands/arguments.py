@@ -97,3 +97,26 @@ def make_renderer_from(args: argparse.Namespace) -> Any:
 
     name, options = renderer_choice(args)
     return make_renderer(name, options, resolution=args.resolution, mode=args.render_mode)
+
+
+def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
+    """The flags that say how to read a camera's video: ``--calibration``, ``--background``,
+    ``--start``, ``--end`` (the same in ``track``, ``run --video`` and ``discover VIDEO``)."""
+    group.add_argument(
+        "--calibration",
+        default=None,
+        metavar="C.toml",
+        help="pixels to metres (default: the scene's bounds fill the frame; docs/video.md)",
+    )
+    group.add_argument(
+        "--background",
+        default=None,
+        metavar="IMAGE",
+        help="a picture of the empty scene (default: the video's median)",
+    )
+    group.add_argument(
+        "--start", type=float, default=None, metavar="S", help="skip the video's first S seconds"
+    )
+    group.add_argument(
+        "--end", type=float, default=None, metavar="S", help="stop at S seconds into the video"
+    )

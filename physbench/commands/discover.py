@@ -5,15 +5,16 @@ from __future__ import annotations
 
 import argparse
 
-from physbench.commands.arguments import add_renderer_arguments
+from physbench.commands.arguments import add_renderer_arguments, add_video_input_arguments
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "recording",
         metavar="RECORDING",
-        help="tracked trajectories (.csv: t,body,x,y[,angle][,run]) or observed frames "
-        "(.npz, key 'frames')",
+        help="tracked trajectories (.csv: t,body,x,y[,angle][,run]), observed frames "
+        "(.npz, key 'frames'), or a camera's video (.mp4, .mov, .avi, .mkv, .webm, .gif, or a "
+        "folder of images): tracked first, as physbench track does",
     )
     p.add_argument(
         "--scene",
@@ -76,6 +77,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--seed", type=int, default=0, help="seed of a black-box base-fit estimator (default 0)"
     )
     p.add_argument("-q", "--quiet", action="store_true", help="print only the causes and the gain")
+    video = p.add_argument_group("video", "when RECORDING is a video: how to read and track it")
+    add_video_input_arguments(video)
+    video.add_argument(
+        "--track-out",
+        default=None,
+        metavar="REC.csv",
+        help="also write the video's tracks as a recording CSV",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -88,7 +97,17 @@ def main(args: argparse.Namespace) -> int:
     from physbench.discover.verdict import text, to_dict
     from physbench.plugins import create
 
-    runs = load_runs(args.recording, args.scene, run=args.run)
+    runs = load_runs(
+        args.recording,
+        args.scene,
+        run=args.run,
+        calibration=args.calibration,
+        background=args.background,
+        start=args.start,
+        end=args.end,
+        track_out=args.track_out,
+        progress=not args.quiet,
+    )
     nuisance = args.nuisance[0] if args.nuisance in (["auto"], ["none"]) else list(args.nuisance)
     kw = {
         k: v

@@ -12,7 +12,7 @@ import argparse
 import sys
 from typing import Any
 
-from physbench.commands.arguments import add_renderer_arguments
+from physbench.commands.arguments import add_renderer_arguments, add_video_input_arguments
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -107,24 +107,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     video.add_argument(
         "--video", default=None, metavar="FILE", help="a video file or a folder of images"
     )
-    video.add_argument(
-        "--calibration",
-        default=None,
-        metavar="C.toml",
-        help="pixels to metres (default: the scene's bounds fill the frame; docs/video.md)",
-    )
-    video.add_argument(
-        "--background",
-        default=None,
-        metavar="IMAGE",
-        help="a picture of the empty scene (default: the video's median)",
-    )
-    video.add_argument(
-        "--start", type=float, default=None, metavar="S", help="skip the video's first S seconds"
-    )
-    video.add_argument(
-        "--end", type=float, default=None, metavar="S", help="stop at S seconds into the video"
-    )
+    add_video_input_arguments(video)
     video.add_argument(
         "--observer",
         default=None,

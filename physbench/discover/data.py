@@ -22,6 +22,7 @@ from physbench.recording import Recording, Track
 if TYPE_CHECKING:
     from physbench.datasets.run import DatasetRun
     from physbench.scene import Scene
+    from physbench.video.calibration import Calibration
 
 #: Fewest samples (recordings) or frames (frames) a run needs in its fitted and held-out parts.
 MIN_FIT_SAMPLES = 6
@@ -85,20 +86,52 @@ def runs_from_dataset(runs: Iterable[DatasetRun]) -> list[Run]:
 
 
 def load_runs(
-    recording: str | Path, scene: Scene | str | Path, *, run: str | None = None
+    recording: str | Path,
+    scene: Scene | str | Path,
+    *,
+    run: str | None = None,
+    calibration: Calibration | str | Path | None = None,
+    background: str | Path | None = None,
+    start: float | None = None,
+    end: float | None = None,
+    track_out: str | Path | None = None,
+    progress: bool = False,
 ) -> list[Run]:
     """Runs from a recording file (``.csv``: tracked trajectories, one run per ``run`` label;
-    ``.npz``: observed frames under key ``frames``) and a scene (object or ``.toml`` file) that
-    every run shares. ``run`` keeps one run of a multi-run CSV."""
+    ``.npz``: observed frames under key ``frames``; a video file or a folder of images: tracked
+    first, see :func:`~physbench.video.track.track_video`) and a scene (object or ``.toml`` file)
+    that every run shares. ``run`` keeps one run of a multi-run CSV. ``calibration``,
+    ``background``, ``start`` and ``end`` apply to a video only; ``track_out`` writes its tracks as
+    a recording CSV."""
     from physbench.scene_toml import load_scene
+    from physbench.video.reader import VIDEO_SUFFIXES, is_video
 
     sc = scene if not isinstance(scene, str | Path) else load_scene(scene)
     sc.validate()
     path = Path(recording)
-    if not path.is_file():
+    video = is_video(path)
+    if not path.exists() or (not video and not path.is_file()):
         raise DiscoverError(
-            f"recording file {str(path)!r} does not exist; expected a .csv recording or .npz frames"
+            f"recording file {str(path)!r} does not exist; expected a .csv recording, .npz frames "
+            f"or a video ({', '.join(VIDEO_SUFFIXES)}, or a folder of images)"
         )
+    stray = {
+        "calibration": calibration,
+        "background": background,
+        "start": start,
+        "end": end,
+        "track_out": track_out,
+    }
+    stray_given = [k for k, v in stray.items() if v is not None]
+    if stray_given and not video:
+        raise DiscoverError(
+            f"{', '.join(stray_given)} apply to a video only; {str(path)!r} is not a video "
+            f"({', '.join(VIDEO_SUFFIXES)}, or a folder of images)"
+        )
+    if video:
+        return [
+            _video_run(path, sc, calibration, background, start, end, track_out, progress=progress)
+        ]
     suffix = path.suffix.lower()
     if suffix == ".csv":
         from physbench.recording import read_recordings
@@ -119,9 +152,40 @@ def load_runs(
         ]
     raise DiscoverError(
         f"recording {str(path)!r}: unknown format {suffix or '(no suffix)'!r}; expected .csv "
-        "(tracked "
-        "trajectories t,body,x,y[,angle][,run]) or .npz (frames)"
+        "(tracked trajectories t,body,x,y[,angle][,run]), .npz (frames) or a video "
+        f"({', '.join(VIDEO_SUFFIXES)}, or a folder of images)"
     )
+
+
+def _video_run(
+    path: Path,
+    scene: Scene,
+    calibration: Calibration | str | Path | None,
+    background: str | Path | None,
+    start: float | None,
+    end: float | None,
+    track_out: str | Path | None,
+    *,
+    progress: bool,
+) -> Run:
+    """Track the scene's bodies through a video into one run; the summary goes to stderr."""
+    import sys
+
+    from physbench.recording import write_recordings
+    from physbench.video.calibration import load_calibration
+    from physbench.video.track import track_video
+
+    cal = load_calibration(calibration) if isinstance(calibration, str | Path) else calibration
+    tracked = track_video(
+        path, scene, cal, start=start, end=end, background=background, progress=progress
+    )
+    if progress:
+        print(tracked.summary.format(), file=sys.stderr)
+    if track_out is not None:
+        write_recordings(track_out, tracked.recording)
+        if progress:
+            print(f"wrote {track_out}", file=sys.stderr)
+    return Run(path.stem, scene, recording=tracked.recording, source=str(path))
 
 
 # --------------------------------------------------------------------------- splitting

@@ -38,6 +38,9 @@ class SyntheticRun:
     effect: str | None
     truth: dict[str, float] = field(default_factory=dict)
     options: dict[str, Any] = field(default_factory=dict)
+    #: What the bodies really did (the effect's measurement included), before tracking noise: what
+    #: a camera filming the run would see.
+    trajectory: Trajectory | None = None
 
 
 def _rng(seed: int, salt: int) -> np.random.Generator:
@@ -379,6 +382,25 @@ def hidden_values(effect: str, scene: Scene, rng: np.random.Generator) -> dict[s
     raise KeyError(effect)
 
 
+def magnitude_error(effect: str, truth: dict[str, float], got: dict[str, float]) -> float:
+    """Relative error of the fitted magnitude: of the parameter vector for vector effects (force,
+    tilt, offset), of the restitution law over the impact speeds seen (1.5-5 m/s) for the contact
+    law, of the single parameter otherwise."""
+    if effect == "velocity_dependent_restitution":
+        v = np.linspace(1.5, 5.0, 8)
+        from physbench.effects import restitution_law
+
+        want = np.asarray(restitution_law(v, truth["e0"], truth["k"]))
+        have = np.asarray(restitution_law(v, got["e0"], got["k"]))
+        return float(np.max(np.abs(have - want) / want))
+    keys = list(truth)
+    t = np.array([truth[k] for k in keys])
+    g = np.array([got.get(k, math.nan) for k in keys])
+    if effect == "clock_scale":  # the magnitude is the deviation from a true clock
+        t, g = t - 1.0, g - 1.0
+    return float(np.linalg.norm(g - t) / np.linalg.norm(t))
+
+
 def _record(
     scene_kind: str, scene: Scene, traj: Trajectory, t_end: float, rng: np.random.Generator
 ) -> Recording:
@@ -429,6 +451,7 @@ def make_case(effect: str | None, scene_kind: str, seed: int, engine: Any) -> Sy
         Run(name, _blur(scene, rng), recording=rec, source="synthetic"),
         effect,
         truth,
+        trajectory=traj,
     )
 
 

@@ -7,6 +7,8 @@ nearest video frame and segment it into the model renderer's frames
 (:class:`~physbench.video.segment.Segmenter`), once unmarked and once per marked body.
 :func:`filmed_observation` does the same to a simulated observation filmed by a camera renderer
 and encoded as a real video file: the visual gap between a camera and sharp renders.
+:func:`filmed_recording` films a trajectory and tracks it: what a camera and the tracker make of
+known motion, for discovery from video.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ if TYPE_CHECKING:
     from physbench.render.camera import CameraRenderer
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
+    from physbench.trajectory import Trajectory
     from physbench.video.calibration import Calibration
     from physbench.video.reader import Frame
 
@@ -177,3 +180,62 @@ def filmed_observation(
     obs.truth = dict(truth)
     obs.source = f"simulated ({type(simulator).name}), filmed by {camera.name}"
     return obs
+
+
+def motion_view(scene: Scene, traj: Trajectory, *, margin: float = 0.15) -> list[float]:
+    """``[xmin, ymin, xmax, ymax]`` (m) around where ``traj``'s bodies go, padded by their size and
+    ``margin`` of the extent: the part of a large world a camera should frame (a camera's
+    ``view`` option)."""
+    pos = np.asarray(traj.states, dtype=float)[:, :, :2].reshape(-1, 2)
+    reach = max(b.shape.extent() for b in scene.bodies)
+    lo, hi = pos.min(axis=0) - reach, pos.max(axis=0) + reach
+    pad = margin * (hi - lo).max()
+    return [float(lo[0] - pad), float(lo[1] - pad), float(hi[0] + pad), float(hi[1] + pad)]
+
+
+def frame_trajectory(traj: Trajectory, times: np.ndarray) -> Trajectory:
+    """``traj`` resampled at ``times`` (s; linear in every state column): a trajectory on a
+    camera's frame clock when the simulation's differs (a measurement effect that rescales time)."""
+    from physbench.trajectory import Trajectory
+
+    src = np.asarray(traj.times, dtype=float)
+    states = np.asarray(traj.states, dtype=float)
+    out = np.empty((len(times), *states.shape[1:]))
+    for i in range(states.shape[1]):
+        for c in range(states.shape[2]):
+            out[:, i, c] = np.interp(times, src, states[:, i, c])
+    return Trajectory(traj.bodies, np.asarray(times, dtype=float), out, traj.engine)
+
+
+def filmed_recording(
+    scene: Scene,
+    traj: Trajectory,
+    camera: CameraRenderer,
+    *,
+    fields: tuple[str, ...] | None = None,
+    run: str = "",
+) -> Recording:
+    """Film ``traj`` of ``scene`` with ``camera`` into an encoded video file, track it
+    (:func:`~physbench.video.track.track_video`) with a calibration through the four corners of the
+    camera's view as a user would click them and the camera's plate as the background, and return
+    the tracks in the scene's metres; ``fields`` and ``run`` label the recording."""
+    from dataclasses import replace
+
+    from physbench.video.calibration import Calibration
+    from physbench.video.track import track_video
+
+    xmin, ymin, xmax, ymax = camera.view if camera.view is not None else scene.bounds
+    corners = np.array([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
+    cal = Calibration.from_points(
+        camera.image_points(scene, corners), corners, lens=camera.calibration(scene).lens
+    )
+    with tempfile.TemporaryDirectory(prefix="physbench-film-") as tmp:
+        clip = Path(tmp) / "run.mp4"
+        camera.write(clip, scene, traj)
+        rec = track_video(clip, scene, cal, background=camera.plate(scene)).recording
+    return replace(
+        rec,
+        fields=rec.fields if fields is None else fields,
+        run=run or rec.run,
+        source=f"filmed by {camera.name}, tracked",
+    )

@@ -24,6 +24,15 @@ from physbench.errors import PhysbenchError
 
 #: Image files a folder may hold, as frames.
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+#: Suffixes taken for video files where a command also accepts other inputs (any container FFmpeg
+#: reads opens in :class:`VideoReader`; these are the ones a command recognises by name).
+VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".avi", ".mkv", ".webm", ".gif", ".mpg", ".mpeg")
+
+
+def is_video(path: str | Path) -> bool:
+    """Whether a command should read ``path`` as a video: a video suffix or a folder."""
+    p = Path(path)
+    return p.is_dir() or p.suffix.lower() in VIDEO_SUFFIXES
 
 
 class VideoError(PhysbenchError, ValueError):

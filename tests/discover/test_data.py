@@ -44,3 +44,20 @@ def test_load_runs_reads_one_run_per_label(tmp_path, slide):
     runs = load_runs(tmp_path / "r.csv", tmp_path / "s.toml")
     assert [r.name for r in runs] == ["a", "b"] and runs[0].scene.frames == 21
     assert [r.name for r in load_runs(tmp_path / "r.csv", tmp_path / "s.toml", run="b")] == ["b"]
+
+
+def test_video_options_apply_to_a_video_only(tmp_path, slide):
+    t = np.arange(21) * 0.05
+    write_recordings(tmp_path / "r.csv", Recording({"ball": Track(t, 1 + 2 * t, 1 + 0.5 * t)}))
+    save_scene(slide(), tmp_path / "s.toml")
+    with pytest.raises(DiscoverError, match=r"calibration, start apply to a video only"):
+        load_runs(tmp_path / "r.csv", tmp_path / "s.toml", calibration="c.toml", start=1.0)
+
+
+def test_unknown_inputs_name_every_accepted_format(tmp_path, slide):
+    save_scene(slide(), tmp_path / "s.toml")
+    (tmp_path / "r.txt").write_text("hello")
+    with pytest.raises(DiscoverError, match=r"\.csv.*\.npz.*\.mp4.*folder of images"):
+        load_runs(tmp_path / "r.txt", tmp_path / "s.toml")
+    with pytest.raises(DiscoverError, match=r"does not exist.*\.mp4"):
+        load_runs(tmp_path / "missing.mp4", tmp_path / "s.toml")

@@ -12,15 +12,13 @@ suite within its CI budget. ``PHYSBENCH_DISCOVERY_LOG=FILE`` appends one JSON li
 from __future__ import annotations
 
 import json
-import math
 import os
 
-import numpy as np
 import pytest
 
 from physbench.discover import discover
-from physbench.discover.synthetic import EFFECT_SCENES, SCENES, make_case
-from physbench.effects import BUILTIN_EFFECTS, restitution_law
+from physbench.discover.synthetic import EFFECT_SCENES, SCENES, magnitude_error, make_case
+from physbench.effects import BUILTIN_EFFECTS
 from physbench.simulators.box2d_sim import Box2DSimulator
 from physbench.simulators.pymunk_sim import PymunkSimulator
 
@@ -36,23 +34,6 @@ HIDDEN = [
     for seed in SEEDS
 ]
 CONTROLS = [(sc, eng, seed) for sc in sorted(SCENES) for eng in ENGINES for seed in SEEDS]
-
-
-def magnitude_error(effect: str, truth: dict[str, float], got: dict[str, float]) -> float:
-    """Relative error of the fitted magnitude: of the parameter vector for vector effects (force,
-    tilt, offset), of the restitution law over the impact speeds seen (1.5-5 m/s) for the contact
-    law, of the single parameter otherwise."""
-    if effect == "velocity_dependent_restitution":
-        v = np.linspace(1.5, 5.0, 8)
-        want = np.asarray(restitution_law(v, truth["e0"], truth["k"]))
-        have = np.asarray(restitution_law(v, got["e0"], got["k"]))
-        return float(np.max(np.abs(have - want) / want))
-    keys = list(truth)
-    t = np.array([truth[k] for k in keys])
-    g = np.array([got.get(k, math.nan) for k in keys])
-    if effect == "clock_scale":  # the magnitude is the deviation from a true clock
-        t, g = t - 1.0, g - 1.0
-    return float(np.linalg.norm(g - t) / np.linalg.norm(t))
 
 
 def _log(**row: object) -> None:
