@@ -26,6 +26,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="BODY.PARAM=VALUE",
         help="override a body parameter, e.g. --set a.mass=3 (repeatable)",
     )
+    p.add_argument(
+        "--effect",
+        action="append",
+        default=[],
+        metavar="NAME[:KEY=VALUE,...]",
+        help="simulate with an effect, e.g. linear_drag:c=0.3 (repeatable; see `physbench "
+        "plugins`): a recording or clip with physics the scene's model lacks, for discover",
+    )
     add_renderer_arguments(p)
     p.add_argument(
         "--out",
@@ -56,6 +64,29 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
             raise PhysbenchError(
                 f"--set {item!r}: expected BODY.PARAM=NUMBER, e.g. a.mass=3.5"
             ) from None
+    return out
+
+
+def make_effects(items: list[str]) -> list:
+    """Effect instances from ``--effect NAME[:KEY=VALUE,...]`` items."""
+    from physbench.errors import PhysbenchError
+    from physbench.plugins import create
+
+    out = []
+    for item in items:
+        name, _, rest = item.partition(":")
+        values: dict[str, float] = {}
+        for pair in filter(None, (p.strip() for p in rest.split(","))):
+            key, sep, value = pair.partition("=")
+            try:
+                if not sep or not key.strip():
+                    raise ValueError
+                values[key.strip()] = float(value)
+            except ValueError:
+                raise PhysbenchError(
+                    f"--effect {item!r}: expected NAME[:KEY=NUMBER,...], e.g. linear_drag:c=0.3"
+                ) from None
+        out.append(create("effect", name.strip(), **values))
     return out
 
 
@@ -94,7 +125,12 @@ def main(args: argparse.Namespace) -> int:
                 f"{renderer.name!r} makes {renderer.mode!r} channels, not a colour image "
                 "(write its frames to an .npz file)"
             )
-    traj = create("simulator", args.engine).simulate(scene)
+    effects = make_effects(args.effect)
+    traj = create("simulator", args.engine).simulate(scene, effects=effects)
+    if effects:
+        from physbench.effects import apply_measurements
+
+        traj = apply_measurements(traj, effects)
     # A video is filmed by write() below: no separate render of the frames.
     frames_shape = renderer.shape(scene, traj.frames) if video else None
     frames = None if video else renderer.render(scene, traj)

@@ -158,6 +158,9 @@ def test_estimator_options(capsys: pytest.CaptureFixture[str]) -> None:
         (["--observation", "x.npz", "--blur", "2"], "cannot apply to --observation frames"),
         (["--observation", "missing.npz"], "observation file 'missing.npz' does not exist"),
         (["--blur", "-1"], "blur = -1.0: expected a finite number >= 0"),
+        (["--calibration", "c.toml"], "--calibration apply to a --video only"),
+        (["--observer-option", "tilt=5"], "but no observer: name the camera renderer"),
+        (["--video", "v.mp4", "--observation", "x.npz"], "give one source of the observation"),
     ],
 )
 def test_clear_errors(capsys: pytest.CaptureFixture[str], argv: list[str], message: str) -> None:
@@ -204,3 +207,24 @@ def test_bad_renderer_choices_are_named(
     assert code == 2 and "supports modes mark, mask" in err
     code, _, err = run(capsys, "-R", "resolution=8", *FAST)
     assert code == 2 and "--resolution" in err
+
+
+def test_video_and_filmed_observations(capsys: pytest.CaptureFixture[str], tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from physbench.plugins import create
+    from physbench.render.camera import CameraRenderer
+    from physbench.scenes import resolve_scene
+
+    # The visual gap: the simulated observation filmed, encoded, tracked and segmented.
+    code, out, _ = run(
+        capsys, *FAST, "--observer", "camera", "--observer-option", "tilt=10", "--json", "-q"
+    )
+    history = json.loads(out)
+    assert code == 0 and history["meta"]["observer"] == "camera"
+    assert history["meta"]["observer_options"] == {"tilt": 10}
+    assert history["iterations"][0]["param_error"] is not None
+    # A user's video: the same scene filmed, no truth known.
+    scene = resolve_scene("three_circles", 0)
+    cam = CameraRenderer(640, seed=4)
+    cam.write(tmp_path / "clip.mp4", scene, create("simulator", "pymunk").simulate(scene))
+    code, out, _ = run(capsys, *FAST, "--video", str(tmp_path / "clip.mp4"))
+    assert code == 0 and f"no truth: observation from {tmp_path / 'clip.mp4'}" in out

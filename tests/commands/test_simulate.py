@@ -119,3 +119,21 @@ def test_video_and_plate_outputs_need_the_camera(tmp_path: Path, capsys) -> None
     assert main([*base, "--out", str(tmp_path / "a.txt")]) == 2
     assert "expected an .npz file, or a video file (.mp4, .mkv" in capsys.readouterr().err
     assert not list(tmp_path.iterdir())
+
+
+def test_effects_change_the_simulated_motion(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    assert main(["simulate", "--scene", "ball_drop", "--out", str(tmp_path / "free.npz")]) == 0
+    argv = ["--effect", "linear_drag:c=0.5", "--out", str(tmp_path / "drag.npz")]
+    assert main(["simulate", "--scene", "ball_drop", *argv]) == 0
+    free, drag = np.load(tmp_path / "free.npz"), np.load(tmp_path / "drag.npz")
+    fall = free["states"][0, 0, 1] - free["states"][-1, 0, 1]
+    slowed = drag["states"][0, 0, 1] - drag["states"][-1, 0, 1]
+    assert 0 < slowed < 0.5 * fall  # drag c = 0.5 kg/s on a light ball: a much shorter fall
+    capsys.readouterr()
+    for bad, message in (
+        ("linear_drag:c", "expected NAME[:KEY=NUMBER,...]"),
+        ("linear_drag:q=1", "known parameters of effect 'linear_drag': c"),
+        ("nope", "unknown effect 'nope'; known effects: clock_scale"),
+    ):
+        assert main(["simulate", "--scene", "ball_drop", "--effect", bad]) == 2
+        assert message in capsys.readouterr().err
