@@ -355,12 +355,15 @@ class Tracker:
             for j, i in enumerate(ids):
                 if any(i in v for v in owner.values()):
                     continue
-                near = [c for c in np.argsort(dist[j]) if dist[j, c] <= gates[i] + reach[i]]
-                for c in near[:1]:
+                for c in np.argsort(dist[j]):
+                    _, u, v, _ = blobs[c]
+                    if np.hypot(u - preds[i, 0], v - preds[i, 1]).min() > gates[i]:
+                        continue  # the prediction is not on this blob
                     taken = owner.get(int(c), [])
                     expected = sum(self.states[k].area for k in taken) + self.states[i].area
                     if blobs[c][0].area > 0.6 * expected:
                         owner.setdefault(int(c), []).append(i)
+                        break
             for c, members in owner.items():
                 blob, u, v, w = blobs[c]
                 if len(members) == 1:
