@@ -84,7 +84,7 @@ def write_overlay(
 
         images = [Image.fromarray(f) for f in marked()]
         gaps = np.diff(times) if len(times) > 1 else np.array([0.1])
-        ms = int(round(1000 * float(np.median(gaps))))
+        ms = round(1000 * float(np.median(gaps)))
         images[0].save(out, save_all=True, append_images=images[1:], duration=ms, loop=0)
         return out
     from physbench.video.writer import write_video
