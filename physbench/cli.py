@@ -28,6 +28,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "discover",
         "find the missing physical effect behind a recording's disagreement with the model",
     ),
+    "track": ("track", "follow a scene's bodies through a video into a recording CSV (metres)"),
 }
 
 

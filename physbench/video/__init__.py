@@ -1,4 +1,8 @@
-"""From a camera's video to the scene's metres. So far: reading and writing video with container
+"""From a camera's video to the scene's metres: reading and writing video with container
 timestamps (:mod:`~physbench.video.reader`, :mod:`~physbench.video.writer`, PyAV: ``pip install
-physbench[video]``) and calibration, pixels to metres on the plane of motion
-(:mod:`~physbench.video.calibration`)."""
+physbench[video]``), calibration, pixels to metres on the plane of motion
+(:mod:`~physbench.video.calibration`), tracking the scene's bodies into a recording
+(:mod:`~physbench.video.background`, :mod:`~physbench.video.detect`,
+:mod:`~physbench.video.track`, pictures in :mod:`~physbench.video.overlay`; ``physbench track``),
+and per-body masks for the correction loop (:mod:`~physbench.video.segment`,
+:mod:`~physbench.video.observe`)."""

@@ -106,14 +106,14 @@ def video_observation(
         difference,
         noise_threshold,
     )
-    from physbench.video.track import default_calibration, track_video
+    from physbench.video.track import bounds_calibration, track_video
 
     reader = VideoReader(path, start=start, end=end)
     info = reader.info()
     if isinstance(calibration, str | Path):
         calibration = load_calibration(calibration)
     if calibration is None:
-        calibration = default_calibration(scene, (info.height, info.width))
+        calibration = bounds_calibration(scene, (info.height, info.width))
     if isinstance(background, str | Path):
         background = load_plate(background)
     tracked = track_video(path, scene, calibration, start=start, end=end, background=background)

@@ -1,0 +1,76 @@
+"""``physbench track``: follow a scene's bodies through a video into a recording CSV."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("video", metavar="VIDEO", help="video file (mp4, mov, webm, gif, ...)")
+    p.add_argument(
+        "--scene",
+        required=True,
+        help="the filmed scene: registered name or .toml file (its initial positions say where "
+        "the bodies start)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="scene instance seed (default 0)")
+    p.add_argument(
+        "--calibration",
+        metavar="C.toml",
+        help="pixels to metres ([scale], [[points]] or [body]; default: the scene's bounds fill "
+        "the frame)",
+    )
+    p.add_argument("--out", required=True, metavar="REC.csv", help="write the recording here")
+    p.add_argument(
+        "--preview", metavar="FILE.mp4|.gif", help="write the video with the tracks drawn on"
+    )
+    p.add_argument("--start", type=float, help="track from this time (s); it becomes t = 0")
+    p.add_argument("--end", type=float, help="track up to this time (s)")
+    p.add_argument(
+        "--background",
+        metavar="IMAGE",
+        help="image of the empty scene (default: the median of the video)",
+    )
+    p.add_argument("-q", "--quiet", action="store_true", help="print only where files went")
+
+
+def main(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from physbench.errors import PhysbenchError
+    from physbench.recording import write_recordings
+    from physbench.scenes import resolve_scene
+    from physbench.video.calibration import load_calibration
+    from physbench.video.overlay import OVERLAY_SUFFIXES, write_overlay
+    from physbench.video.track import track_video
+
+    video = Path(args.video)
+    for flag, value in (("--out", args.out), ("--preview", args.preview)):
+        if value and video.exists() and Path(value).resolve() == video.resolve():
+            raise PhysbenchError(f"{flag} {value!r} is the input video; choose another file")
+    if Path(args.out).suffix.lower() != ".csv":
+        raise PhysbenchError(f"--out {args.out!r}: expected a .csv recording file")
+    if args.preview and Path(args.preview).suffix.lower() not in OVERLAY_SUFFIXES:
+        raise PhysbenchError(
+            f"--preview {args.preview!r}: expected a {' or '.join(OVERLAY_SUFFIXES)} file"
+        )
+    scene = resolve_scene(args.scene, args.seed).validate()
+    calibration = load_calibration(args.calibration) if args.calibration else None
+    result = track_video(
+        video,
+        scene,
+        calibration,
+        start=args.start,
+        end=args.end,
+        background=args.background,
+        progress=not args.quiet,
+    )
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    write_recordings(args.out, result.recording)
+    if not args.quiet:
+        print(result.summary.format())
+    print(f"wrote {args.out}")
+    if args.preview:
+        write_overlay(args.preview, video, result.pixels, start=args.start, end=args.end)
+        print(f"wrote {args.preview}")
+    return 0

@@ -1,0 +1,69 @@
+"""The background a tracker subtracts: a plate of the empty scene, or the median of the video.
+
+A plate (an image filmed before the bodies came in, or :meth:`CameraRenderer.plate
+<physbench.render.camera.CameraRenderer.plate>`) is the better choice: the median of a clip holds a
+body that never moves as background. :func:`median_background` streams the video and keeps about
+``samples`` frames spread over the whole clip (it never holds the video in memory).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from physbench.errors import PhysbenchError
+
+if TYPE_CHECKING:
+    from physbench.video.reader import Frame, VideoReader
+
+
+class BackgroundError(PhysbenchError, ValueError):
+    """A background that cannot be used: names the file or the value and what is expected."""
+
+
+def load_plate(path: str | Path) -> np.ndarray:
+    """The image of the empty scene at ``path`` (png, jpg, ...) as ``(H, W, 3)`` uint8 RGB."""
+    from PIL import Image, UnidentifiedImageError
+
+    p = Path(path)
+    if not p.is_file():
+        raise BackgroundError(f"background image {str(p)!r} does not exist")
+    try:
+        with Image.open(p) as im:
+            return np.array(im.convert("RGB"))
+    except (OSError, UnidentifiedImageError, ValueError) as exc:
+        raise BackgroundError(
+            f"background image {str(p)!r} cannot be read as an image (png, jpg, bmp, tif): {exc}"
+        ) from None
+
+
+def median_background(
+    source: VideoReader | Iterable[Frame | np.ndarray], *, samples: int = 30
+) -> np.ndarray:
+    """The per-pixel median of about ``samples`` frames spread over the whole of ``source`` (a
+    :class:`~physbench.video.reader.VideoReader` or frames / ``(H, W, 3)`` arrays), streamed: it
+    keeps every ``k``-th frame and doubles ``k`` (dropping every other kept frame) whenever more
+    than ``2 samples`` are held, so memory stays flat in the video's length."""
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+        raise BackgroundError(f"samples = {samples!r}: expected a whole number >= 1")
+    frames = source.frames() if hasattr(source, "frames") else source
+    kept: list[np.ndarray] = []
+    step = 1
+    for i, fr in enumerate(frames):
+        if i % step:
+            continue
+        kept.append(np.asarray(getattr(fr, "image", fr)))
+        if len(kept) > 2 * samples:
+            kept = kept[::2]
+            step *= 2
+    if not kept:
+        raise BackgroundError("no frames to take a median background from")
+    if len(kept) > samples:  # thin evenly to about `samples`
+        kept = [kept[int(j)] for j in np.linspace(0, len(kept) - 1, samples).round()]
+    shapes = {k.shape for k in kept}
+    if len(shapes) != 1:
+        raise BackgroundError(f"frames of different sizes: {sorted(shapes)}")
+    return np.median(np.stack(kept), axis=0).round().astype(np.uint8)

@@ -1,0 +1,74 @@
+"""``physbench track``: a clip becomes a recording CSV and a preview; bad input gets a clear error
+and the input file is never changed."""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from physbench.cli import main
+from physbench.plugins import create
+from physbench.recording import read_recording
+from physbench.render.camera import CameraRenderer
+from physbench.scenes import resolve_scene
+
+
+@pytest.fixture(scope="module")
+def clip(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("track")
+    scene = resolve_scene("bouncing_balls", 4)
+    traj = create("simulator", "pymunk").simulate(scene)
+    cam = CameraRenderer(640, bitrate=1_500_000, seed=4)
+    cam.write(tmp / "clip.mp4", scene, traj)
+    Image.fromarray(cam.plate(scene)).save(tmp / "plate.png")
+    cal = cam.calibration(scene).homography
+    rows = "\n".join(f"[{', '.join(repr(float(x)) for x in r)}]," for r in cal)
+    (tmp / "cal.toml").write_text(f"[homography]\nmatrix = [\n{rows}\n]\n")
+    return tmp, scene, traj
+
+
+def digest(path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def test_a_clip_becomes_a_recording_and_a_preview(clip, capsys) -> None:
+    tmp, scene, traj = clip
+    before = digest(tmp / "clip.mp4")
+    args = ["track", str(tmp / "clip.mp4"), "--scene", "bouncing_balls", "--seed", "4"]
+    args += ["--calibration", str(tmp / "cal.toml"), "--background", str(tmp / "plate.png")]
+    args += ["--out", str(tmp / "out" / "rec.csv"), "--preview", str(tmp / "ov.mp4")]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "tracked" in out and "reprojection error" in out and "wrote" in out
+    rec = read_recording(tmp / "out" / "rec.csv", bodies=scene)
+    assert rec.bodies == scene.body_names
+    got = np.column_stack([rec.track("test").x, rec.track("test").y])
+    assert np.abs(got - traj.states[:, 0, :2]).max() < 0.01  # metres, 1.5 px
+    assert (tmp / "ov.mp4").stat().st_size > 0 and digest(tmp / "clip.mp4") == before
+
+
+def test_bad_input_gets_a_clear_error(clip, capsys) -> None:
+    tmp, _, _ = clip
+    before = digest(tmp / "clip.mp4")
+    data = (tmp / "clip.mp4").read_bytes()
+    (tmp / "cut.mp4").write_bytes(data[: len(data) // 2])
+    (tmp / "junk.mp4").write_bytes(b"\x00" * 1000)
+    (tmp / "bad.png").write_text("no image")
+    base = ["--scene", "bouncing_balls", "--seed", "4", "--out", str(tmp / "r.csv")]
+    cases = [
+        (["track", str(tmp / "junk.mp4"), *base], "not a video FFmpeg can read"),
+        (["track", str(tmp / "cut.mp4"), *base], "cut.mp4"),
+        (["track", str(tmp / "clip.mp4"), *base, "--start", "20"], "has no frames after 20 s"),
+        (["track", str(tmp / "clip.mp4"), "--scene", "three_circles", *base[4:]], "not in the"),
+        (["track", str(tmp / "clip.mp4"), *base, "--background", str(tmp / "bad.png")], "bad.png"),
+        (["track", str(tmp / "clip.mp4"), *base[:4], "--out", str(tmp / "clip.mp4")], "input"),
+        (["track", str(tmp / "clip.mp4"), *base, "--preview", str(tmp / "p.png")], ".gif"),
+    ]
+    for argv, message in cases:
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.startswith("physbench track: error:") and message in err, err
+    assert digest(tmp / "clip.mp4") == before

@@ -1,0 +1,40 @@
+"""Backgrounds: a plate is read or refused by name; the median streams and removes moving bodies."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from physbench.video.background import BackgroundError, load_plate, median_background
+
+
+def test_a_plate_reads_as_rgb_and_bad_files_are_named(tmp_path) -> None:
+    img = np.random.default_rng(0).integers(0, 256, (6, 8, 3), dtype=np.uint8)
+    Image.fromarray(img).convert("L").save(tmp_path / "grey.png")
+    plate = load_plate(tmp_path / "grey.png")
+    assert plate.shape == (6, 8, 3) and plate.dtype == np.uint8
+    with pytest.raises(BackgroundError, match="does not exist"):
+        load_plate(tmp_path / "none.png")
+    (tmp_path / "bad.png").write_text("not an image")
+    with pytest.raises(BackgroundError, match=r"'.*bad.png' cannot be read as an image"):
+        load_plate(tmp_path / "bad.png")
+
+
+def test_the_median_removes_a_moving_body_and_holds_few_frames() -> None:
+    bg = np.full((10, 40, 3), 90, np.uint8)
+    held = []
+
+    def frames(n: int):
+        for i in range(n):
+            img = bg.copy()
+            img[4:7, i % 40 : i % 40 + 3] = 250  # a body sweeping across
+            held.append(img)
+            yield img
+
+    out = median_background(frames(1000), samples=9)
+    np.testing.assert_array_equal(out, bg)
+    with pytest.raises(BackgroundError, match="samples = 0"):
+        median_background(frames(3), samples=0)
+    with pytest.raises(BackgroundError, match="no frames"):
+        median_background(iter([]))

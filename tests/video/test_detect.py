@@ -1,0 +1,57 @@
+"""Detection: anti-aliased discs give sub-pixel centres, touching discs split at their contact,
+and moments give a long axis and a square's sides."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from physbench.video.detect import find_blobs, split_blob
+
+
+def disc(img: np.ndarray, u: float, v: float, r: float, level: float = 200.0) -> None:
+    """Add an anti-aliased disc (4x4 supersampled coverage) to ``img``."""
+    h, w = img.shape
+    off = (np.arange(4) + 0.5) / 4 - 0.5
+    vv, uu = np.mgrid[0:h, 0:w].astype(float)
+    cov = np.zeros_like(img)
+    for a in off:
+        for b in off:
+            cov += np.hypot(uu + a - u, vv + b - v) <= r
+    img += level * cov / 16
+
+
+def test_a_disc_centre_is_found_to_a_twentieth_of_a_pixel() -> None:
+    for u, v in [(30.0, 20.0), (30.37, 19.81), (31.5, 22.25)]:
+        img = np.zeros((48, 64))
+        disc(img, u, v, 9.3)
+        ((blob, *_),) = find_blobs(img, 20.0, 100.0)
+        assert abs(blob.u - u) < 0.05 and abs(blob.v - v) < 0.05  # 4x4-sampled edges
+        assert abs(blob.area - math.pi * 9.3**2) < 0.08 * math.pi * 9.3**2  # edges count from 0.6
+        assert blob.elongation < 1.05
+
+
+def test_touching_discs_split_at_their_contact() -> None:
+    img = np.zeros((48, 80))
+    disc(img, 30.2, 24.4, 10.0)
+    disc(img, 50.3, 23.6, 10.0)
+    blobs = find_blobs(np.minimum(img, 200), 20.0, 100.0, offset=(5, 7))
+    assert len(blobs) == 1  # one blob for both
+    _, u, v, w = blobs[0]
+    guess = np.array([[28.0 + 7, 26.0 + 5], [52.0 + 7, 22.0 + 5]])  # a few px off
+    a, b = split_blob(u, v, w, guess, np.array([10.0, 10.0]))
+    assert np.hypot(a.u - 37.2, a.v - 29.4) < 0.3 and np.hypot(b.u - 57.3, b.v - 28.6) < 0.3
+
+
+def test_moments_give_the_long_axis_and_a_squares_sides() -> None:
+    vv, uu = np.mgrid[0:60, 0:60].astype(float)
+    for angle in (0.2, -0.6, 1.1):
+        c, s = math.cos(angle), math.sin(angle)
+        lu, lv = c * (uu - 30) + s * (vv - 30), -s * (uu - 30) + c * (vv - 30)
+        bar = 200.0 * ((np.abs(lu) < 15) & (np.abs(lv) < 4))
+        ((blob, *_),) = find_blobs(bar, 20.0, 100.0)
+        assert abs(blob.axis - angle) < 0.02 and blob.elongation > 5
+        square = 200.0 * ((np.abs(lu) < 10) & (np.abs(lv) < 10))
+        ((blob, *_),) = find_blobs(square, 20.0, 100.0)
+        assert abs((blob.square - angle + math.pi / 4) % (math.pi / 2) - math.pi / 4) < 0.03
