@@ -4,9 +4,15 @@ from __future__ import annotations
 
 import argparse
 
+from physbench.commands.arguments import add_video_input_arguments
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("video", metavar="VIDEO", help="video file (mp4, mov, webm, gif, ...)")
+    p.add_argument(
+        "video",
+        metavar="VIDEO",
+        help="a video file (mp4, mov, avi, mkv, webm, gif, ...) or a folder of images",
+    )
     p.add_argument(
         "--scene",
         required=True,
@@ -14,23 +20,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "the bodies start)",
     )
     p.add_argument("--seed", type=int, default=0, help="scene instance seed (default 0)")
-    p.add_argument(
-        "--calibration",
-        metavar="C.toml",
-        help="pixels to metres ([scale], [[points]] or [body]; default: the scene's bounds fill "
-        "the frame)",
-    )
     p.add_argument("--out", required=True, metavar="REC.csv", help="write the recording here")
     p.add_argument(
         "--preview", metavar="FILE.mp4|.gif", help="write the video with the tracks drawn on"
     )
-    p.add_argument("--start", type=float, help="track from this time (s); it becomes t = 0")
-    p.add_argument("--end", type=float, help="track up to this time (s)")
-    p.add_argument(
-        "--background",
-        metavar="IMAGE",
-        help="image of the empty scene (default: the median of the video)",
-    )
+    add_video_input_arguments(p)
     p.add_argument("-q", "--quiet", action="store_true", help="print only where files went")
 
 

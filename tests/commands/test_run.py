@@ -221,7 +221,7 @@ def test_video_and_filmed_observations(capsys: pytest.CaptureFixture[str], tmp_p
     history = json.loads(out)
     assert code == 0 and history["meta"]["observer"] == "camera"
     assert history["meta"]["observer_options"] == {"tilt": 10}
-    assert history["iterations"][0]["param_error"] is not None
+    assert history["truth"] and history["iterations"][0]["nmse"] is not None
     # A user's video: the same scene filmed, no truth known.
     scene = resolve_scene("three_circles", 0)
     cam = CameraRenderer(640, seed=4)

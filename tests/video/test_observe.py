@@ -95,7 +95,7 @@ def test_a_filmed_encoded_clip_segments_into_the_sharp_masks(circles, tmp_path) 
     assert obs.frames.shape == ref.shape and obs.truth is None
     assert np.mean((obs.frames - ref) ** 2) < 0.02 * np.mean(ref**2)
     for name in marked:
-        view = obs.views[name]
+        view = obs.marked[name]
         want = sharp.render(scene, traj, focus=name)
         assert np.mean((view - want) ** 2) < 0.03 * np.mean(want**2), name
         # The marked body's channel holds about all of its area.
