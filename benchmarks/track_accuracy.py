@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import tempfile
 from pathlib import Path
 
@@ -21,10 +20,8 @@ import numpy as np
 from physbench.plugins import create
 from physbench.render.camera import CameraRenderer
 from physbench.scenes import bouncing_balls
+from physbench.video.accuracy import pixel_errors
 from physbench.video.track import track_video
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "video"))
-from conftest import Clip, pixel_errors
 
 
 def main() -> None:
@@ -45,7 +42,7 @@ def main() -> None:
                 path = Path(tmp) / "clip.mp4"
                 cam.write(path, scene, traj)
                 res = track_video(path, scene, cam.calibration(scene), background=cam.plate(scene))
-                errors, swaps = pixel_errors(Clip(path, scene, traj, cam), res.pixels)
+                errors, swaps = pixel_errors(scene, traj, cam, res.pixels)
                 missing = scene.frames * len(scene.bodies) - errors.size
                 every[engine].append(errors)
                 cases.append(

@@ -2,10 +2,11 @@
 
 A pixel's *coverage* is how much of it a body covers, estimated from the difference to the
 background: ``(diff - low) / (high - low)`` clipped to ``[0, 1]``, with ``high`` about half the
-bodies' contrast and ``low`` above the noise. Blobs are the connected pixels above ``low``
-(:func:`scipy.ndimage.label`); a blob's centre is the coverage-weighted mean of its pixels, so a
-partly covered edge pixel counts in part and the centre moves smoothly with the body (and, under
-motion blur, sits at the middle of the smear: the body's pose at mid-exposure).
+bodies' contrast and ``low`` above the noise, on a blob's rim; pixels inside a blob count whole.
+Blobs are the connected pixels above ``low`` (:func:`scipy.ndimage.label`); a blob's centre is
+the coverage-weighted mean of its pixels, so a partly covered edge pixel counts in part and the
+centre moves smoothly with the body (and, under motion blur, sits at the middle of the smear: the
+body's pose at mid-exposure).
 
 Orientation comes from moments: the second moments give a blob's long axis (``symmetry=2``, for an
 elongated body), the fourth-order angular moment a square's sides (``symmetry=4``). Where one blob
@@ -40,6 +41,30 @@ class Blob:
     @property
     def centre(self) -> np.ndarray:
         return np.array([self.u, self.v])
+
+
+@dataclass(frozen=True)
+class Outline:
+    """A body's outline in the image around its centre, for sharing a blob between bodies: a disc
+    of ``radius`` px, or a convex polygon of ``vertices`` ``(K, 2)`` px around the centre (a box or
+    polygon at its predicted angle, through the calibration)."""
+
+    radius: float
+    vertices: np.ndarray | None = None
+
+    def distance(self, du: np.ndarray, dv: np.ndarray) -> np.ndarray:
+        """Signed distance (px, < 0 inside) of pixels at offsets ``(du, dv)`` from the centre;
+        exact inside a polygon and along its sides, a lower bound off its corners."""
+        if self.vertices is None:
+            return np.hypot(du, dv) - self.radius
+        p = np.asarray(self.vertices, dtype=np.float64)
+        q = np.roll(p, -1, axis=0)
+        e = q - p
+        ccw = float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1])) > 0
+        n = np.stack([e[:, 1], -e[:, 0]], axis=1) * (1.0 if ccw else -1.0)
+        n /= np.maximum(np.hypot(n[:, 0], n[:, 1]), 1e-12)[:, None]
+        d = n[:, :1] * (du[None] - p[:, :1]) + n[:, 1:] * (dv[None] - p[:, 1:])
+        return d.max(axis=0)
 
 
 def coverage(diff: np.ndarray, low: float, high: float) -> np.ndarray:
@@ -82,6 +107,9 @@ def find_blobs(
     if n == 0:
         return []
     cov = coverage(diff, low, high)
+    # Inside a blob a pixel is covered whole, however dim its shading or the wall behind it: only
+    # the rim is weighed by contrast (else a shaded body's centre leans to its lit side).
+    cov[ndimage.binary_erosion(mask)] = 1.0
     out = []
     for k, sl in enumerate(ndimage.find_objects(labels), start=1):
         if sl is None:
@@ -104,23 +132,25 @@ def split_blob(
     v: np.ndarray,
     w: np.ndarray,
     centres: np.ndarray,
-    radii: np.ndarray,
+    outlines: list[Outline],
     *,
     iterations: int = 6,
 ) -> list[Blob | None]:
-    """Share one blob's pixels among bodies predicted at ``centres`` (``(N, 2)`` px) with outline
-    radii ``radii`` (``(N,)`` px): each pixel goes to the body whose outline is nearest (signed
-    distance, so touching discs split along their contact), and each body's centre is re-fitted to
-    the pixels it owns within its radius, ``iterations`` times. One blob (or ``None``) per body."""
+    """Share one blob's pixels among bodies predicted at ``centres`` (``(N, 2)`` px) with
+    ``outlines``: each pixel goes to the body whose outline is nearest (signed distance, so
+    touching bodies split along their contact), and each body's centre is re-fitted to the pixels
+    it owns inside its outline, ``iterations`` times. One blob (or ``None``) per body."""
     c = np.array(centres, dtype=np.float64)
-    r = np.asarray(radii, dtype=np.float64)
-    owner = np.zeros(u.size, dtype=np.intp)
+
+    def distances() -> np.ndarray:
+        return np.stack([o.distance(u - c[j, 0], v - c[j, 1]) for j, o in enumerate(outlines)])
+
     for _ in range(iterations):
-        dist = np.hypot(u[None] - c[:, :1], v[None] - c[:, 1:])  # (N, P)
-        owner = np.argmin(dist - r[:, None], axis=0)
+        dist = distances()  # (N, P)
+        owner = np.argmin(dist, axis=0)
         moved = 0.0
         for j in range(len(c)):
-            inside = (owner == j) & (dist[j] <= r[j] + 1.0)
+            inside = (owner == j) & (dist[j] <= 1.0)
             wj = w[inside]
             if wj.sum() <= 0:
                 continue
@@ -129,8 +159,7 @@ def split_blob(
             c[j] = new
         if moved < 0.01:
             break
-    dist = np.hypot(u[None] - c[:, :1], v[None] - c[:, 1:])
-    owner = np.argmin(dist - r[:, None], axis=0)
+    owner = np.argmin(distances(), axis=0)
     out: list[Blob | None] = []
     for j in range(len(c)):
         mine = owner == j

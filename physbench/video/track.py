@@ -34,7 +34,7 @@ import numpy as np
 
 from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
-from physbench.video.detect import Blob, find_blobs, split_blob
+from physbench.video.detect import Blob, Outline, find_blobs, split_blob
 from physbench.video.segment import difference, noise_threshold
 
 if TYPE_CHECKING:
@@ -82,6 +82,18 @@ def _symmetry(body: Body) -> tuple[int, float]:
     if isinstance(shape, Box):
         return 4, 0.0
     return 0, 0.0
+
+
+def _area_centroid(pts: np.ndarray) -> np.ndarray:
+    """The centroid of the polygon ``pts`` ``(K, 2)``'s area (its vertex mean if degenerate)."""
+    q = np.roll(pts, -1, axis=0)
+    cross = pts[:, 0] * q[:, 1] - q[:, 0] * pts[:, 1]
+    a = cross.sum() / 2
+    if abs(a) < 1e-15:
+        return pts.mean(axis=0)
+    return np.array(
+        [((pts[:, 0] + q[:, 0]) * cross).sum(), ((pts[:, 1] + q[:, 1]) * cross).sum()]
+    ) / (6 * a)
 
 
 @dataclass
@@ -238,7 +250,7 @@ class Tracker:
             else:
                 gates[i] = 0.75 * s.radius + 3.0 + 1.5 * s.step + s.missed * (s.radius + s.step)
             reach[i] = s.radius + gates[i] + 0.5 * s.step + 3.0
-        found = self._measure(image, preds, gates, reach)
+        found = self._measure(image, preds, gates, reach, t)
         for i, s in enumerate(self.states):
             blob = found.get(i)
             if blob is None:
@@ -330,8 +342,26 @@ class Tracker:
                     break
         return [(ids, tuple(box)) for ids, box in groups]
 
+    def _outline(self, i: int, uv: np.ndarray, t: float) -> Outline:
+        """Body ``i``'s outline in the image at its prediction ``uv`` (px) for time ``t``: its
+        polygon at the predicted angle through the calibration, or a disc."""
+        s = self.states[i]
+        if s.angle is None or not hasattr(s.body.shape, "vertices"):
+            return Outline(s.radius)
+        pts = np.asarray(s.body.shape.vertices(), dtype=float)
+        pts = pts - _area_centroid(pts)
+        a = s.angle + s.omega * (t - s.t)
+        rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+        xy = self._predict(s, t)
+        return Outline(s.radius, self.cal.to_image(xy + pts @ rot.T) - uv)
+
     def _measure(
-        self, image: np.ndarray, preds: np.ndarray, gates: np.ndarray, reach: np.ndarray
+        self,
+        image: np.ndarray,
+        preds: np.ndarray,
+        gates: np.ndarray,
+        reach: np.ndarray,
+        t: float,
     ) -> dict[int, Blob]:
         from scipy.optimize import linear_sum_assignment
 
@@ -370,11 +400,7 @@ class Tracker:
                     found[members[0]] = blob
                     continue
                 parts = split_blob(
-                    u,
-                    v,
-                    w,
-                    preds[members],
-                    np.array([self.states[i].radius for i in members]),
+                    u, v, w, preds[members], [self._outline(i, preds[i], t) for i in members]
                 )
                 for i, part in zip(members, parts, strict=True):
                     if part is not None:

@@ -13,6 +13,7 @@ from physbench.plugins import create
 from physbench.render.camera import CameraRenderer
 from physbench.scene import Scene
 from physbench.trajectory import Trajectory
+from physbench.video.accuracy import pixel_errors
 
 #: A realistic camera: motion blur, sensor noise, uneven flickering light, lossy H.264.
 REAL = {"shutter": 0.5, "subframes": 8, "noise": 0.02, "bitrate": 1_500_000}
@@ -25,29 +26,9 @@ class Clip:
     traj: Trajectory
     camera: CameraRenderer
 
-    def truth(self, body: str, times: np.ndarray) -> np.ndarray:
-        """True image positions (px) of ``body`` at frame ``times`` (s)."""
-        i = self.scene.body_index(body)
-        k = np.searchsorted(np.asarray(self.traj.times), np.asarray(times) - 1e-6)
-        return self.camera.image_points(self.scene, self.traj.states[k, i, :2])
-
-
-def pixel_errors(clip: Clip, pixels: dict[str, np.ndarray]) -> tuple[np.ndarray, int]:
-    """Centre errors (px) over all bodies and frames, and the identity swaps: frames where a
-    tracked body lies nearer another body's true position than its own."""
-    errors, swaps = [], 0
-    names = clip.scene.body_names
-    all_truth = {b: clip.truth(b, pixels[b][:, 0]) for b in names}
-    for b in names:
-        rows = pixels[b]
-        errors.append(np.hypot(*(rows[:, 1:] - all_truth[b]).T))
-        for k, (t, u, v) in enumerate(rows):
-            mine = np.hypot(u - all_truth[b][k, 0], v - all_truth[b][k, 1])
-            for other in names:
-                if other != b:
-                    o = clip.truth(other, np.array([t]))[0]
-                    swaps += bool(np.hypot(u - o[0], v - o[1]) < mine)
-    return np.concatenate(errors), swaps
+    def errors(self, pixels: dict[str, np.ndarray]) -> tuple[np.ndarray, int]:
+        """Centre errors (px) and identity swaps of tracked ``pixels`` against this clip's truth."""
+        return pixel_errors(self.scene, self.traj, self.camera, pixels)
 
 
 @pytest.fixture

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from physbench.video.detect import find_blobs, split_blob
+from physbench.video.detect import Outline, find_blobs, split_blob
 
 
 def disc(img: np.ndarray, u: float, v: float, r: float, level: float = 200.0) -> None:
@@ -40,7 +40,7 @@ def test_touching_discs_split_at_their_contact() -> None:
     assert len(blobs) == 1  # one blob for both
     _, u, v, w = blobs[0]
     guess = np.array([[28.0 + 7, 26.0 + 5], [52.0 + 7, 22.0 + 5]])  # a few px off
-    a, b = split_blob(u, v, w, guess, np.array([10.0, 10.0]))
+    a, b = split_blob(u, v, w, guess, [Outline(10.0), Outline(10.0)])
     assert np.hypot(a.u - 37.2, a.v - 29.4) < 0.3 and np.hypot(b.u - 57.3, b.v - 28.6) < 0.3
 
 

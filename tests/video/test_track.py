@@ -18,15 +18,13 @@ from physbench.video.track import (
     track_video,
 )
 
-from .conftest import pixel_errors
-
 
 @pytest.mark.parametrize("engine", ["pymunk", "box2d"])
 def test_centres_are_sub_pixel_on_realistic_footage(film, engine: str) -> None:
     clip = film(bouncing_balls.generate(5, n_balls=5), engine)
     cal = clip.camera.calibration(clip.scene)
     result = track_video(clip.path, clip.scene, cal, background=clip.camera.plate(clip.scene))
-    errors, swaps = pixel_errors(clip, result.pixels)
+    errors, swaps = clip.errors(result.pixels)
     assert errors.size == clip.scene.frames * len(clip.scene.bodies)  # every body in every frame
     assert np.median(errors) <= 0.5 and np.percentile(errors, 95) <= 1.5  # measured 0.09, 0.25
     assert swaps == 0
@@ -46,7 +44,7 @@ def test_no_identity_swaps_in_the_rack(film, seed: int, n: int) -> None:
     result = track_video(
         clip.path, clip.scene, clip.camera.calibration(clip.scene), background=plate
     )
-    errors, swaps = pixel_errors(clip, result.pixels)
+    errors, swaps = clip.errors(result.pixels)
     assert swaps == 0
     assert np.percentile(errors, 95) <= 1.5
 
@@ -104,7 +102,7 @@ def test_occlusions_are_gaps_and_a_long_one_is_lost(film) -> None:
     assert len(tr) == len(frames) - 3  # no rows made up for the hidden frames
     assert not np.isin(np.round(tr.t * clip.scene.fps), list(hidden)).any()
     assert result.summary.gaps["test"] == 1 and not result.summary.lost
-    errors, swaps = pixel_errors(clip, result.pixels)
+    errors, swaps = clip.errors(result.pixels)
     assert swaps == 0 and np.percentile(errors, 95) <= 1.5  # found again after the gap
     lost = track_frames(occluded(frames, set(range(8, 30))), clip.scene, cal, plate, max_gap=0.3)
     assert "test" in lost.summary.lost and "lost" in lost.summary.format()
