@@ -108,7 +108,7 @@ def video_observation(
     )
     from physbench.video.track import bounds_calibration, track_video
 
-    reader = VideoReader(path, start=start, end=end)
+    reader = VideoReader(path, start=start, end=end, fps=scene.fps)
     info = reader.info()
     if isinstance(calibration, str | Path):
         calibration = load_calibration(calibration)
@@ -119,7 +119,7 @@ def video_observation(
     tracked = track_video(path, scene, calibration, start=start, end=end, background=background)
     recording = tracked.recording
     if background is None:
-        background = median_background(VideoReader(path, start=start, end=end))
+        background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
     expected = tuple(renderer.shape(scene))
     seg = Segmenter(
         scene,

@@ -478,6 +478,7 @@ def track_video(
 ) -> TrackResult:
     """Track ``scene``'s bodies through the video at ``path`` (see the module docstring).
 
+    ``path``: a video file, or a folder of images taken at the scene's frame rate.
     ``calibration``: pixels to metres (default :func:`bounds_calibration`); ``start``/``end``: the
     part of the video to track (s; recording time 0 is the first frame at or after ``start``);
     ``background``: an image of the empty scene (array or file; default: the median of the
@@ -486,14 +487,15 @@ def track_video(
     from physbench.video.reader import VideoError, VideoReader
 
     try:
-        reader = VideoReader(path, start=start, end=end)
+        # A folder of images has no timestamps: its frames come at the scene's rate.
+        reader = VideoReader(path, start=start, end=end, fps=scene.fps)
         info = reader.info()
         if calibration is None:
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
             background = load_plate(background)
         elif background is None:
-            background = median_background(VideoReader(path, start=start, end=end))
+            background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
         background = np.asarray(background)
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise TrackError(

@@ -144,3 +144,20 @@ def test_touching_boxes_and_a_ball_split_along_their_outlines(film) -> None:
     assert swaps == 0 and errors.size == clip.scene.frames * 3
     # Discs of a box's half-diagonal put the centres ~2 px off; the boxes' own outlines ~0.5 px.
     assert np.median(errors) <= 0.8 and np.percentile(errors, 95) <= 2.0  # measured 0.43, 0.71
+
+
+def test_a_folder_of_images_is_tracked_at_the_scenes_frame_rate(tmp_path) -> None:
+    from PIL import Image
+
+    from physbench.plugins import create
+    from physbench.render.camera import CameraRenderer
+
+    scene = bouncing_balls.generate(1, n_balls=2)
+    traj = create("simulator", "pymunk").simulate(scene)
+    cam = CameraRenderer(320, seed=1)
+    for k, image in enumerate(cam.film(scene, traj)):
+        Image.fromarray(image).save(tmp_path / f"frame{k:04d}.png")
+    result = track_video(tmp_path, scene, cam.calibration(scene), background=cam.plate(scene))
+    tr = result.recording.track("test")
+    np.testing.assert_allclose(tr.t, np.arange(scene.frames) / scene.fps)
+    np.testing.assert_allclose(tr.x, traj.states[:, 0, 0], atol=0.02)
