@@ -53,6 +53,10 @@ class TrackError(PhysbenchError, ValueError):
     """A video that cannot be tracked against a scene: names the body, frame or value."""
 
 
+class BodyNotFoundError(TrackError):
+    """A scene body with no blob near where the scene says it starts."""
+
+
 def bounds_calibration(scene: Scene, image_shape: tuple[int, int]) -> Calibration:
     """The calibration of a camera square-on to the plane with ``scene.bounds`` filling an image
     of ``image_shape = (H, W)`` px: the scene's aspect is kept, so the bounds touch two opposite
@@ -256,7 +260,7 @@ class Tracker:
             if blob is None:
                 if first:
                     u, v = preds[i]
-                    raise TrackError(
+                    raise BodyNotFoundError(
                         f"body {s.body.name!r} is not in the first frame: expected near pixel "
                         f"(u={u:.0f}, v={v:.0f}) of the {self.w}x{self.h} image (its initial "
                         f"position {tuple(round(c, 3) for c in s.body.position)} m through the "
@@ -494,8 +498,11 @@ def track_video(
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
             background = load_plate(background)
-        elif background is None:
-            background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
+        median = None
+        if background is None:
+            background = median = median_background(
+                VideoReader(path, start=start, end=end, fps=scene.fps)
+            )
         background = np.asarray(background)
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise TrackError(
@@ -508,8 +515,16 @@ def track_video(
                 f"{str(path)!r} is {info.width}x{info.height} px: give a plate of this camera's "
                 "view"
             )
-        return track_frames(
-            reader.frames(), scene, calibration, background, max_gap=max_gap, progress=progress
-        )
+        try:
+            return track_frames(
+                reader.frames(), scene, calibration, background, max_gap=max_gap, progress=progress
+            )
+        except BodyNotFoundError as exc:
+            if median is None:
+                raise
+            raise BodyNotFoundError(
+                f"{exc}; the background is the median of the clip, which holds a body that stays "
+                "put for most of it: film the empty scene and give it as the background"
+            ) from None
     except VideoError as exc:
         raise TrackError(str(exc)) from None

@@ -228,3 +228,18 @@ def test_video_and_filmed_observations(capsys: pytest.CaptureFixture[str], tmp_p
     cam.write(tmp_path / "clip.mp4", scene, create("simulator", "pymunk").simulate(scene))
     code, out, _ = run(capsys, *FAST, "--video", str(tmp_path / "clip.mp4"))
     assert code == 0 and f"no truth: observation from {tmp_path / 'clip.mp4'}" in out
+    # A clip that ends before the scene does is refused by name, not padded.
+    from physbench.trajectory import Trajectory
+
+    traj = create("simulator", "pymunk").simulate(scene)
+    short = Trajectory(traj.bodies, traj.times[:10], traj.states[:10])
+    cam.write(tmp_path / "short.mp4", scene, short)
+    code, _, err = run(capsys, *FAST, "--video", str(tmp_path / "short.mp4"))
+    # Over 10 frames the resting circles are part of the median: a plate is needed, and said so.
+    assert code == 2 and "not in the first frame" in err and "film the empty scene" in err, err
+    from PIL import Image
+
+    Image.fromarray(cam.plate(scene)).save(tmp_path / "plate.png")
+    plate = ["--background", str(tmp_path / "plate.png")]
+    code, _, err = run(capsys, *FAST, "--video", str(tmp_path / "short.mp4"), *plate)
+    assert code == 2 and "short.mp4: has 0.300 s of frames, but the scene needs" in err, err

@@ -87,6 +87,10 @@ def test_unusable_files_are_named_and_left_untouched(tmp_path: Path) -> None:
             list(VideoReader(tmp_path / name).frames())
     with pytest.raises(VideoError, match="does not exist"):
         VideoReader(tmp_path / "missing.mp4")
+    # A codec FFmpeg has no decoder for: the stream's sample entry renamed from avc1.
+    (tmp_path / "odd.mp4").write_bytes(data.replace(b"avc1", b"zzz9"))
+    with pytest.raises(VideoError, match=r"odd\.mp4': its video codec is not supported"):
+        VideoReader(tmp_path / "odd.mp4").info()
     assert clip.read_bytes() == data and (tmp_path / "text.mp4").read_text() == "hello"
     with pytest.raises(VideoError, match="no frames to write"):
         write_video(tmp_path / "none.mp4", [], fps=10)
