@@ -25,26 +25,17 @@ import numpy as np
 from physbench.discover import discover
 from physbench.discover.synthetic import (
     EFFECT_SCENES,
+    FILM,
     SCENES,
+    filmed_run,
     magnitude_error,
     make_case,
 )
-from physbench.render.camera import CameraRenderer
 from physbench.simulators.box2d_sim import Box2DSimulator
 from physbench.simulators.pymunk_sim import PymunkSimulator
-from physbench.video.observe import filmed_recording, frame_trajectory, motion_view
 
 ENGINES = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}
 TOLERANCE = 0.15
-CAMERA = {
-    "resolution": 640,
-    "tilt": 12.0,
-    "shutter": 0.5,
-    "subframes": 8,
-    "noise": 0.01,
-    "flicker": 0.05,
-    "bitrate": 2_000_000,
-}
 
 
 def cases(seeds: list[int]) -> list[tuple[str | None, str, str, int]]:
@@ -57,19 +48,6 @@ def cases(seeds: list[int]) -> list[tuple[str | None, str, str, int]]:
     ]
     controls = [(None, sc, eng, s) for sc in sorted(SCENES) for eng in ENGINES for s in seeds]
     return hidden + controls
-
-
-def film(case, seed: int):
-    """The case's run with its recording replaced by what a camera and the tracker make of it."""
-    from dataclasses import replace
-
-    run = case.run
-    rec = run.recording
-    times = np.arange(run.scene.frames) / run.scene.fps
-    traj = frame_trajectory(case.trajectory, times)
-    camera = CameraRenderer(**CAMERA, seed=seed, view=motion_view(run.scene, traj))
-    filmed = filmed_recording(run.scene, traj, camera, fields=rec.fields, run=rec.run)
-    return replace(run, recording=filmed, source="filmed")
 
 
 def evaluate(effect, disc, truth) -> dict:
@@ -103,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
         row["truth"] = case.truth
         row["clean"] = evaluate(effect, discover([case.run], sim, diagnose=False), case.truth)
         try:
-            filmed = film(case, seed)
+            filmed = filmed_run(case, seed)
         except Exception as exc:  # a failed track is a result to report
             row["filmed"] = {"causes": None, "error": None, "gain": None, "ok": False}
             row["filmed_failure"] = f"{type(exc).__name__}: {exc}"
@@ -121,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
         )
     (out / "results.json").write_text(
         json.dumps(
-            {"camera": CAMERA, "seeds": args.seeds, "tolerance": TOLERANCE, "rows": rows},
+            {"camera": FILM, "seeds": args.seeds, "tolerance": TOLERANCE, "rows": rows},
             indent=1,
         )
         + "\n"

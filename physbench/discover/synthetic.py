@@ -479,3 +479,34 @@ def _blur(scene: Scene, rng: np.random.Generator) -> Scene:
         )
         scene = scene.with_params({u.key: guess})
     return scene
+
+
+#: How :func:`filmed_run` films a case by default: an oblique camera with motion blur, sensor
+#: noise, flickering light and lossy H.264, at 640x480.
+FILM = {
+    "resolution": 640,
+    "tilt": 12.0,
+    "shutter": 0.5,
+    "subframes": 8,
+    "noise": 0.01,
+    "flicker": 0.05,
+    "bitrate": 2_000_000,
+}
+
+
+def filmed_run(case: SyntheticRun, seed: int = 0, **camera: Any) -> Run:
+    """``case``'s run with its recording replaced by what a camera and the tracker make of the
+    true motion: filmed by the ``camera`` renderer (options :data:`FILM`, overridden by
+    ``camera``; the view frames where the bodies go), encoded, tracked with a four-point
+    calibration, keeping the recording's fields
+    (:func:`~physbench.video.observe.filmed_recording`)."""
+    from physbench.render.camera import CameraRenderer
+    from physbench.video.observe import filmed_recording, frame_trajectory, motion_view
+
+    run, rec = case.run, case.run.recording
+    if case.trajectory is None or rec is None:
+        raise ValueError(f"case {case.name!r} has no true trajectory to film")
+    traj = frame_trajectory(case.trajectory, np.arange(run.scene.frames) / run.scene.fps)
+    options = {**FILM, "seed": seed, "view": motion_view(run.scene, traj), **camera}
+    filmed = filmed_recording(run.scene, traj, CameraRenderer(**options), fields=rec.fields)
+    return replace(run, recording=replace(filmed, run=rec.run), source="filmed")

@@ -1,0 +1,41 @@
+"""Discovery from video, end to end: hidden-effect runs (``discover/synthetic.py``) filmed by the
+``camera`` renderer as H.264 video and tracked must name the same cause as their clean tracks, with
+the magnitude within 15 %, and controls must stay quiet. A subset for CI; every effect, scene,
+engine and seeds 0-2 are in ``benchmarks/video_discover.py`` (table in docs/video.md)."""
+
+from __future__ import annotations
+
+import pytest
+
+from physbench.discover import discover
+from physbench.discover.synthetic import filmed_run, magnitude_error, make_case
+from physbench.simulators.box2d_sim import Box2DSimulator
+from physbench.simulators.pymunk_sim import PymunkSimulator
+
+ENGINES = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}
+
+CASES = [
+    ("linear_drag", "projectile", "pymunk"),
+    ("joint_viscous_damping", "pendulum", "box2d"),
+    ("constant_force", "two_pucks", "pymunk"),
+    ("velocity_dependent_restitution", "bouncer", "box2d"),
+]
+CONTROLS = [("projectile", "box2d"), ("pendulum", "pymunk")]
+
+
+@pytest.mark.parametrize(("effect", "scene", "engine"), CASES, ids=["/".join(c) for c in CASES])
+def test_a_filmed_hidden_effect_is_named_with_its_magnitude(effect, scene, engine) -> None:
+    sim = ENGINES[engine]()
+    case = make_case(effect, scene, 0, sim)
+    clean = discover([case.run], sim, diagnose=False)
+    filmed = discover([filmed_run(case)], sim, diagnose=False)
+    assert clean.causes[:1] == filmed.causes[:1] == [effect], (clean.causes, filmed.causes)
+    err = magnitude_error(effect, case.truth, filmed.cause_results[0].params)
+    assert err <= 0.15, (filmed.cause_results[0].params, case.truth)
+
+
+@pytest.mark.parametrize(("scene", "engine"), CONTROLS, ids=["/".join(c) for c in CONTROLS])
+def test_a_filmed_control_gives_no_cause(scene, engine) -> None:
+    sim = ENGINES[engine]()
+    disc = discover([filmed_run(make_case(None, scene, 0, sim))], sim, diagnose=False)
+    assert disc.causes == [], [(c.effect, c.gain) for c in disc.cause_results]
