@@ -50,6 +50,20 @@ def cases(seeds: list[int]) -> list[tuple[str | None, str, str, int]]:
     return hidden + controls
 
 
+def body_px(effect: str | None, scene: str, engine: str, seed: int) -> float:
+    """The smallest body's radius in the filmed image (px): how big the camera saw it."""
+    from physbench.render.camera import CameraRenderer
+    from physbench.video.observe import frame_trajectory, motion_view
+
+    case = make_case(effect, scene, seed, ENGINES[engine]())
+    sc = case.run.scene
+    traj = frame_trajectory(case.trajectory, np.arange(sc.frames) / sc.fps)
+    cam = CameraRenderer(**{**FILM, "view": motion_view(sc, traj)})
+    cal = cam.calibration(sc)
+    centre = cal.to_image(np.asarray(sc.bodies[0].position, dtype=float))
+    return round(min(b.shape.extent() for b in sc.bodies) / cal.metres_per_pixel(centre), 2)
+
+
 def evaluate(effect, disc, truth) -> dict:
     found = disc.cause_results[0] if effect is not None and disc.causes[:1] == [effect] else None
     err = magnitude_error(effect, truth, found.params) if found is not None else None
@@ -66,9 +80,26 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
     p.add_argument("--out", default="results/video_discover")
     p.add_argument("--only", default=None, help="run only cases whose name contains this")
+    p.add_argument(
+        "--merge",
+        nargs="+",
+        metavar="RESULTS.json",
+        help="run nothing: join these results files (e.g. seeds run in parallel) into --out",
+    )
     args = p.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.merge:
+        parts = [json.loads(Path(f).read_text()) for f in args.merge]
+        rows = [r for part in parts for r in part["rows"]]
+        for r in rows:
+            r.setdefault("body_px", body_px(r["effect"], r["scene"], r["engine"], r["seed"]))
+        seeds = sorted({s for part in parts for s in part["seeds"]})
+        payload = {"camera": FILM, "seeds": seeds, "tolerance": TOLERANCE, "rows": rows}
+        (out / "results.json").write_text(json.dumps(payload, indent=1) + "\n")
+        (out / "table.md").write_text(table(rows))
+        print(table(rows))
+        return 0
     rows = []
     todo = cases(args.seeds)
     if args.only:
@@ -79,6 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         case = make_case(effect, scene, seed, sim)
         row: dict = {"effect": effect, "scene": scene, "engine": engine, "seed": seed}
         row["truth"] = case.truth
+        row["body_px"] = body_px(effect, scene, engine, seed)
         row["clean"] = evaluate(effect, discover([case.run], sim, diagnose=False), case.truth)
         try:
             filmed = filmed_run(case, seed)
@@ -130,6 +162,15 @@ def table(rows: list[dict]) -> str:
             f"| {name} | {len(rs)} | {sum(r['clean']['ok'] for r in rs)} | "
             f"{sum(r['filmed']['ok'] for r in rs)} | {med('clean')} | {med('filmed')} |"
         )
+    misses = [
+        f"- {r['effect'] or 'control'}/{r['scene']}/{r['engine']}/{r['seed']}: clean "
+        f"{r['clean']['causes']}, filmed {r['filmed']['causes']} (smallest body "
+        f"{r.get('body_px', float('nan')):.1f} px in radius)"
+        for r in rows
+        if not r["filmed"]["ok"] or (r["effect"] and (r["filmed"]["causes"] or [])[1:])
+    ]
+    if misses:
+        lines += ["", "Filmed cases that missed, or named more than the hidden effect:", *misses]
     return "\n".join(lines) + "\n"
 
 
