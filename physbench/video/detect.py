@@ -2,11 +2,13 @@
 
 A pixel's *coverage* is how much of it a body covers, estimated from the difference to the
 background: ``(diff - low) / (high - low)`` clipped to ``[0, 1]``, with ``high`` about half the
-bodies' contrast and ``low`` above the noise, on a blob's rim; pixels inside a blob count whole.
-Blobs are the connected pixels above ``low`` (:func:`scipy.ndimage.label`); a blob's centre is
-the coverage-weighted mean of its pixels, so a partly covered edge pixel counts in part and the
-centre moves smoothly with the body (and, under motion blur, sits at the middle of the smear: the
-body's pose at mid-exposure).
+bodies' contrast and ``low`` above the noise. Blobs are the connected pixels above ``low``
+(:func:`scipy.ndimage.label`); a blob's centre is the coverage-weighted mean of its pixels, so a
+partly covered edge pixel counts in part and the centre moves smoothly with the body (and, under
+motion blur, sits at the middle of the smear: the body's pose at mid-exposure, for a body that
+does not turn much during the exposure; a fast-swinging arm's centre is biased towards where it
+stays longest). What the tracker records is measured on the scene's plane
+(:func:`plane_pose`): the centroid and axes of the pixels mapped into metres.
 
 Orientation comes from moments: the second moments give a blob's long axis (``symmetry=2``, for an
 elongated body), the fourth-order angular moment a square's sides (``symmetry=4``). Where one blob
@@ -17,10 +19,14 @@ the nearest predicted outline and re-fits each body's centre inside its own outl
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import ndimage
+
+if TYPE_CHECKING:
+    from physbench.video.calibration import Calibration
 
 
 @dataclass(frozen=True)
@@ -107,9 +113,6 @@ def find_blobs(
     if n == 0:
         return []
     cov = coverage(diff, low, high)
-    # Inside a blob a pixel is covered whole, however dim its shading or the wall behind it: only
-    # the rim is weighed by contrast (else a shaded body's centre leans to its lit side).
-    cov[ndimage.binary_erosion(mask)] = 1.0
     out = []
     for k, sl in enumerate(ndimage.find_objects(labels), start=1):
         if sl is None:
@@ -127,7 +130,7 @@ def find_blobs(
     return out
 
 
-def split_blob(
+def split_pixels(
     u: np.ndarray,
     v: np.ndarray,
     w: np.ndarray,
@@ -135,11 +138,12 @@ def split_blob(
     outlines: list[Outline],
     *,
     iterations: int = 6,
-) -> list[Blob | None]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Share one blob's pixels among bodies predicted at ``centres`` (``(N, 2)`` px) with
     ``outlines``: each pixel goes to the body whose outline is nearest (signed distance, so
     touching bodies split along their contact), and each body's centre is re-fitted to the pixels
-    it owns inside its outline, ``iterations`` times. One blob (or ``None``) per body."""
+    it owns inside its outline, ``iterations`` times. Returns the centres ``(N, 2)``, each pixel's
+    owner ``(P,)`` and whether it lies inside its owner's outline ``(P,)``."""
     c = np.array(centres, dtype=np.float64)
 
     def distances() -> np.ndarray:
@@ -159,16 +163,57 @@ def split_blob(
             c[j] = new
         if moved < 0.01:
             break
-    owner = np.argmin(distances(), axis=0)
+    dist = distances()
+    owner = np.argmin(dist, axis=0)
+    return c, owner, dist[owner, np.arange(owner.size)] <= 1.0
+
+
+def split_blob(
+    u: np.ndarray,
+    v: np.ndarray,
+    w: np.ndarray,
+    centres: np.ndarray,
+    outlines: list[Outline],
+    *,
+    iterations: int = 6,
+) -> list[Blob | None]:
+    """:func:`split_pixels` as one blob (or ``None``) per body: the centre is the fit inside the
+    outline; the moments come from all the pixels the body owns."""
+    c, owner, _ = split_pixels(u, v, w, centres, outlines, iterations=iterations)
     out: list[Blob | None] = []
     for j in range(len(c)):
         mine = owner == j
         blob = blob_from_pixels(u[mine], v[mine], w[mine])
-        # The centre is the fit inside the outline; moments come from all the body's pixels.
         if blob is not None:
-            blob = Blob(c[j, 0], c[j, 1], *[getattr(blob, f) for f in _REST])
+            blob = replace(blob, u=float(c[j, 0]), v=float(c[j, 1]))
         out.append(blob)
     return out
 
 
-_REST = ("area", "count", "axis", "elongation", "square")
+@dataclass(frozen=True)
+class PlanePose:
+    """A body's pixels measured on the scene's plane: the area centroid ``xy`` (m), the long
+    axis ``axis`` (rad, CCW from x, mod pi) with ``elongation``, and a square's sides ``square``
+    (rad, mod pi/2). Measured in metres, so an oblique view's foreshortening and perspective do
+    not bias them (a centroid or an axis taken in the image does not map to the body's)."""
+
+    xy: np.ndarray
+    axis: float
+    elongation: float
+    square: float
+
+
+def plane_pose(u: np.ndarray, v: np.ndarray, w: np.ndarray, calibration: Calibration) -> PlanePose:
+    """The :class:`PlanePose` of pixels at ``(u, v)`` with coverage ``w``: each pixel mapped
+    into the plane and weighted by its coverage times the plane area it sees (the homography's
+    Jacobian; a lens's is neglected)."""
+    uv = np.column_stack([u, v])
+    xy = calibration.to_scene(uv)
+    und = uv if calibration.lens is None else calibration.lens.undistort(uv)
+    h = calibration.homography
+    den = und @ h[2, :2] + h[2, 2]
+    weights = w * np.abs(np.linalg.det(h) / den**3)
+    blob = blob_from_pixels(xy[:, 0], xy[:, 1], weights)
+    if blob is None:
+        return PlanePose(xy.mean(axis=0), 0.0, 1.0, 0.0)
+    return PlanePose(blob.centre, blob.axis, blob.elongation, blob.square)

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import time as _time
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -34,7 +34,15 @@ import numpy as np
 
 from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
-from physbench.video.detect import Blob, Outline, find_blobs, split_blob
+from physbench.video.detect import (
+    Blob,
+    Outline,
+    PlanePose,
+    blob_from_pixels,
+    find_blobs,
+    plane_pose,
+    split_pixels,
+)
 from physbench.video.segment import difference, noise_threshold
 
 if TYPE_CHECKING:
@@ -270,12 +278,12 @@ class Tracker:
                     s.gap_start = s.t
                 s.missed += 1
                 continue
-            self._accept(s, blob, t)
+            self._accept(s, *blob, t)
         self.frames += 1
         self.t_last = t
 
-    def _accept(self, s: _State, blob: Blob, t: float) -> None:
-        xy = self.cal.to_scene(blob.centre)
+    def _accept(self, s: _State, blob: Blob, pose: PlanePose, t: float) -> None:
+        xy = pose.xy
         dt = t - s.t
         if s.rows and dt > 0:
             a = self.g if s.free else 0.0
@@ -283,7 +291,7 @@ class Tracker:
             s.step = float(np.hypot(*(blob.centre - self.cal.to_image(s.xy)))) / max(
                 1, s.missed + 1
             )
-        angle = self._angle(s, blob, t) if s.k else None
+        angle = self._angle(s, pose, t) if s.k else None
         if s.missed:
             s.gaps += 1
             if s.gap_start is not None and t - s.gap_start > self.max_gap:
@@ -293,20 +301,14 @@ class Tracker:
         s.rows.append((t, float(xy[0]), float(xy[1]), math.nan if angle is None else angle))
         s.uv_rows.append((t, blob.u, blob.v))
 
-    def _angle(self, s: _State, blob: Blob, t: float) -> float | None:
+    def _angle(self, s: _State, pose: PlanePose, t: float) -> float | None:
         assert s.angle is not None
         if s.k == 2:
-            if blob.elongation < 0.5 * (1 + ELONGATED):
-                return None  # too round in this frame (blur or a foreshortened view)
-            img = blob.axis
+            if pose.elongation < 0.5 * (1 + ELONGATED):
+                return None  # too round in this frame (motion blur along the short axis)
+            axis = pose.axis - s.offset
         else:
-            img = blob.square
-        # The image direction into the scene, through the calibration at the blob.
-        c = blob.centre
-        d = self.cal.to_scene(c + 3.0 * np.array([math.cos(img), math.sin(img)])) - (
-            self.cal.to_scene(c)
-        )
-        axis = math.atan2(d[1], d[0]) - s.offset
+            axis = pose.square - s.offset
         period = 2 * math.pi / s.k
         guess = s.angle + s.omega * (t - s.t)
         angle = guess + ((axis - guess + period / 2) % period - period / 2)
@@ -366,10 +368,10 @@ class Tracker:
         gates: np.ndarray,
         reach: np.ndarray,
         t: float,
-    ) -> dict[int, Blob]:
+    ) -> dict[int, tuple[Blob, PlanePose]]:
         from scipy.optimize import linear_sum_assignment
 
-        found: dict[int, Blob] = {}
+        found: dict[int, tuple[Blob, PlanePose]] = {}
         for ids, (r0, r1, c0, c1) in self._windows(preds, reach):
             diff = difference(image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1])
             small = min(self.states[i].area for i in ids)
@@ -401,14 +403,18 @@ class Tracker:
             for c, members in owner.items():
                 blob, u, v, w = blobs[c]
                 if len(members) == 1:
-                    found[members[0]] = blob
+                    found[members[0]] = (blob, plane_pose(u, v, w, self.cal))
                     continue
-                parts = split_blob(
-                    u, v, w, preds[members], [self._outline(i, preds[i], t) for i in members]
-                )
-                for i, part in zip(members, parts, strict=True):
-                    if part is not None:
-                        found[i] = part
+                outlines = [self._outline(i, preds[i], t) for i in members]
+                centres, owner, inside = split_pixels(u, v, w, preds[members], outlines)
+                for j, i in enumerate(members):
+                    mine = owner == j
+                    part = blob_from_pixels(u[mine], v[mine], w[mine])
+                    fit = mine & inside
+                    if part is None or not fit.any():
+                        continue
+                    part = replace(part, u=float(centres[j, 0]), v=float(centres[j, 1]))
+                    found[i] = (part, plane_pose(u[fit], v[fit], w[fit], self.cal))
         return found
 
     # ----------------------------------------------------------------- result
