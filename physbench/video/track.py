@@ -414,7 +414,10 @@ class Tracker:
                     if part is None or not fit.any():
                         continue
                     part = replace(part, u=float(centres[j, 0]), v=float(centres[j, 1]))
-                    found[i] = (part, plane_pose(u[fit], v[fit], w[fit], self.cal))
+                    # Centre from the pixels inside the outline, axes from all the body owns.
+                    centre = plane_pose(u[fit], v[fit], w[fit], self.cal)
+                    axes = plane_pose(u[mine], v[mine], w[mine], self.cal)
+                    found[i] = (part, replace(axes, xy=centre.xy))
         return found
 
     # ----------------------------------------------------------------- result
