@@ -49,7 +49,7 @@ ROWS = [
         "stacked_boxes",
         "mass",
         marks=pytest.mark.xfail(
-            strict=True, reason="5.3x its sharp-mask error: the open part of issue 12 (README)"
+            strict=True, reason="6.5x its sharp-mask error: the open part of issue 12 (README)"
         ),
     ),
     ("stacked_boxes", "friction"),

@@ -1,0 +1,50 @@
+"""The committed end-to-end discovery-from-video table (``results/video_discover``,
+``benchmarks/video_discover.py``): the whole grid ran, filmed hidden effects are named as their
+clean tracks are, and the false alarms on controls are the known ones (README, docs/video.md)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from physbench.discover.synthetic import EFFECT_SCENES, SCENES
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = json.loads((ROOT / "results" / "video_discover" / "results.json").read_text())
+ROWS = DATA["rows"]
+HIDDEN = [r for r in ROWS if r["effect"]]
+CONTROLS = [r for r in ROWS if not r["effect"]]
+
+
+def test_every_effect_scene_engine_and_seed_was_filmed() -> None:
+    seeds = DATA["seeds"]
+    assert seeds == [0, 1, 2]
+    want = {
+        (e, sc, eng, s)
+        for e, scenes in EFFECT_SCENES.items()
+        for sc in scenes
+        for eng in ("pymunk", "box2d")
+        for s in seeds
+    }
+    assert {(r["effect"], r["scene"], r["engine"], r["seed"]) for r in HIDDEN} == want
+    assert len(CONTROLS) == len(SCENES) * 2 * len(seeds)
+    assert all(r["clean"]["ok"] for r in ROWS)  # the clean tracks: every case right
+
+
+def test_filmed_hidden_effects_are_named_with_their_magnitude() -> None:
+    wrong = [r for r in HIDDEN if not r["filmed"]["ok"]]
+    assert len(wrong) <= 1, wrong  # measured: 1 of 132, balls 1 px in radius
+    assert all(r["body_px"] < 2 for r in wrong)
+
+
+def test_false_alarms_on_filmed_controls_are_the_known_ones() -> None:
+    alarms = {(r["scene"], r["engine"], r["seed"]) for r in CONTROLS if not r["filmed"]["ok"]}
+    assert len(alarms) == 11
+    assert {scene for scene, *_ in alarms} <= {"pendulum_xy", "pendulum_both", "bouncer", "drops"}
+
+
+@pytest.mark.xfail(strict=True, reason="11 of 90 filmed controls raise a cause: issue 12 open")
+def test_no_false_alarm_on_filmed_controls() -> None:
+    assert all(r["filmed"]["ok"] for r in CONTROLS)
