@@ -4,5 +4,6 @@ physbench[video]``), calibration, pixels to metres on the plane of motion
 (:mod:`~physbench.video.calibration`), tracking the scene's bodies into a recording
 (:mod:`~physbench.video.background`, :mod:`~physbench.video.detect`,
 :mod:`~physbench.video.track`, pictures in :mod:`~physbench.video.overlay`; ``physbench track``),
-and per-body masks for the correction loop (:mod:`~physbench.video.segment`,
-:mod:`~physbench.video.observe`)."""
+per-body masks for the correction loop (:mod:`~physbench.video.segment`,
+:mod:`~physbench.video.observe`), and scoring a tracker against known motion
+(:mod:`~physbench.video.accuracy`)."""
