@@ -104,6 +104,7 @@ def video_observation(
         Segmenter,
         body_threshold,
         difference,
+        fill_holes,
         noise_threshold,
     )
     from physbench.video.track import bounds_calibration, track_video
@@ -139,17 +140,27 @@ def video_observation(
         b: np.zeros(expected, np.float32) for b in (None, *marked)
     }
     floor = None
+    hole = _largest_hole(scene, calibration)
     for k, fr, t in scene_frames(reader.frames(), times, what=str(path)):
         if floor is None:
             floor = noise_threshold(fr.image, background)
         poses = poses_at(recording, scene, t)
         diff = difference(fr.image, background)
         threshold = body_threshold(diff, calibration.to_image(poses[:, :2]), floor)
-        cov = seg.coverage((diff > threshold).astype(np.float32), poses)
+        cov = seg.coverage(fill_holes(diff > threshold, hole).astype(np.float32), poses)
         for b, arr in views.items():
             arr[k] = seg.frame(cov, b)
     frames = views.pop(None)
     return Observation(frames, None, views, source=f"video {path}")  # type: ignore[arg-type]
+
+
+def _largest_hole(scene: Scene, calibration: Calibration) -> float:
+    """Holes in a frame's foreground up to half the smallest body's area (px, at the middle of
+    the scene's bounds) are filled: a body is opaque, and a real gap that small is not one."""
+    xmin, ymin, xmax, ymax = scene.bounds
+    middle = calibration.to_image(np.array([[(xmin + xmax) / 2, (ymin + ymax) / 2]]))[0]
+    smallest = min(b.shape.area() for b in scene.bodies)
+    return 0.5 * smallest / calibration.metres_per_pixel(middle) ** 2
 
 
 def filmed_observation(

@@ -56,6 +56,24 @@ def foreground(image: np.ndarray, background: np.ndarray, threshold: float) -> n
     return (difference(image, background) > threshold).astype(np.float32)
 
 
+def fill_holes(mask: np.ndarray, max_area: float) -> np.ndarray:
+    """``mask`` (bool ``(H, W)``) with its holes of at most ``max_area`` pixels filled: a body is
+    opaque, but where its colour nears the wall's (a highlight on a light wall) it falls under
+    the threshold, and the hole changes the body's shape in the frames an estimator compares.
+    Background regions larger than that, or touching the image's edge, stay."""
+    from scipy import ndimage
+
+    labels, n = ndimage.label(~mask)
+    if n <= 1:
+        return mask
+    sizes = np.bincount(labels.ravel(), minlength=n + 1)
+    small = sizes <= max_area
+    small[0] = False
+    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    small[edge] = False
+    return mask | small[labels] if small.any() else mask
+
+
 def noise_threshold(image: np.ndarray, background: np.ndarray, *, floor: float = 12.0) -> float:
     """A foreground threshold from the frame's own noise: 6 robust standard deviations (from the
     median absolute difference, which the bodies' few pixels do not move), at least ``floor``."""
