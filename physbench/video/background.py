@@ -66,4 +66,21 @@ def median_background(
     shapes = {k.shape for k in kept}
     if len(shapes) != 1:
         raise BackgroundError(f"frames of different sizes: {sorted(shapes)}")
-    return np.median(np.stack(kept), axis=0).round().astype(np.uint8)
+    return _median(np.stack(kept))
+
+
+def _median(stack: np.ndarray) -> np.ndarray:
+    """The per-pixel median of ``stack`` ``(N, H, W, 3)`` uint8, rounded: a partial sort in
+    uint8, a band of rows at a time (``np.median`` converts to float64 and sorts the whole
+    stack, several times slower; ``benchmarks/track_speed.py``)."""
+    n = len(stack)
+    mid = n // 2
+    out = np.empty(stack.shape[1:], np.uint8)
+    for r in range(0, stack.shape[1], 16):
+        band = stack[:, r : r + 16]
+        if n % 2:
+            out[r : r + 16] = np.partition(band, mid, axis=0)[mid]
+        else:
+            part = np.partition(band, (mid - 1, mid), axis=0)
+            out[r : r + 16] = (part[mid - 1].astype(np.uint16) + part[mid] + 1) // 2
+    return out

@@ -38,3 +38,14 @@ def test_the_median_removes_a_moving_body_and_holds_few_frames() -> None:
         median_background(frames(3), samples=0)
     with pytest.raises(BackgroundError, match="no frames"):
         median_background(iter([]))
+
+
+@pytest.mark.parametrize("n", [7, 8])
+def test_the_median_is_numpys_median(n: int) -> None:
+    from physbench.video.background import _median
+
+    stack = np.random.default_rng(n).integers(0, 256, (n, 37, 23, 3), dtype=np.uint8)
+    want = np.median(stack, axis=0)
+    got = _median(stack).astype(float)
+    # Odd counts exactly; even ones round the middle pair's half up (numpy: to even).
+    assert np.abs(got - want).max() <= (0 if n % 2 else 0.5)
