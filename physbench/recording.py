@@ -124,17 +124,22 @@ class Track:
 class Recording:
     """The tracked bodies of one run. ``fields`` names the pose fields that were measured (the
     default of :meth:`residuals`; ``None`` = all the tracks hold), since a loader may have to fill
-    in a coordinate the format requires but the sensor did not see."""
+    in a coordinate the format requires but the sensor did not see. ``accuracy``: the sensor's
+    systematic accuracy (m): a model that disagrees with the recording by less is not wrong as
+    far as this sensor can tell (0: not stated)."""
 
     tracks: Mapping[str, Track]
     run: str = ""
     fields: tuple[str, ...] | None = None
     source: str = ""
     meta: Mapping[str, object] = field(default_factory=dict)
+    accuracy: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.tracks:
             raise RecordingError("a recording needs at least one tracked body")
+        if not (isinstance(self.accuracy, int | float) and 0 <= self.accuracy < math.inf):
+            raise RecordingError(f"accuracy = {self.accuracy!r}: expected metres >= 0")
         if self.fields is not None:
             for f in self.fields:
                 if f not in POSE_FIELDS:

@@ -21,7 +21,7 @@ from physbench.discover.diagnostics import findings, views
 from physbench.discover.fit import fit_model, is_rough, score
 from physbench.discover.results import CandidateResult, Scored, Selection, Skipped
 from physbench.discover.settings import Settings
-from physbench.discover.significance import judge
+from physbench.discover.significance import floored_gain, judge, measurement_floor
 from physbench.discover.trial import refit, try_effect
 
 
@@ -178,7 +178,8 @@ def prune_causes(selection: Selection, settings: Settings) -> Selection:
             free = [k for k in current.fit.free if k in m.values]
             fr = fit_model(m, settings, base=False, free=free)
             reduced = score(current.label, tuple(c for c in causes if c != key), m, fr)
-            loss = 1.0 - current.heldout / reduced.heldout if reduced.heldout > 0 else 0.0
+            floor = measurement_floor(current.model.problem, settings)
+            loss = floored_gain(current.heldout, reduced.heldout, floor)
             if loss < settings.min_gain:
                 results = [
                     replace(c, chosen=False, note=_dropped(c, loss))

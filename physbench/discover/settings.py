@@ -29,6 +29,9 @@ class Settings:
     seed: int = 0
     min_gain: float = 0.1
     min_delta_bic: float = 10.0
+    #: Measurement floor (m): held-out errors count in quadrature with it, so a disagreement
+    #: below what the sensor can tell is no evidence; None: the recordings' stated accuracy.
+    floor: float | None = None
     max_causes: int = 3
     shortlist: int = 4
     max_nfev: int = 30
@@ -65,5 +68,11 @@ class Settings:
         for name, n in counts.items():
             if isinstance(n, bool) or not isinstance(n, int) or n < 1:
                 raise DiscoverError(f"{name} = {n!r}: expected a whole number >= 1")
+        if self.floor is not None and (
+            isinstance(self.floor, bool)
+            or not isinstance(self.floor, int | float)
+            or self.floor < 0
+        ):
+            raise DiscoverError(f"floor = {self.floor!r}: expected a number >= 0 (metres) or None")
         if not isinstance(self.min_delta_bic, int | float) or self.min_delta_bic < 0:
             raise DiscoverError(f"min_delta_bic = {self.min_delta_bic!r}: expected a number >= 0")

@@ -3,17 +3,41 @@ extends.
 
 A candidate is *significant* when both hold, against the model it extends:
 
-* held-out gain ``1 - heldout(extended) / heldout(current) >= min_gain``, and
+* held-out gain ``1 - heldout(extended) / heldout(current) >= min_gain``, where both held-out
+  errors (RMS) are first put in quadrature with the measurement floor (:func:`measurement_floor`:
+  a disagreement smaller than what the sensor can tell does not count), and
 * ``ΔBIC = BIC(extended) - BIC(current) <= -min_delta_bic`` on the fitted part
   (``BIC = n ln(SSR/n) + k ln n``).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from physbench.discover.results import CandidateResult, Scored
 from physbench.discover.settings import Settings
+
+if TYPE_CHECKING:
+    from physbench.discover.model import Problem
+
+
+def measurement_floor(problem: Problem | None, settings: Settings) -> float:
+    """The accuracy below which the data cannot tell a model wrong (m, or rad for angle-only
+    data): ``settings.floor`` when given, else the largest ``accuracy`` the recordings of
+    ``problem`` state (a tracker states its own; 0 for data that states none)."""
+    if settings.floor is not None:
+        return float(settings.floor)
+    if problem is None:
+        return 0.0
+    return max((r.recording.accuracy for r in problem.runs if r.recording is not None), default=0.0)
+
+
+def floored_gain(new: float, old: float, floor: float) -> float:
+    """``1 - new / old`` for held-out RMS errors, each in quadrature with ``floor``."""
+    old_f = math.hypot(old, floor)
+    return 1.0 - math.hypot(new, floor) / old_f if old_f > 0 else 0.0
 
 
 def judge(c: CandidateResult, current: Scored, base: Scored, settings: Settings) -> CandidateResult:
@@ -22,10 +46,13 @@ def judge(c: CandidateResult, current: Scored, base: Scored, settings: Settings)
     ``previous``)."""
     gain = 1.0 - c.heldout_error / current.heldout if current.heldout > 0 else 0.0
     gain_vs_base = 1.0 - c.heldout_error / base.heldout if base.heldout > 0 else 0.0
+    floor = measurement_floor(current.model and current.model.problem, settings)
+    counted = floored_gain(c.heldout_error, current.heldout, floor)
     delta = c.criterion - current.bic
     why = []
-    if gain < settings.min_gain:
-        why.append(f"held-out gain {gain:+.1%} < {settings.min_gain:.0%}")
+    if counted < settings.min_gain:
+        above = f" above the data's accuracy {floor:.2g}" if floor > 0 else ""
+        why.append(f"held-out gain{above} {counted:+.1%} < {settings.min_gain:.0%}")
     if delta > -settings.min_delta_bic:
         why.append(f"ΔBIC {delta:+.1f} > -{settings.min_delta_bic:g}")
     return replace(
@@ -34,6 +61,6 @@ def judge(c: CandidateResult, current: Scored, base: Scored, settings: Settings)
         gain=gain,
         gain_vs_base=gain_vs_base,
         delta_criterion=delta,
-        significant=bool(gain >= settings.min_gain and delta <= -settings.min_delta_bic),
+        significant=bool(counted >= settings.min_gain and delta <= -settings.min_delta_bic),
         note="; ".join(why),
     )

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from physbench.discover import CandidateResult, FitResult, Scored, Settings
-from physbench.discover.significance import judge
+from physbench.discover.data import DiscoverError
+from physbench.discover.significance import floored_gain, judge, measurement_floor
+from physbench.recording import Recording, RecordingError, Track
 
 
 def scored(heldout: float, ssr: float, k: int, n: int = 100) -> Scored:
@@ -42,3 +46,32 @@ def test_judging_returns_a_new_result():
     c = candidate(0.8, -500.0)
     judged = judge(c, scored(1.0, 1.0, 4), scored(2.0, 4.0, 3), Settings())
     assert judged is not c and c.gain == 0.0 and c.previous is None
+
+
+def test_a_gain_below_the_datas_accuracy_is_no_evidence():
+    # Held-out RMS 1.2 mm -> 0.4 mm is a 67 % gain; against a tracker accurate to 2 mm it is
+    # 1 - hypot(0.4, 2) / hypot(1.2, 2) = 13 %, and against 3 mm 6 %: not a cause.
+    current, base = scored(1.2e-3, 1.0, 4), scored(1.2e-3, 1.0, 4)
+    bic = current.bic - 50
+    assert judge(candidate(0.4e-3, bic), current, base, Settings()).significant
+    coarse = judge(candidate(0.4e-3, bic), current, base, Settings(floor=3e-3))
+    assert not coarse.significant
+    assert coarse.note == "held-out gain above the data's accuracy 0.003 +6.3% < 10%"
+    assert coarse.gain == pytest.approx(2 / 3)  # the reported gain stays the plain one
+    assert floored_gain(0.4e-3, 1.2e-3, 2e-3) == pytest.approx(0.1255, abs=1e-4)
+    assert floored_gain(0.4, 1.2, 0.0) == pytest.approx(2 / 3)
+    with pytest.raises(DiscoverError, match="floor = -1"):
+        Settings(floor=-1)
+
+
+def test_the_floor_is_the_largest_accuracy_the_recordings_state():
+    track = Track(np.arange(3.0), np.zeros(3), np.zeros(3))
+    runs = [
+        SimpleNamespace(recording=Recording({"b": track}, accuracy=a)) for a in (0.0, 2e-3, 1e-3)
+    ]
+    problem = SimpleNamespace(runs=[*runs, SimpleNamespace(recording=None)])  # frames: no say
+    assert measurement_floor(problem, Settings()) == 2e-3
+    assert measurement_floor(problem, Settings(floor=0.0)) == 0.0
+    assert measurement_floor(None, Settings()) == 0.0
+    with pytest.raises(RecordingError, match=r"accuracy = -0\.1"):
+        Recording({"b": track}, accuracy=-0.1)

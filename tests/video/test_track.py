@@ -36,6 +36,9 @@ def test_centres_are_sub_pixel_on_realistic_footage(film, engine: str) -> None:
     got = np.column_stack([rec.track("b0").x, rec.track("b0").y])
     assert np.abs(got - true).max() < 0.02
     assert result.summary.gaps == dict.fromkeys(clip.scene.body_names, 0)
+    # It states its accuracy (half a pixel) in metres, for discover's measurement floor.
+    mpp = cal.metres_per_pixel((320.0, 240.0))
+    assert 0.4 * mpp < rec.accuracy < 0.7 * mpp
 
 
 @pytest.mark.parametrize("seed,n", [(0, 2), (1, 3), (2, 4), (3, 5), (4, 6)])
