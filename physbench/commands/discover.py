@@ -71,6 +71,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--min-delta-bic", type=float, default=None, help="BIC drop a cause must reach (default 10)"
     )
+    p.add_argument(
+        "--floor",
+        type=float,
+        default=None,
+        metavar="METRES",
+        help="the data's accuracy: held-out errors count in quadrature with it, so a smaller "
+        "disagreement names no cause (default: what the recording states; a video's tracker "
+        "states half a pixel)",
+    )
     p.add_argument("--max-causes", type=int, default=None, help="most effects added (default 3)")
     add_renderer_arguments(p, from_frames=True)
     p.add_argument(
@@ -115,6 +124,7 @@ def main(args: argparse.Namespace) -> int:
             ("min_gain", args.min_gain),
             ("min_delta_bic", args.min_delta_bic),
             ("max_causes", args.max_causes),
+            ("floor", args.floor),
         )
         if v is not None
     }

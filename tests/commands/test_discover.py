@@ -270,3 +270,22 @@ def test_cli_prints_the_verdict_and_the_table(tmp_path, capsys):
     assert rc == 0
     assert "no cause found" in out and "linear_drag" in out and "held-out" in out
     assert (tmp_path / "rep" / "index.html").is_file()
+
+
+def test_a_disagreement_below_the_floor_names_no_cause(tmp_path):
+    # Drag found in tracks accurate to 2 mm names nothing in data said to be good to a metre.
+    scene = slide()
+    rec = noisy(PymunkSimulator().simulate(scene, effects=[LinearDrag(c=0.3)]))
+    write_recordings(tmp_path / "r.csv", rec)
+    save_scene(scene, tmp_path / "s.toml")
+    argv = ["discover", str(tmp_path / "r.csv"), "--scene", str(tmp_path / "s.toml")]
+    argv += ["--effects", "linear_drag", "constant_force", "-q", "--json"]
+    verdicts = []
+    for extra in ([], ["--floor", "1"]):
+        out = tmp_path / f"d{len(extra)}.json"
+        assert cli([*argv, str(out), *extra]) == 0
+        verdicts.append(json.loads(out.read_text()))
+    assert verdicts[0]["causes"] == ["linear_drag"]
+    assert verdicts[1]["causes"] == []
+    notes = [c["note"] for c in verdicts[1]["candidates"]]
+    assert any("above the data's accuracy 1 " in n for n in notes), notes
