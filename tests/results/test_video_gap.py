@@ -45,13 +45,7 @@ ROWS = [
     ("three_circles", "mass+elasticity"),
     ("second_order", "mass"),
     ("second_order", "elasticity"),
-    pytest.param(
-        "stacked_boxes",
-        "mass",
-        marks=pytest.mark.xfail(
-            strict=True, reason="6.5x its sharp-mask error: the open part of issue 12 (README)"
-        ),
-    ),
+    ("stacked_boxes", "mass"),
     ("stacked_boxes", "friction"),
     ("bouncing_balls", "mass"),
 ]
