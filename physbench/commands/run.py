@@ -206,7 +206,7 @@ def describe_observation(history: Any) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
-    from physbench.errors import PhysbenchError
+    from physbench.errors import PhysbenchError, counted
 
     if args.iterations < 1:
         raise PhysbenchError(f"--iterations {args.iterations}: expected a whole number >= 1")
@@ -311,12 +311,12 @@ def main(args: argparse.Namespace) -> int:
         )
     if history.best_nmse is not None:
         print(
-            f"normalized min MSE after {n} iterations: {history.best_nmse:.3e} "
+            f"normalized min MSE after {counted(n, 'iteration')}: {history.best_nmse:.3e} "
             f"(initial guess {history.initial_nmse:.3e}; min image MSE {history.min_loss:.3e})"
         )
     else:
         print(
-            f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation "
-            f"from {args.observation or args.video})"
+            f"min image MSE after {counted(n, 'iteration')}: {history.min_loss:.3e} (no truth: "
+            f"observation from {args.observation or args.video})"
         )
     return 0

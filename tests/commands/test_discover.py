@@ -269,6 +269,7 @@ def test_cli_prints_the_verdict_and_the_table(tmp_path, capsys):
     out = capsys.readouterr().out
     assert rc == 0
     assert "no cause found" in out and "linear_drag" in out and "held-out" in out
+    assert out.startswith("discovery on 1 run [r] with pymunk; ")
     assert (tmp_path / "rep" / "index.html").is_file()
 
 

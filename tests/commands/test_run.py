@@ -45,6 +45,8 @@ def test_quiet_prints_only_the_final_line(capsys: pytest.CaptureFixture[str]) ->
     code, out, err = run(capsys, "--estimator", "random", *FAST, "-q")
     assert code == 0 and err == ""
     assert out.count("\n") == 1 and out.startswith("normalized min MSE after 4 iterations")
+    code, out, _ = run(capsys, "--estimator", "random", "--iterations", "1", "-q")
+    assert code == 0 and out.startswith("normalized min MSE after 1 iteration: ")
 
 
 def test_json_history_is_reproducible(capsys: pytest.CaptureFixture[str]) -> None:

@@ -13,6 +13,7 @@ from physbench.video.calibration import Calibration
 from physbench.video.reader import Frame, VideoReader
 from physbench.video.track import (
     TrackError,
+    TrackSummary,
     bounds_calibration,
     track_frames,
     track_video,
@@ -161,3 +162,16 @@ def test_a_folder_of_images_is_tracked_at_the_scenes_frame_rate(tmp_path) -> Non
     tr = result.recording.track("test")
     np.testing.assert_allclose(tr.t, np.arange(scene.frames) / scene.fps)
     np.testing.assert_allclose(tr.x, traj.states[:, 0, 0], atol=0.02)
+
+
+def test_the_summary_counts_in_words_that_agree() -> None:
+    one = TrackSummary(1, 0.1, {"ball": 1}, {"ball": 1}, {}, 0.25, fps=30.0)
+    assert one.format().splitlines() == [
+        "tracked 1 body over 1 frame (0.10 s) at 30 frames/s; calibration reprojection error "
+        "0.25 px",
+        "      ball: seen in 1/1 frames, 1 gap",
+    ]
+    two = TrackSummary(5, 0.2, {"a": 5, "b": 3}, {"a": 0, "b": 2}, {}, 0.25)
+    assert "tracked 2 bodies over 5 frames" in two.format() and "b: seen in 3/5 frames, 2 gaps" in (
+        two.format()
+    )
