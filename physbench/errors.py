@@ -16,6 +16,11 @@ def plural(noun: str) -> str:
     return noun + ("es" if noun.endswith(("s", "x", "ch", "sh")) else "s")
 
 
+def counted(n: int, noun: str) -> str:
+    """``1 worker``, ``3 workers``: ``n`` and its ``noun`` in agreement, for messages."""
+    return f"{n} {noun if n == 1 else plural(noun)}"
+
+
 class UnknownNameError(PhysbenchError, KeyError):
     """A name (scene, engine, estimator, parameter, ...) that is not registered."""
 

@@ -5,7 +5,9 @@ A :class:`RunConfig` names everything that determines the result (scene, unknown
 its options, seed, iteration budget, model and observation engines, renderer and its options,
 observation blur and noise, resolution, channel layout), so the same configuration gives the same
 :class:`~physbench.loop.History` in any process. The observation is simulated from the seed (random
-truth, random initial guess) unless ``observation`` names a frames file.
+truth, random initial guess) unless ``observation`` names a frames file; a file written by
+``physbench simulate`` (or by a run's ``save_observation``) brings its scene instance, its truth
+and the engine that made it.
 """
 
 from __future__ import annotations
@@ -30,12 +32,19 @@ if TYPE_CHECKING:
     from physbench.render.camera import CameraRenderer
     from physbench.scene import Scene
 
+#: The scene of a run that names none (and observes no file that carries one).
+DEFAULT_SCENE = "three_circles"
+
 
 @dataclass(frozen=True)
 class RunConfig:
-    """Settings of one run. ``params``: unknown parameter names (``("mass", "elasticity")``);
-    ``bodies``: restrict them to these bodies (``None``: every body that has them);
-    ``observe_engine``: the engine that makes the observation (``None``: ``engine``);
+    """Settings of one run. ``scene``: a registered scene or a scene TOML (``None``: the scene
+    of the ``observation`` file, else :data:`DEFAULT_SCENE`; a scene given with a file that
+    carries one must be that scene); ``params``: unknown parameter names
+    (``("mass", "elasticity")``); ``bodies``: restrict them to these bodies (``None``: every body
+    that has them); ``engine``: the model's simulator (``None``: the one that made the
+    ``observation`` file, else the default); ``observe_engine``: the engine that makes the
+    observation (``None``: ``engine``);
     ``renderer`` and ``renderer_options``: the renderer of the model and of the observation,
     built with ``resolution`` and ``render_mode`` besides its options; ``blur`` and ``noise``:
     the observation model applied to the observed frames only; ``observer`` and
@@ -45,13 +54,13 @@ class RunConfig:
     ``background``, ``video_start`` and ``video_end``: observe a video file instead (a camera's
     footage, tracked and segmented the same way; no truth then)."""
 
-    scene: str = "three_circles"
+    scene: str | None = DEFAULT_SCENE
     params: tuple[str, ...] = ("mass",)
     estimator: str = DEFAULT_ESTIMATOR
     options: Mapping[str, Any] = field(default_factory=dict)
     seed: int = 0
     iterations: int = 11
-    engine: str = DEFAULT_SIMULATOR
+    engine: str | None = DEFAULT_SIMULATOR
     observe_engine: str | None = None
     renderer: str = DEFAULT_RENDERER
     renderer_options: Mapping[str, Any] = field(default_factory=dict)
@@ -100,7 +109,7 @@ class RunConfig:
 
     @property
     def observer_engine(self) -> str:
-        return self.observe_engine or self.engine
+        return self.observe_engine or self.engine or DEFAULT_SIMULATOR
 
 
 #: Settings added after sweeps were first stored: omitted from :meth:`RunConfig.to_dict` while
@@ -245,12 +254,42 @@ def _check_observation(config: RunConfig) -> None:
         )
 
 
+def load_observed(config: RunConfig) -> Observation | None:
+    """The ``observation`` file of ``config``, read (``None`` when it names none)."""
+    from physbench.observation import load_observation
+
+    return load_observation(config.observation) if config.observation else None
+
+
+def observed_scene(config: RunConfig, observed: Observation | None = None) -> Scene:
+    """The scene instance of a run: the one ``observed`` (a loaded file) carries, which a scene
+    named in ``config`` must match by name; else ``config.scene`` at ``config.seed``."""
+    from physbench.scenes import resolve_scene
+
+    if observed is None or observed.scene is None:
+        return resolve_scene(config.scene or DEFAULT_SCENE, config.seed)
+    if config.scene is not None:
+        named = resolve_scene(config.scene, config.seed).name
+        if named != observed.scene.name:
+            given = repr(config.scene) + ("" if named == config.scene else f" (scene {named!r})")
+            raise PhysbenchError(
+                f"--scene {given} does not match the observation {observed.source}, which shows "
+                f"scene {observed.scene.name!r}; leave --scene out to use the file's scene"
+            )
+    return observed.scene
+
+
+def model_engine(config: RunConfig, observed: Observation | None = None) -> str:
+    """The model's simulator: ``config.engine``, else the engine that made ``observed``, else
+    the default."""
+    return config.engine or (observed.engine if observed else "") or DEFAULT_SIMULATOR
+
+
 def config_space(config: RunConfig, scene: Scene | None = None) -> ParamSpace:
     """The unknowns of ``config`` on its scene instance (``scene`` saves regenerating it)."""
     from physbench.params import ParamSpace
-    from physbench.scenes import resolve_scene
 
-    scene = resolve_scene(config.scene, config.seed) if scene is None else scene
+    scene = observed_scene(config) if scene is None else scene
     return ParamSpace.from_scene(
         scene, list(config.params), None if config.bodies is None else list(config.bodies)
     )
@@ -262,9 +301,10 @@ def check_config(config: RunConfig) -> ParamSpace:
     from physbench.plugins import get_registry
 
     _check_observation(config)
+    observed = load_observed(config)
     reg = get_registry()
     try:
-        for engine in {config.engine, config.observer_engine}:
+        for engine in {model_engine(config, observed), config.observer_engine}:
             reg.get("simulator", engine)
     except UnknownNameError as exc:
         raise PhysbenchError(str(exc)) from None
@@ -277,7 +317,7 @@ def check_config(config: RunConfig) -> ParamSpace:
         resolution=config.resolution,
         mode=config.render_mode,
     )
-    return config_space(config)
+    return config_space(config, observed_scene(config, observed))
 
 
 def run_config(
@@ -291,16 +331,16 @@ def run_config(
     ``callback`` receives each iteration's record; ``save_observation`` writes the frames used."""
     _check_observation(config)
     from physbench.loop import draw_problem, refine
-    from physbench.observation import load_observation, simulate_observation
     from physbench.observation import save_observation as save_obs
+    from physbench.observation import simulate_observation
     from physbench.plugins import create
     from physbench.render.observe import ObservationModel
-    from physbench.scenes import resolve_scene
 
-    scene = resolve_scene(config.scene, config.seed)
+    observed = load_observed(config)
+    scene = observed_scene(config, observed)
     space = config_space(config, scene)
     estimator = make_estimator(config.estimator, config.options)
-    simulator = create("simulator", config.engine)
+    simulator = create("simulator", model_engine(config, observed))
 
     def renderer() -> Renderer:
         return make_renderer(
@@ -315,8 +355,8 @@ def run_config(
     truth, initial = draw_problem(space, config.seed)
     obs: Observation
     marked = space.bodies if per_object else ()
-    if config.observation:
-        obs = load_observation(config.observation)
+    if observed is not None:
+        obs = observed
     elif config.video:
         from physbench.video.observe import video_observation
 
@@ -364,8 +404,13 @@ def run_config(
         initial=initial,
         callback=callback,
     )
+    observe_engine: str | None = config.observer_engine
+    if observed is not None:
+        observe_engine = observed.engine or None  # a file's maker, where it says
+    elif config.video:
+        observe_engine = None
     history.meta.update(
-        observe_engine=None if config.observation or config.video else config.observer_engine,
+        observe_engine=observe_engine,
         renderer=config.renderer,
         renderer_options=dict(config.renderer_options),
         blur=config.blur,
@@ -379,4 +424,6 @@ def run_config(
         )
     if config.video:
         history.meta.update(video=config.video, calibration=config.calibration)
+    if observed is not None and observed.effects:
+        history.meta.update(observe_effects=list(observed.effects))
     return history

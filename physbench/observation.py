@@ -10,14 +10,23 @@ File format (``.npz``, written by :func:`save_observation`, read by :func:`load_
 ``marked_<body>``
     optional, same shape: the frames with ``<body>`` marked (rendered with ``focus=<body>``),
     needed only by estimators that correct one marked object at a time.
+``scene_toml``
+    optional, a 0-d string: the scene instance observed (:func:`~physbench.scene_toml.dumps_scene`)
+    with every body parameter at its true value, so the file carries the truth of any unknowns.
+    ``physbench simulate --out`` writes it, and :func:`save_observation` when the truth is known.
+``engine``
+    optional, a 0-d string: the simulator that made the frames.
+``effects``
+    optional, strings: the effects simulated besides the scene's physics (``repr`` of each).
 
-A file carries no true parameters, so a run on it reports only image MSE.
+A file without ``scene_toml`` (e.g. a camera's frames) carries no truth, so a run on it reports
+only image MSE.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -34,6 +43,8 @@ if TYPE_CHECKING:
     from physbench.simulators.base import Simulator
 
 MARK_PREFIX = "marked_"
+#: Keys of an observation file besides the frames: scene, engine, effects.
+SCENE_KEY, ENGINE_KEY, EFFECTS_KEY = "scene_toml", "engine", "effects"
 
 
 class ObservationError(PhysbenchError, ValueError):
@@ -42,12 +53,17 @@ class ObservationError(PhysbenchError, ValueError):
 
 @dataclass
 class Observation:
-    """Observed frames, the true parameters when known, and per-body marked frames if any."""
+    """Observed frames, the true parameters when known, and per-body marked frames if any.
+    ``scene``: the scene instance observed, at the true parameters, when known; ``engine`` and
+    ``effects``: what simulated it, when it was simulated (``""`` and ``()`` otherwise)."""
 
     frames: np.ndarray  # (T, C, H, W) float32 in [0, 1]
     truth: Params | None = None
     marked: dict[str, np.ndarray] = field(default_factory=dict)
     source: str = ""
+    scene: Scene | None = None
+    engine: str = ""
+    effects: tuple[str, ...] = ()
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -112,7 +128,7 @@ def validate(
             f"corrects one marked object at a time needs '{MARK_PREFIX}<body>' arrays for every "
             "unknown body"
         )
-    return Observation(frames, obs.truth, marked, obs.source)
+    return replace(obs, frames=frames, marked=marked)
 
 
 def simulate_observation(
@@ -133,13 +149,41 @@ def simulate_observation(
     if camera is not None:
         views = {b: camera.apply(f) for b, f in views.items()}
     frames = views.pop(None)
-    return Observation(frames, dict(truth), views, source=f"simulated ({type(simulator).name})")
+    name = type(simulator).name
+    return Observation(
+        frames,
+        dict(truth),
+        views,
+        source=f"simulated ({name})",
+        scene=scene.with_params(truth),
+        engine=name,
+        effects=tuple(repr(e) for e in effects),
+    )
+
+
+def true_params(scene: Scene) -> Params:
+    """Every body parameter of ``scene`` as ``{"body.param": value}`` (a moment left to the shape
+    at its value from the mass): the truth of a scene observed at its own values."""
+    from physbench.scene import BODY_PARAMS
+
+    return {
+        f"{b.name}.{p}": float(b.inertia() if p == "moment" else getattr(b, p))
+        for b in scene.bodies
+        for p in BODY_PARAMS
+    }
 
 
 def save_observation(path: str | Path, obs: Observation) -> None:
-    """Write ``obs`` in the documented ``.npz`` format (truth is not stored)."""
+    """Write ``obs`` in the documented ``.npz`` format; its scene (at the true parameters), engine
+    and effects go with the frames when the truth is known."""
     arrays = {"frames": np.asarray(obs.frames, np.float32)}
     arrays.update({MARK_PREFIX + b: np.asarray(f, np.float32) for b, f in obs.marked.items()})
+    if obs.truth is not None and obs.scene is not None:
+        from physbench.scene_toml import dumps_scene
+
+        arrays[SCENE_KEY] = np.array(dumps_scene(obs.scene))
+        arrays[ENGINE_KEY] = np.array(obs.engine)
+        arrays[EFFECTS_KEY] = np.array(obs.effects, dtype=str)
     np.savez_compressed(path, **arrays)  # type: ignore[arg-type]
 
 
@@ -165,4 +209,12 @@ def load_observation(path: str | Path) -> Observation:
             f"{p}: 'frames' has shape {frames.shape}; expected 4 axes (T, C, H, W)"
         )
     marked = {k[len(MARK_PREFIX) :]: v for k, v in arrays.items() if k.startswith(MARK_PREFIX)}
-    return Observation(frames, None, marked, source=str(p))
+    obs = Observation(frames, None, marked, source=str(p))
+    if SCENE_KEY not in arrays:
+        return obs  # frames only: no truth
+    from physbench.scene_toml import loads_scene
+
+    scene = loads_scene(str(arrays[SCENE_KEY]), source=f"{p} [{SCENE_KEY}]")
+    engine = str(arrays[ENGINE_KEY]) if ENGINE_KEY in arrays else ""
+    effects = tuple(str(e) for e in arrays.get(EFFECTS_KEY, ()))
+    return replace(obs, truth=true_params(scene), scene=scene, engine=engine, effects=effects)

@@ -11,7 +11,11 @@ may be sampled at its own, irregular times. Rules:
 - ``angle`` may be left empty for a body that has no measured angle, but then for all of that
   body's rows in the run;
 - ``run`` labels several runs in one file (any non-empty text); without it the file holds one run;
-- blank lines and lines starting with ``#`` are skipped.
+- blank lines and lines starting with ``#`` are skipped, except that comment lines before the
+  header may name the fields that were measured (:attr:`Recording.fields`; the other columns then
+  hold whatever the tracker filled in): ``# fields: y`` for every run, ``# fields of run "drop 1":
+  x, y`` for one run (its label as a JSON string), which overrides the former. Without such a
+  line, every field a run's tracks hold counts as measured.
 
 Errors name the line (1 = header), the data row (1 = first row after the header) and the column.
 """
@@ -20,7 +24,9 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,6 +45,8 @@ OPTIONAL_COLUMNS = ("angle", "run")
 #: Pose fields a recording can hold, and the trajectory state column of each and of its rate.
 POSE_FIELDS = ("x", "y", "angle")
 _STATE_COLUMN = {"x": (0, 3), "y": (1, 4), "angle": (2, 5)}
+#: A comment line naming measured fields: an optional run label (a JSON string), then the fields.
+_FIELDS_LINE = re.compile(r'#\s*fields(?:\s+of\s+run\s+(".*"|[^:]*?))?\s*:(.*)')
 
 
 class RecordingError(PhysbenchError, ValueError):
@@ -52,6 +60,7 @@ class RecordingError(PhysbenchError, ValueError):
         line: int | None = None,
         row: int | None = None,
         column: str | None = None,
+        comment: bool = False,
     ) -> None:
         self.source, self.line, self.row, self.column, self.reason = (
             source,
@@ -62,7 +71,8 @@ class RecordingError(PhysbenchError, ValueError):
         )
         where = []
         if line is not None:
-            where.append(f"line {line} ({'header' if row is None else f'data row {row}'})")
+            part = "comment" if comment else "header" if row is None else f"data row {row}"
+            where.append(f"line {line} ({part})")
         if column is not None:
             where.append(f"column {column!r}")
         prefix = f"{source}: " if source else ""
@@ -321,13 +331,59 @@ def _known_bodies(bodies: Scene | Iterable[str] | None) -> tuple[str, ...] | Non
     return bodies.body_names if isinstance(bodies, Scene) else tuple(bodies)
 
 
+def _declared_fields(
+    text: str, source: str
+) -> tuple[dict[str | None, tuple[tuple[str, ...], int]], str]:
+    """The ``# fields`` lines before the header, as run label (``None``: every run) -> (fields,
+    line), and ``text`` with the comment lines before the header blanked: the CSV reader would
+    take a quote in them for the start of a quoted cell."""
+    out: dict[str | None, tuple[tuple[str, ...], int]] = {}
+    skipped = 0
+
+    def bad(msg: str, line: int) -> RecordingError:
+        return RecordingError(msg, source=source, line=line, comment=True)
+
+    for line, raw in enumerate(io.StringIO(text), start=1):
+        stripped = raw.strip()
+        if stripped and not stripped.startswith("#"):
+            break  # the header: comments after it are skipped as CSV rows
+        skipped += len(raw)
+        m = _FIELDS_LINE.fullmatch(stripped)
+        if m is None:
+            continue
+        run: str | None = None
+        if m.group(1) is not None:
+            try:
+                run = json.loads(m.group(1))
+            except json.JSONDecodeError:
+                run = None
+            if not isinstance(run, str):
+                raise bad(
+                    f"run label {m.group(1)} is not a JSON string; expected e.g. "
+                    '# fields of run "drop 1": x, y',
+                    line,
+                )
+        names = tuple(f.strip() for f in m.group(2).split(","))
+        names = () if names == ("",) else names
+        for f in names:
+            if f not in POSE_FIELDS:
+                raise bad(f"unknown field {f!r}; fields are {', '.join(POSE_FIELDS)}", line)
+        if run in out:
+            which = "every run" if run is None else f"run {run!r}"
+            raise bad(f"fields of {which} given twice (also at line {out[run][1]})", line)
+        out[run] = (names, line)
+    return out, "\n" * text.count("\n", 0, skipped) + text[skipped:]
+
+
 def parse_recordings(
     text: str, *, bodies: Scene | Iterable[str] | None = None, source: str = "<string>"
 ) -> list[Recording]:
     """Parse recording CSV text into one :class:`Recording` per run, in order of first
     appearance. ``bodies`` (a scene or names) makes an unknown body name an error."""
     known = _known_bodies(bodies)
-    reader = csv.reader(io.StringIO(text.removeprefix("\ufeff")))
+    text = text.removeprefix("\ufeff")
+    declared, text = _declared_fields(text, source)
+    reader = csv.reader(io.StringIO(text))
     header: list[str] | None = None
     header_line = 0
     row_no = 0
@@ -462,7 +518,20 @@ def parse_recordings(
         runs.setdefault(run, {})[body] = Track(
             t[order], np.asarray(g["x"])[order], np.asarray(g["y"])[order], ang
         )
-    return [Recording(tracks, run=run, source=source) for run, tracks in runs.items()]
+    for run, (_, line) in declared.items():
+        if run is not None and run not in runs:
+            have = ", ".join(repr(r) for r in runs)
+            raise RecordingError(
+                f"fields of run {run!r}, but no row is of that run; runs: {have}",
+                source=source,
+                line=line,
+                comment=True,
+            )
+    every = declared.get(None, (None, 0))[0]
+    return [
+        Recording(tracks, run=run, fields=declared.get(run, (every, 0))[0], source=source)
+        for run, tracks in runs.items()
+    ]
 
 
 def read_recordings(
@@ -498,7 +567,8 @@ def read_recording(
 
 
 def format_recordings(recordings: Sequence[Recording]) -> str:
-    """CSV text of ``recordings`` (one run each), exact to the last bit (``repr`` floats)."""
+    """CSV text of ``recordings`` (one run each), exact to the last bit (``repr`` floats), with a
+    ``# fields`` line for each run whose measured fields are named."""
     if not recordings:
         raise RecordingError("nothing to write: no recordings")
     labels = [r.run for r in recordings]
@@ -507,8 +577,18 @@ def format_recordings(recordings: Sequence[Recording]) -> str:
         raise RecordingError(
             f"each run needs a distinct, non-empty label to share a file; labels: {labels}"
         )
+    for name in (*labels, *(b for r in recordings for b in r.tracks)):
+        if name != name.strip():
+            raise RecordingError(
+                f"name {name!r} starts or ends with white space, which a reader strips; give it "
+                "without"
+            )
     with_angle = any(tr.angle is not None for r in recordings for tr in r.tracks.values())
     buf = io.StringIO()
+    for r in recordings:
+        if r.fields is not None:
+            which = f" of run {json.dumps(r.run)}" if with_run else ""
+            buf.write(f"# fields{which}: {', '.join(r.fields)}\n")
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(
         ["t", "body", "x", "y", *(["angle"] if with_angle else []), *(["run"] if with_run else [])]

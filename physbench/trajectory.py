@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physbench.errors import UnknownNameError
+from physbench.errors import UnknownNameError, counted
 
 #: Columns of :attr:`Trajectory.states`, in order.
 STATE_FIELDS = ("x", "y", "angle", "vx", "vy", "omega")
@@ -27,8 +27,8 @@ class Trajectory:
         t, n, c = self.states.shape
         if n != len(self.bodies) or c != len(STATE_FIELDS) or self.times.shape != (t,):
             raise ValueError(
-                f"states {self.states.shape} do not match {len(self.bodies)} bodies and "
-                f"{len(self.times)} times"
+                f"states {self.states.shape} do not match {counted(len(self.bodies), 'body')} "
+                f"and {counted(len(self.times), 'time')}"
             )
 
     @property

@@ -71,3 +71,10 @@ def test_plurals_of_the_kinds_physbench_names() -> None:
     err = UnknownNameError("body of recording 'r'", "z", ["a"])
     assert str(err) == "unknown body of recording 'r' 'z'; known bodies of recording 'r': a"
     assert "known drag laws: " in str(UnknownNameError("drag law", "x", ["linear"]))
+
+
+def test_counts_agree_with_their_nouns() -> None:
+    from physbench.errors import counted
+
+    assert [counted(n, "worker") for n in (0, 1, 2)] == ["0 workers", "1 worker", "2 workers"]
+    assert (counted(1, "body"), counted(3, "body")) == ("1 body", "3 bodies")

@@ -5,16 +5,23 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physbench.observation import ObservationError, load_observation, save_observation
+from physbench.observation import (
+    Observation,
+    ObservationError,
+    load_observation,
+    save_observation,
+    simulate_observation,
+)
 from physbench.testing import toy_task
 
 
 def test_observation_files_round_trip_and_bad_files_are_explained(tmp_path) -> None:  # type: ignore[no-untyped-def]
     t = toy_task()
     path = tmp_path / "obs.npz"
-    save_observation(path, t.observation)
+    save_observation(path, Observation(t.observation.frames, marked=t.observation.marked))
     back = load_observation(path)
-    assert back.truth is None and np.array_equal(back.frames, t.observation.frames)
+    assert back.truth is None and back.scene is None and back.engine == ""
+    assert np.array_equal(back.frames, t.observation.frames)
     assert set(back.marked) == {"a", "b"}
     np.savez(tmp_path / "nokey.npz", images=t.observation.frames)
     with pytest.raises(ObservationError, match=r"no 'frames' array .*found: images"):
@@ -27,3 +34,28 @@ def test_observation_files_round_trip_and_bad_files_are_explained(tmp_path) -> N
     (tmp_path / "junk.npz").write_text("not a zip")
     with pytest.raises(ObservationError, match=r"cannot read as \.npz"):
         load_observation(tmp_path / "junk.npz")
+
+
+def test_a_simulated_observation_file_carries_its_scene_truth_and_engine(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from physbench.effects.drag import LinearDrag
+    from physbench.plugins import create
+    from physbench.render.raster import RasterRenderer
+    from physbench.scenes import resolve_scene
+
+    scene = resolve_scene("three_circles", 3)
+    truth = {"a.mass": 2.5, "b.elasticity": 0.4}
+    obs = simulate_observation(
+        scene,
+        truth,
+        create("simulator", "box2d"),
+        RasterRenderer(resolution=16),
+        effects=[LinearDrag(c=0.2)],
+    )
+    save_observation(tmp_path / "obs.npz", obs)
+    back = load_observation(tmp_path / "obs.npz")
+    assert back.scene == scene.with_params(truth) and back.engine == "box2d"
+    assert back.effects == ("LinearDrag(c=0.2)",)
+    assert back.truth is not None and {k: back.truth[k] for k in truth} == truth
+    # every other body parameter at the scene's value (a moment from shape and mass)
+    assert back.truth["b.mass"] == scene.bodies[2].mass == 5.0
+    assert back.truth["a.moment"] == scene.with_params(truth).bodies[1].inertia()

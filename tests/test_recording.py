@@ -195,6 +195,104 @@ def test_single_run_without_run_column(tmp_path):
     assert read_recording(tmp_path / "one.csv").track("ball").x.tolist() == [1.0, 2.0]
 
 
+#: Characters of random run and body names: CSV and JSON specials, a comment mark, non-ASCII.
+NAME_CHARS = [*"ab01 ,\"'#:;\\\n\té€", '": y', "of run"]
+
+
+def random_name(rng: np.random.Generator) -> str:
+    name = "".join(rng.choice(NAME_CHARS) for _ in range(int(rng.integers(1, 8))))
+    return name.strip() or "r"  # a reader strips cells: the writer refuses edge white space
+
+
+def random_track(rng: np.random.Generator, with_angle: bool) -> Track:
+    n = int(rng.integers(1, 12))
+    scale = 10.0 ** rng.integers(-300, 300)  # repr must carry any double
+    t = np.cumsum(rng.uniform(1e-9, 1.0, n)) - rng.uniform(0, 1e-9)
+    values = [rng.normal(size=n) * scale for _ in range(3)]
+    return Track(t, values[0], values[1], values[2] if with_angle else None)
+
+
+def random_fields(rng: np.random.Generator) -> tuple[str, ...] | None:
+    if rng.random() < 0.3:
+        return None
+    k = int(rng.integers(0, 4))
+    return tuple(str(f) for f in rng.permutation(["x", "y", "angle"])[:k])
+
+
+def test_write_then_parse_gives_back_the_same_recordings() -> None:
+    """Seeded cases: tracks bit for bit, run labels and measured fields (any subset, any order,
+    or none named), one run without a label or several with labels full of CSV specials."""
+    rng = np.random.default_rng(13)
+    for case in range(300):
+        n_runs = int(rng.integers(1, 4))
+        labels: list[str] = [""] if n_runs == 1 and rng.random() < 0.5 else []
+        while len(labels) < n_runs:
+            label = random_name(rng)
+            labels += [] if label in labels else [label]
+        recs = []
+        for run in labels:
+            bodies = {random_name(rng) for _ in range(int(rng.integers(1, 4)))}
+            tracks = {b: random_track(rng, bool(rng.random() < 0.5)) for b in sorted(bodies)}
+            recs.append(Recording(tracks, run=run, fields=random_fields(rng)))
+        text = format_recordings(recs)
+        back = parse_recordings(text, source="rec.csv")
+        assert [(r.run, r.fields, r.bodies) for r in back] == [
+            (r.run, r.fields, r.bodies) for r in recs
+        ], (case, text)
+        for a, b in zip(recs, back, strict=True):
+            assert b.source == "rec.csv" and dict(b.meta) == {}
+            for name in a.bodies:
+                ta, tb = a.track(name), b.track(name)
+                assert (ta.angle is None) == (tb.angle is None), (case, text)
+                for f in ("t", "x", "y", "angle")[: 4 if ta.angle is not None else 3]:
+                    got, want = getattr(tb, f), getattr(ta, f)
+                    assert got.tobytes() == want.tobytes(), (case, f, text)
+
+
+def test_fields_lines_are_read_and_files_without_them_are_unchanged() -> None:
+    plain = "t,body,x,y,run\n0,ball,0,1,a\n0,ball,0,2,b\n"
+    assert [r.fields for r in parse_recordings(plain)] == [None, None]
+    # a comment that is no fields line changes nothing
+    assert [r.fields for r in parse_recordings("# fields were tracked by hand\n" + plain)] == [
+        None,
+        None,
+    ]
+    every = "# made by hand\n# fields: y\n" + plain
+    assert [r.fields for r in parse_recordings(every)] == [("y",), ("y",)]
+    one = '#fields of run "b" : x ,angle\n# fields: y\n' + plain
+    assert [r.fields for r in parse_recordings(one)] == [("y",), ("x", "angle")]
+    assert parse_recordings("# fields:\nt,body,x,y\n0,ball,0,1\n")[0].fields == ()
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "fragment"),
+    [
+        ("# fields: y, z\n", 1, "unknown field 'z'; fields are x, y, angle"),
+        ("# fields: y\n#fields:x\n", 2, "fields of every run given twice (also at line 1)"),
+        ("# fields of run a: y\n", 1, "run label a is not a JSON string"),
+        (
+            '\n# fields of run "c": y\n',
+            2,
+            "fields of run 'c', but no row is of that run; runs: 'a'",
+        ),
+    ],
+)
+def test_bad_fields_lines_name_their_line(text: str, line: int, fragment: str) -> None:
+    with pytest.raises(RecordingError) as info:
+        parse_recordings(text + "t,body,x,y,run\n0,ball,0,1,a\n", source="rec.csv")
+    assert info.value.line == line
+    assert str(info.value).startswith(f"rec.csv: line {line} (comment): ") and fragment in str(
+        info.value
+    )
+
+
+def test_names_a_reader_would_strip_are_refused() -> None:
+    track = Track(np.array([0.0]), np.zeros(1), np.zeros(1))
+    for rec in (Recording({"ball": track}, run=" a"), Recording({"ball ": track})):
+        with pytest.raises(RecordingError, match="starts or ends with white space"):
+            format_recordings([rec])
+
+
 # --------------------------------------------------------------------------- comparison
 
 

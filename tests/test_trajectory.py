@@ -28,8 +28,8 @@ def test_states_hold_six_fields_per_body_and_frame() -> None:
     ("bodies", "times", "states", "message"),
     [
         (("a", "b"), 3, (3, 3, 6), r"states \(3, 3, 6\) do not match 2 bodies and 3 times"),
-        (("a",), 3, (3, 1, 5), r"states \(3, 1, 5\) do not match 1 bodies and 3 times"),
-        (("a",), 4, (3, 1, 6), r"states \(3, 1, 6\) do not match 1 bodies and 4 times"),
+        (("a",), 3, (3, 1, 5), r"states \(3, 1, 5\) do not match 1 body and 3 times"),
+        (("a",), 4, (3, 1, 6), r"states \(3, 1, 6\) do not match 1 body and 4 times"),
     ],
 )
 def test_states_that_do_not_match_are_refused(

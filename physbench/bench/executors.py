@@ -13,7 +13,7 @@ import os
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol, TypeVar
 
-from physbench.errors import PhysbenchError
+from physbench.errors import PhysbenchError, counted
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -101,7 +101,7 @@ class ProcessExecutor:
                 fut.cancel()
 
     def describe(self) -> str:
-        return f"processes ({self.workers} workers)"
+        return f"processes ({counted(self.workers, 'worker')})"
 
 
 class DaskExecutor:
@@ -178,7 +178,7 @@ class DaskExecutor:
             self._client.cancel(futures)
 
     def describe(self) -> str:
-        return f"dask ({self.address or 'LocalCluster'}, {self.workers} workers)"
+        return f"dask ({self.address or 'LocalCluster'}, {counted(self.workers, 'worker')})"
 
 
 def make_executor(name: str, *, workers: int | None = None, address: str | None = None) -> Executor:

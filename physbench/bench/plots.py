@@ -30,6 +30,7 @@ from physbench.bench.tables import (
     upgrade,
     win_rate_table,
 )
+from physbench.errors import counted
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
@@ -140,7 +141,7 @@ def convergence(df: pd.DataFrame, out: Path) -> list[Path]:
         axes[0, -1].legend(fontsize="x-small", loc="upper right")
         n = rows["seed"].nunique()
         fig.suptitle(
-            f"{_title(cfg, varying)}: mean over {n} seeds, band = interquartile range",
+            f"{_title(cfg, varying)}: mean over {counted(n, 'seed')}, band = interquartile range",
             fontsize="medium",
         )
         fig.tight_layout()

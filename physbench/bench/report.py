@@ -11,6 +11,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from physbench.errors import counted
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -67,7 +69,8 @@ def build(
     iters = ", ".join(str(i) for i in dict.fromkeys(st["iterations"]))
     renderers = ", ".join(html.escape(str(r)) for r in dict.fromkeys(df["renderer"]))
     parts.append(
-        f"<p>{cells} cells ({failed} failed), {fin['seed'].nunique()} seeds, {iters} iterations, "
+        f"<p>{counted(cells, 'cell')} ({failed} failed), "
+        f"{counted(fin['seed'].nunique(), 'seed')}, {iters} iterations, "
         f"rendered by {renderers}. Score: normalized min MSE of the best-by-image-MSE iterate "
         "(the paper's Table 1 metric).</p>"
     )

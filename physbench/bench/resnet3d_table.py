@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from physbench.bench.tables import paper_value, ratio_ci
+from physbench.errors import counted
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -99,6 +100,7 @@ def table(folder: str | Path) -> str:
         rows.append("")
         for key, g in failed.groupby(keys):
             rows.append(
-                f"failed: {' '.join(map(str, key))}: {len(g)} cells ({g.error.iloc[0][:120]})"
+                f"failed: {' '.join(map(str, key))}: {counted(len(g), 'cell')} "
+                f"({g.error.iloc[0][:120]})"
             )
     return "\n".join(rows)

@@ -20,7 +20,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from physbench.errors import PhysbenchError
+from physbench.errors import PhysbenchError, counted
 
 if TYPE_CHECKING:
     from physbench.bench.spec import Cell
@@ -162,8 +162,8 @@ def describe(stale: Sequence[Stale], finished: int, where: str) -> str:
     unstamped = [s for s in stale if s.stored is None]
     if unstamped:
         lines.append(
-            f"  - {len(unstamped)} cells carry no stamp (written before physbench recorded what "
-            "produced a cell)"
+            f"  - {counted(len(unstamped), 'cell')} without a stamp (written before physbench "
+            "recorded what produced a cell)"
         )
     stamped = [s for s in stale if s.stored is not None]
     scenes: dict[str, list[int]] = {}

@@ -82,6 +82,7 @@ def main(args: argparse.Namespace) -> int:
     from physbench.bench.runner import run_sweep
     from physbench.bench.spec import load_spec, with_renderer
     from physbench.commands.arguments import parse_key_values
+    from physbench.errors import counted
 
     spec = load_spec(args.spec)
     if args.renderer is not None or args.renderer_option:
@@ -115,7 +116,7 @@ def main(args: argparse.Namespace) -> int:
 
         print(markdown(paper_layout(res.stats)))
     print(
-        f"{spec.name}: {res.cells} cells ({res.ran} run, {res.skipped} already done, "
+        f"{spec.name}: {counted(res.cells, 'cell')} ({res.ran} run, {res.skipped} already done, "
         f"{res.failed} failed) in {res.wall_s:.1f} s with {res.executor}; "
         f"table {res.out / 'results.parquet'}"
     )

@@ -59,6 +59,7 @@ def main(args: argparse.Namespace) -> int:
     from physbench.bench.compare import compare
     from physbench.bench.runner import read_table
     from physbench.bench.tables import SETTINGS, markdown
+    from physbench.errors import counted
 
     res = compare(
         read_table(args.new), read_table(args.baseline), alpha=args.alpha, min_ratio=args.min_ratio
@@ -103,7 +104,8 @@ def main(args: argparse.Namespace) -> int:
         else ""
     )
     print(
-        f"compared {int(t['matched'].sum())} cells in {len(t)} configurations: "
+        f"compared {counted(int(t['matched'].sum()), 'cell')} in "
+        f"{counted(len(t), 'configuration')}: "
         f"{summary}{unmatched} (worse: one-sided Wilcoxon, Holm-corrected p < {args.alpha}, "
         f"and geometric-mean ratio >= {args.min_ratio})"
     )

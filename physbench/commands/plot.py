@@ -36,7 +36,7 @@ def main(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from physbench.errors import PhysbenchError
+    from physbench.errors import PhysbenchError, counted
 
     if args.seeds < 1:
         raise PhysbenchError(f"--seeds {args.seeds}: expected a whole number >= 1")
@@ -69,5 +69,5 @@ def main(args: argparse.Namespace) -> int:
         log, title = None, out.name
     page = report.build(df, out, figures, title=title, run_log=log)
     count = sum(len(v) for v in figures.values())
-    print(f"{count} figures in {out / 'plots'}; report {page}")
+    print(f"{counted(count, 'figure')} in {out / 'plots'}; report {page}")
     return 0

@@ -2,8 +2,9 @@
 
 By default the observation is simulated: for ``--seed`` the scene instance, random true
 parameters and a random initial guess all derive from that seed. ``--observation FILE`` uses
-a user's frames instead (format: :mod:`physbench.observation`); there is no truth then, so only
-image MSE is reported.
+given frames instead (format: :mod:`physbench.observation`): a file from ``physbench simulate``
+(or ``--save-observation``) brings its scene instance, its truth and the engine that made it, so
+the normalized error is reported; a file of frames only has no truth, so only image MSE is.
 """
 
 from __future__ import annotations
@@ -33,9 +34,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--scene",
-        default="three_circles",
+        default=None,
         metavar="NAME|FILE",
-        help="registered scene or scene TOML (default: three_circles)",
+        help="registered scene or scene TOML (default: three_circles; with an --observation file "
+        "that carries its scene, that scene instance, which --scene must name)",
     )
     p.add_argument(
         "--params",
@@ -63,13 +65,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--seed",
         type=int,
         default=0,
-        help="scene instance, truth, initial guess and estimator seed (default: 0)",
+        help="scene instance, truth, initial guess and estimator seed (default: 0); with an "
+        "--observation file that carries its scene, only the initial guess and estimator seed",
     )
     p.add_argument(
         "--engine",
-        default="pymunk",
+        default=None,
         metavar="NAME",
-        help="simulator of the model (default: pymunk)",
+        help="simulator of the model (default: pymunk, or the engine that made the --observation "
+        "file)",
     )
     p.add_argument(
         "--observe-engine",
@@ -97,7 +101,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--observation",
         default=None,
         metavar="FILE",
-        help="observed frames (.npz with key 'frames', (T, C, H, W) in [0, 1])",
+        help="observed frames (.npz with key 'frames', (T, C, H, W) in [0, 1]), e.g. from "
+        "`physbench simulate --out`, whose scene, truth and engine the run takes",
     )
     video = p.add_argument_group(
         "video",
@@ -183,8 +188,25 @@ def print_table(history: Any, out: Any = None) -> None:
         )
 
 
+def describe_observation(history: Any) -> str:
+    """One line on an observation file: its scene, what made it and what models it."""
+    meta = history.meta
+    if history.truth is None:
+        return (
+            f"observation {meta['observation']}: frames only (no scene or truth in the file); "
+            f"modelled as scene {meta['scene']} by {meta['simulator']}"
+        )
+    maker = f"made by {meta['observe_engine'] or 'an engine the file does not name'}"
+    if meta.get("observe_effects"):
+        maker += f" with {', '.join(meta['observe_effects'])}"
+    return (
+        f"observation {meta['observation']}: scene {meta['scene']}, {maker}; modelled by "
+        f"{meta['simulator']}"
+    )
+
+
 def main(args: argparse.Namespace) -> int:
-    from physbench.errors import PhysbenchError
+    from physbench.errors import PhysbenchError, counted
 
     if args.iterations < 1:
         raise PhysbenchError(f"--iterations {args.iterations}: expected a whole number >= 1")
@@ -192,7 +214,13 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(f"--seed {args.seed}: expected a whole number >= 0")
 
     from physbench.commands.arguments import parse_key_values, renderer_choice
-    from physbench.experiment import RunConfig, check_config, default_render_mode, run_config
+    from physbench.experiment import (
+        DEFAULT_SCENE,
+        RunConfig,
+        check_config,
+        default_render_mode,
+        run_config,
+    )
 
     params = tuple(q for item in args.params for q in item.split(",") if q)
     bodies = (
@@ -232,7 +260,7 @@ def main(args: argparse.Namespace) -> int:
 
     bar = tqdm(
         total=args.iterations,
-        desc=f"{args.estimator} on {args.scene}",
+        desc=f"{args.estimator} on {args.scene or args.observation or DEFAULT_SCENE}",
         unit="it",
         file=sys.stderr,
         disable=True if args.quiet else None,
@@ -265,6 +293,8 @@ def main(args: argparse.Namespace) -> int:
         return 0
     n = len(history)
     if not args.quiet:
+        if args.observation:
+            print(describe_observation(history))
         print_table(history)
         t = history.timings()
         print(
@@ -281,12 +311,12 @@ def main(args: argparse.Namespace) -> int:
         )
     if history.best_nmse is not None:
         print(
-            f"normalized min MSE after {n} iterations: {history.best_nmse:.3e} "
+            f"normalized min MSE after {counted(n, 'iteration')}: {history.best_nmse:.3e} "
             f"(initial guess {history.initial_nmse:.3e}; min image MSE {history.min_loss:.3e})"
         )
     else:
         print(
-            f"min image MSE after {n} iterations: {history.min_loss:.3e} (no truth: observation "
-            f"from {args.observation or args.video})"
+            f"min image MSE after {counted(n, 'iteration')}: {history.min_loss:.3e} (no truth: "
+            f"observation from {args.observation or args.video})"
         )
     return 0

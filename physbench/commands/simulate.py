@@ -152,7 +152,11 @@ def main(args: argparse.Namespace) -> int:
         from physbench.scene_toml import dumps_scene
 
         np.savez_compressed(
-            args.out, frames=frames, scene_toml=np.array(dumps_scene(scene)), **traj.to_npz_dict()
+            args.out,
+            frames=frames,
+            scene_toml=np.array(dumps_scene(scene)),
+            effects=np.array([repr(e) for e in effects], dtype=str),
+            **traj.to_npz_dict(),
         )
         print(f"wrote {args.out}")
     if args.plate:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.errors import PhysbenchError
+from physbench.errors import PhysbenchError, counted
 from physbench.recording import Recording, Track
 
 if TYPE_CHECKING:
@@ -240,10 +240,9 @@ def _cut(run: Run, index: int, t_cut: float, what: str) -> tuple[Part, Part]:
         n_fit, n_held = a.size, b.size
     if n_fit < MIN_FIT_SAMPLES or n_held < MIN_HELD_SAMPLES:
         raise DiscoverError(
-            f"run {run.name!r}: splitting at t = {t_cut:.4g} s ({what}) leaves {n_fit} samples "
-            f"to fit and {n_held} to score; need at least {MIN_FIT_SAMPLES} and "
-            f"{MIN_HELD_SAMPLES}: record a longer run "
-            "or change --holdout"
+            f"run {run.name!r}: splitting at t = {t_cut:.4g} s ({what}) leaves "
+            f"{counted(n_fit, 'sample')} to fit and {n_held} to score; need at least "
+            f"{MIN_FIT_SAMPLES} and {MIN_HELD_SAMPLES}: record a longer run or change --holdout"
         )
     return a, b
 

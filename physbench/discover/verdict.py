@@ -14,6 +14,7 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from physbench.discover.phrasing import describe
+from physbench.errors import counted
 
 if TYPE_CHECKING:
     from physbench.discover.results import CandidateResult, Discovery, Finding
@@ -57,7 +58,7 @@ def text(disc: Discovery) -> str:
     lines = []
     runs = ", ".join(r.name for r in disc.runs[:6]) + (" ..." if len(disc.runs) > 6 else "")
     lines.append(
-        f"discovery on {len(disc.runs)} run(s) [{runs}] with {disc.engine}; "
+        f"discovery on {counted(len(disc.runs), 'run')} [{runs}] with {disc.engine}; "
         f"{disc.split.describe(disc.runs)}"
     )
     b = disc.base

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
-from physbench.errors import PhysbenchError, UnknownNameError
+from physbench.errors import PhysbenchError, UnknownNameError, counted
 from physbench.parameter import Parameter
 
 if TYPE_CHECKING:
@@ -200,7 +200,8 @@ class Effect:
     def _require_setup(self, states: np.ndarray) -> None:
         if self.scene is None or len(self.mask) != states.shape[0]:
             raise EffectError(
-                f"effect {self.name!r} was not set up for this scene ({states.shape[0]} bodies): "
+                f"effect {self.name!r} was not set up for this scene "
+                f"({counted(states.shape[0], 'body')}): "
                 "call setup(scene, values) before simulating"
             )
 

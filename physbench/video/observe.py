@@ -189,7 +189,8 @@ def filmed_observation(
             clip, scene, renderer, calibration=cal, background=camera.plate(scene), marked=marked
         )
     obs.truth = dict(truth)
-    obs.source = f"simulated ({type(simulator).name}), filmed by {camera.name}"
+    obs.scene, obs.engine = scene.with_params(truth), type(simulator).name
+    obs.source = f"simulated ({obs.engine}), filmed by {camera.name}"
     return obs
 
 

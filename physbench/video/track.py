@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.errors import PhysbenchError
+from physbench.errors import PhysbenchError, counted
 from physbench.scene import Box, Circle
 from physbench.video.detect import (
     Blob,
@@ -156,7 +156,8 @@ class TrackSummary:
     def format(self) -> str:
         """A few lines for a person."""
         lines = [
-            f"tracked {len(self.detections)} bodies over {self.frames} frames "
+            f"tracked {counted(len(self.detections), 'body')} over "
+            f"{counted(self.frames, 'frame')} "
             f"({self.duration:.2f} s) at {self.fps:.0f} frames/s; calibration reprojection "
             f"error {self.reprojection_error:.2f} px"
         ]
@@ -164,7 +165,8 @@ class TrackSummary:
             gone = self.lost.get(name, [])
             tail = "; lost " + ", ".join(f"{a:.2f}-{b:.2f} s" for a, b in gone) if gone else ""
             lines.append(
-                f"  {name:>8}: seen in {n}/{self.frames} frames, {self.gaps[name]} gaps{tail}"
+                f"  {name:>8}: seen in {n}/{self.frames} frames, "
+                f"{counted(self.gaps[name], 'gap')}{tail}"
             )
         return "\n".join(lines)
 

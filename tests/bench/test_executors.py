@@ -34,6 +34,8 @@ def test_names_build_their_executor_with_all_cores_by_default() -> None:
 
 def test_worker_counts_and_addresses_are_kept_and_described() -> None:
     assert make_executor("processes", workers=3).describe() == "processes (3 workers)"
+    assert make_executor("processes", workers=1).describe() == "processes (1 worker)"
+    assert make_executor("dask", workers=1).describe() == "dask (LocalCluster, 1 worker)"
     assert make_executor("dask", workers=2).describe() == "dask (LocalCluster, 2 workers)"
     remote = make_executor("dask", workers=2, address="tcp://host:8786")
     assert remote.describe() == "dask (tcp://host:8786, 2 workers)"

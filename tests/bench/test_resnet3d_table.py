@@ -54,4 +54,4 @@ def test_table_rows_from_a_sweep_folder(tmp_path):
     assert cells[12:] == ["2.00", "2.00", "2"]  # seeds 0-9, final iterates, seeds
     tpe = "| three_circles | mass | a | 0 | tpe "
     assert tpe + "| 7.50e-01 ± 3.5e-01 | 1.36e-01 ± 6.4e-02 | 5.50 | 2 |" in lines
-    assert lines[-1] == "failed: three_circles mass a 0.0 random: 1 cells (boom)"
+    assert lines[-1] == "failed: three_circles mass a 0.0 random: 1 cell (boom)"

@@ -118,8 +118,8 @@ def test_cells_from_before_stamps_are_stale_and_still_read(tmp_path: Path, toy: 
         _sweep(tmp_path)
     assert (
         f"{tmp_path}: 12 of 12 finished cells were produced by other code or settings than this "
-        "run would use:\n  - 12 cells carry no stamp (written before physbench recorded what "
-        "produced a cell)\nResuming"
+        "run would use:\n  - 12 cells without a stamp (written before physbench recorded "
+        "what produced a cell)\nResuming"
     ) in str(err.value)
     res = _sweep(tmp_path, allow_stale=True)
     assert res.ran == 0

@@ -269,6 +269,7 @@ def test_cli_prints_the_verdict_and_the_table(tmp_path, capsys):
     out = capsys.readouterr().out
     assert rc == 0
     assert "no cause found" in out and "linear_drag" in out and "held-out" in out
+    assert out.startswith("discovery on 1 run [r] with pymunk; ")
     assert (tmp_path / "rep" / "index.html").is_file()
 
 
@@ -289,3 +290,23 @@ def test_a_disagreement_below_the_floor_names_no_cause(tmp_path):
     assert verdicts[1]["causes"] == []
     notes = [c["note"] for c in verdicts[1]["candidates"]]
     assert any("above the data's accuracy 1 " in n for n in notes), notes
+
+
+def test_a_recording_tracked_in_y_only_is_fitted_in_y_only(tmp_path):
+    """The written CSV keeps the measured fields: the unseen x (filled with zeros by the tracker)
+    is neither fitted nor blamed on a sensor offset."""
+    from physbench.discover.data import load_runs
+
+    scene = slide()
+    seen = Recording.from_trajectory(PymunkSimulator().simulate(scene), angle=False)
+    tracks = {b: Track(t.t, np.zeros(len(t)), t.y) for b, t in seen.tracks.items()}
+    write_recordings(tmp_path / "r.csv", Recording(tracks, fields=("y",)))
+    save_scene(scene, tmp_path / "s.toml")
+    (run,) = load_runs(tmp_path / "r.csv", tmp_path / "s.toml")
+    assert run.recording is not None and run.recording.fields == ("y",)
+    out = tmp_path / "v.json"
+    argv = ["discover", str(tmp_path / "r.csv"), "--scene", str(tmp_path / "s.toml")]
+    assert cli([*argv, "--json", str(out), "-q"]) == 0
+    d = json.loads(out.read_text())
+    assert d["residuals"]["base"]["per_field"] == {"ball": {"y": pytest.approx(0.0, abs=1e-9)}}
+    assert d["causes"] == []

@@ -45,6 +45,8 @@ def test_quiet_prints_only_the_final_line(capsys: pytest.CaptureFixture[str]) ->
     code, out, err = run(capsys, "--estimator", "random", *FAST, "-q")
     assert code == 0 and err == ""
     assert out.count("\n") == 1 and out.startswith("normalized min MSE after 4 iterations")
+    code, out, _ = run(capsys, "--estimator", "random", "--iterations", "1", "-q")
+    assert code == 0 and out.startswith("normalized min MSE after 1 iteration: ")
 
 
 def test_json_history_is_reproducible(capsys: pytest.CaptureFixture[str]) -> None:
@@ -80,12 +82,30 @@ def test_observation_file_round_trip_and_wrong_shape(
     capsys: pytest.CaptureFixture[str], tmp_path
 ) -> None:  # type: ignore[no-untyped-def]
     path = tmp_path / "obs.npz"
-    code, _, _ = run(capsys, "--estimator", "random", *FAST, "-q", "--save-observation", str(path))
+    argv = ("--estimator", "random", *FAST, "-q", "--json")
+    code, saved, _ = run(capsys, *argv, "--seed", "3", "--save-observation", str(path))
     assert code == 0 and path.exists()
-    code, out, _ = run(capsys, "--estimator", "random", *FAST, "-q", "--observation", str(path))
-    assert code == 0 and out.startswith("min image MSE after 4 iterations") and "no truth" in out
-
+    # the run's own observation, with its scene instance and truth: the same history
+    code, again, _ = run(capsys, *argv, "--seed", "3", "--observation", str(path))
+    a, b = json.loads(saved), json.loads(again)
+    assert code == 0 and b["truth"] == a["truth"] and b["meta"]["observe_engine"] == "pymunk"
+    assert [r["nmse"] for r in b["iterations"]] == [r["nmse"] for r in a["iterations"]]
+    assert [r["loss"] for r in b["iterations"]] == [r["loss"] for r in a["iterations"]]
+    # frames only (a camera's, or a file from before scenes were stored): no truth, as before
     frames = np.load(path)["frames"]
+    np.savez(tmp_path / "frames.npz", frames=frames)
+    code, out, _ = run(
+        capsys, "--estimator", "random", *FAST, "-q", "--observation", str(tmp_path / "frames.npz")
+    )
+    assert code == 0 and out.startswith("min image MSE after 4 iterations") and "no truth" in out
+    code, out, _ = run(
+        capsys, "--estimator", "random", *FAST, "--observation", str(tmp_path / "frames.npz")
+    )
+    assert out.startswith(
+        f"observation {tmp_path / 'frames.npz'}: frames only (no scene or truth in the file); "
+        "modelled as scene three_circles by pymunk\n"
+    )
+
     np.savez(tmp_path / "short.npz", frames=frames[:10])
     code, _, err = run(
         capsys, "--estimator", "random", *FAST, "--observation", str(tmp_path / "short.npz")
@@ -101,6 +121,70 @@ def test_observation_file_round_trip_and_wrong_shape(
     assert (
         code == 2 and "H 32 != 64, W 32 != 64" in err
     )  # observed at 32 px, modelled at the default 64
+
+
+def test_a_simulated_file_brings_its_scene_truth_and_engine(
+    capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    from physbench.experiment import RunConfig, observed_scene
+    from physbench.observation import load_observation
+    from physbench.scenes import resolve_scene
+
+    path = str(tmp_path / "run.npz")
+    made = ["simulate", "--scene", "three_circles", "--seed", "3", "--resolution", "32"]
+    assert main([*made, "--engine", "box2d", "--set", "a.mass=2", "--out", path]) == 0
+    capsys.readouterr()
+    # the file's instance (seed 3, a.mass = 2), not three_circles at --seed 0
+    scene = observed_scene(RunConfig(scene=None, observation=path), load_observation(path))
+    assert scene == resolve_scene("three_circles", 3).with_params({"a.mass": 2.0})
+    code, out, _ = run(capsys, "--estimator", "random", *FAST, "--observation", path)
+    lines = out.splitlines()
+    assert code == 0
+    assert lines[0] == (
+        f"observation {path}: scene three_circles, made by box2d; modelled by box2d"
+    )
+    assert "truth:   a.mass=2  b.mass=5" in lines
+    assert lines[-1].startswith("normalized min MSE after 4 iterations: ")
+    # an engine the user chooses models it, and the output says which
+    code, out, _ = run(
+        capsys, "--estimator", "random", *FAST, "--engine", "pymunk", "--observation", path
+    )
+    assert out.splitlines()[0].endswith("made by box2d; modelled by pymunk")
+    code, out, _ = run(
+        capsys, "--estimator", "random", *FAST, "-q", "--json", "--observation", path
+    )
+    meta = json.loads(out)["meta"]
+    assert (meta["scene"], meta["simulator"], meta["observe_engine"]) == (
+        "three_circles",
+        "box2d",
+        "box2d",
+    )
+    # a --scene naming the file's scene is fine; another scene is refused, naming both
+    code, _, _ = run(
+        capsys,
+        "--estimator",
+        "random",
+        *FAST,
+        "-q",
+        "--scene",
+        "three_circles",
+        "--observation",
+        path,
+    )
+    assert code == 0
+    code, _, err = run(capsys, *FAST, "--scene", "stacked_boxes", "--observation", path)
+    assert code == 2 and (
+        f"--scene 'stacked_boxes' does not match the observation {path}, which shows scene "
+        "'three_circles'; leave --scene out" in err
+    )
+    # unknowns the file's scene lacks are named as for any scene
+    code, _, err = run(capsys, *FAST, "--params", "friction", "--observation", path)
+    assert code == 2 and "unknown parameter 'friction' of scene 'three_circles'" in err
+    # effects simulated besides the scene's physics are said
+    assert main([*made, "--effect", "linear_drag:c=0.3", "--out", path]) == 0
+    capsys.readouterr()
+    code, out, _ = run(capsys, "--estimator", "random", *FAST, "--observation", path)
+    assert out.splitlines()[0].endswith("made by pymunk with LinearDrag(c=0.3); modelled by pymunk")
 
 
 def test_reality_gap_blur_and_plot(capsys: pytest.CaptureFixture[str], tmp_path) -> None:  # type: ignore[no-untyped-def]

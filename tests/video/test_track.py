@@ -14,6 +14,7 @@ from physbench.video.calibration import Calibration
 from physbench.video.reader import Frame, VideoReader
 from physbench.video.track import (
     TrackError,
+    TrackSummary,
     bounds_calibration,
     track_frames,
     track_video,
@@ -190,3 +191,16 @@ def test_a_swinging_arm_is_measured_along_its_length(film, seed: int) -> None:
     across = off[:, 0] * along[:, 1] - off[:, 1] * along[:, 0]
     assert np.sqrt(np.mean(radial**2)) < 2e-3, np.sqrt(np.mean(radial**2))
     assert np.sqrt(np.mean(across**2)) < 0.5e-3
+
+
+def test_the_summary_counts_in_words_that_agree() -> None:
+    one = TrackSummary(1, 0.1, {"ball": 1}, {"ball": 1}, {}, 0.25, fps=30.0)
+    assert one.format().splitlines() == [
+        "tracked 1 body over 1 frame (0.10 s) at 30 frames/s; calibration reprojection error "
+        "0.25 px",
+        "      ball: seen in 1/1 frames, 1 gap",
+    ]
+    two = TrackSummary(5, 0.2, {"a": 5, "b": 3}, {"a": 0, "b": 2}, {}, 0.25)
+    assert "tracked 2 bodies over 5 frames" in two.format() and "b: seen in 3/5 frames, 2 gaps" in (
+        two.format()
+    )
