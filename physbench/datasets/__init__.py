@@ -3,8 +3,8 @@
 Each loader returns a list of :class:`~physbench.datasets.run.DatasetRun`: one recorded run and a
 scene that reproduces its setup (geometry, masses and initial state from the data; the plain
 rigid-body model otherwise), so that simulating ``run.scene`` and calling
-``run.recording.residuals(traj)`` measures what the plain model misses. The data live in
-``benchmarks/data/<dataset>/`` of the repository, each folder with its PROVENANCE.md;
+``run.recording.residuals(traj)`` measures what the plain model misses. The data ship inside the
+package, ``physbench/datasets/data/<dataset>/``, each folder with its PROVENANCE.md;
 ``PHYSBENCH_DATA`` or a loader's ``root`` argument points elsewhere
 (:mod:`~physbench.datasets.files`).
 

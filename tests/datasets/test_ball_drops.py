@@ -1,4 +1,4 @@
-"""The ball drops loader on the copy in benchmarks/data, and the direct check of the drag law on
+"""The ball drops loader on the shipped copy, and the direct check of the drag law on
 synthetic drops with a known law."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The billiards loader on the copy in benchmarks/data, and the rolling-segment, cushion and
+"""The billiards loader on the shipped copy, and the rolling-segment, cushion and
 deceleration measurements on synthetic tracks with known answers."""
 
 from __future__ import annotations

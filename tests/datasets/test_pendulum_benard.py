@@ -1,4 +1,4 @@
-"""The Benard rod pendulum loader on the copy in benchmarks/data: each swing starts at its first
+"""The Benard rod pendulum loader on the shipped copy: each swing starts at its first
 extreme, with the period the provenance gives."""
 
 from __future__ import annotations

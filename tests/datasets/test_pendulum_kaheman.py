@@ -1,4 +1,4 @@
-"""The Kaheman pendulum loader on the copy in benchmarks/data: windows, chained arms, and periods
+"""The Kaheman pendulum loader on the shipped copy: windows, chained arms, and periods
 and damping that agree with the provenance."""
 
 from __future__ import annotations
