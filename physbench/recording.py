@@ -15,7 +15,8 @@ may be sampled at its own, irregular times. Rules:
   header may name the fields that were measured (:attr:`Recording.fields`; the other columns then
   hold whatever the tracker filled in): ``# fields: y`` for every run, ``# fields of run "drop 1":
   x, y`` for one run (its label as a JSON string), which overrides the former. Without such a
-  line, every field a run's tracks hold counts as measured.
+  line, every field a run's tracks hold counts as measured. ``# accuracy: 0.0021`` states the
+  sensor's accuracy in metres (:attr:`Recording.accuracy`) for every run of the file.
 
 Errors name the line (1 = header), the data row (1 = first row after the header) and the column.
 """
@@ -46,6 +47,7 @@ OPTIONAL_COLUMNS = ("angle", "run")
 POSE_FIELDS = ("x", "y", "angle")
 _STATE_COLUMN = {"x": (0, 3), "y": (1, 4), "angle": (2, 5)}
 #: A comment line naming measured fields: an optional run label (a JSON string), then the fields.
+_ACCURACY_LINE = re.compile(r"#\s*accuracy\s*:\s*(\S+?)\s*(?:m)?")
 _FIELDS_LINE = re.compile(r'#\s*fields(?:\s+of\s+run\s+(".*"|[^:]*?))?\s*:(.*)')
 
 
@@ -331,6 +333,30 @@ def _known_bodies(bodies: Scene | Iterable[str] | None) -> tuple[str, ...] | Non
     return bodies.body_names if isinstance(bodies, Scene) else tuple(bodies)
 
 
+def _declared_accuracy(text: str, source: str) -> float:
+    """The ``# accuracy: METRES`` line before the header (0 without one)."""
+    for line, raw in enumerate(io.StringIO(text), start=1):
+        stripped = raw.strip()
+        if stripped and not stripped.startswith("#"):
+            break
+        m = _ACCURACY_LINE.fullmatch(stripped)
+        if m is None:
+            continue
+        try:
+            value = float(m.group(1))
+        except ValueError:
+            value = math.nan
+        if not 0 <= value < math.inf:
+            raise RecordingError(
+                f"accuracy {m.group(1)!r} is not metres >= 0; expected e.g. # accuracy: 0.002",
+                source=source,
+                line=line,
+                comment=True,
+            )
+        return value
+    return 0.0
+
+
 def _declared_fields(
     text: str, source: str
 ) -> tuple[dict[str | None, tuple[tuple[str, ...], int]], str]:
@@ -382,6 +408,7 @@ def parse_recordings(
     appearance. ``bodies`` (a scene or names) makes an unknown body name an error."""
     known = _known_bodies(bodies)
     text = text.removeprefix("\ufeff")
+    accuracy = _declared_accuracy(text, source)
     declared, text = _declared_fields(text, source)
     reader = csv.reader(io.StringIO(text))
     header: list[str] | None = None
@@ -529,7 +556,13 @@ def parse_recordings(
             )
     every = declared.get(None, (None, 0))[0]
     return [
-        Recording(tracks, run=run, fields=declared.get(run, (every, 0))[0], source=source)
+        Recording(
+            tracks,
+            run=run,
+            fields=declared.get(run, (every, 0))[0],
+            source=source,
+            accuracy=accuracy,
+        )
         for run, tracks in runs.items()
     ]
 
@@ -585,6 +618,9 @@ def format_recordings(recordings: Sequence[Recording]) -> str:
             )
     with_angle = any(tr.angle is not None for r in recordings for tr in r.tracks.values())
     buf = io.StringIO()
+    accuracy = max(r.accuracy for r in recordings)
+    if accuracy > 0:  # one line for the file: the coarsest of its runs
+        buf.write(f"# accuracy: {accuracy!r}\n")
     for r in recordings:
         if r.fields is not None:
             which = f" of run {json.dumps(r.run)}" if with_run else ""

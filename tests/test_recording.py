@@ -362,3 +362,14 @@ def test_track_checks_its_arrays():
         Track(np.array([0.0, 0.1]), np.zeros(3), np.zeros(2))
     with pytest.raises(RecordingError, match="NaN"):
         Track(np.array([0.0, 0.1]), np.array([0.0, np.nan]), np.zeros(2))
+
+
+def test_the_accuracy_a_recording_states_survives_its_csv():
+    track = Track(np.arange(3.0), np.zeros(3), np.ones(3))
+    runs = [Recording({"b": track}, run="a", accuracy=2e-3), Recording({"b": track}, run="b")]
+    back = parse_recordings(format_recordings(runs))
+    assert [r.accuracy for r in back] == [2e-3, 2e-3]  # one line per file: the coarsest
+    assert parse_recordings("t,body,x,y\n0,b,0,0\n")[0].accuracy == 0.0
+    assert parse_recordings("# accuracy: 0.004 m\nt,body,x,y\n0,b,0,0\n")[0].accuracy == 0.004
+    with pytest.raises(RecordingError, match=r"line 1 \(comment\): accuracy 'x'"):
+        parse_recordings("# accuracy: x\nt,body,x,y\n0,b,0,0\n")
