@@ -139,8 +139,10 @@ def _build(kind: str, name: str, options: Mapping[str, Any], **standard: Any) ->
     """The registered ``kind`` ``name`` built with ``options`` (and the kind's ``standard``
     keywords); a constructor that refuses them becomes one sentence naming the options."""
     from physbench.plugins import get_registry
+    from physbench.requirements import require
 
     cls = get_registry().get(kind, name)
+    require(kind, name, cls)
     try:
         return cls(**standard, **dict(options))
     except PhysbenchError:

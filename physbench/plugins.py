@@ -219,5 +219,11 @@ def reset_registry(registry: Registry | None = None) -> None:
 
 
 def create(kind: str, name: str, **options: Any) -> Any:
-    """Instantiate the registered component ``name`` of ``kind`` with keyword options."""
-    return get_registry().get(kind, name)(**options)
+    """Instantiate the registered component ``name`` of ``kind`` with keyword options; one that
+    needs a module not installed here raises
+    :class:`~physbench.requirements.MissingDependencyError` naming what to install."""
+    from physbench.requirements import require
+
+    cls = get_registry().get(kind, name)
+    require(kind, name, cls)
+    return cls(**options)

@@ -13,15 +13,26 @@ def main(args: argparse.Namespace) -> int:
     import json
 
     from physbench.plugins import get_registry
+    from physbench.requirements import missing_of
 
     reg = get_registry()
-    rows = [(c.kind, c.name, c.plugin, c.package, c.version) for c in reg.all()]
+    missing = {(c.kind, c.name): missing_of(c.obj) for c in reg.all()}
+    rows = [
+        (c.kind, c.name, c.plugin, c.package, c.version, _status(missing[c.kind, c.name]))
+        for c in reg.all()
+    ]
     if args.json:
         print(
             json.dumps(
                 {
                     "components": [
-                        dict(zip(("kind", "name", "plugin", "package", "version"), r, strict=True))
+                        dict(
+                            zip(
+                                ("kind", "name", "plugin", "package", "version"), r[:5], strict=True
+                            ),
+                            available=not missing[r[0], r[1]],
+                            missing=missing[r[0], r[1]],
+                        )
                         for r in rows
                     ],
                     "failed": [f.__dict__ for f in reg.failed],
@@ -30,7 +41,7 @@ def main(args: argparse.Namespace) -> int:
             )
         )
         return 0
-    head = ("KIND", "NAME", "PLUGIN", "PACKAGE", "VERSION")
+    head = ("KIND", "NAME", "PLUGIN", "PACKAGE", "VERSION", "STATUS")
     widths = [max(len(str(x)) for x in col) for col in zip(head, *rows, strict=True)]
     for r in (head, *rows):
         print("  ".join(str(x).ljust(w) for x, w in zip(r, widths, strict=True)).rstrip())
@@ -39,3 +50,10 @@ def main(args: argparse.Namespace) -> int:
         for f in reg.failed:
             print(f"  {f.plugin} ({f.package} {f.version}): {f.error}")
     return 0
+
+
+def _status(missing: dict[str, str]) -> str:
+    if not missing:
+        return "ok"
+    install = " ".join(f"'{r}'" for r in dict.fromkeys(sorted(missing.values())))
+    return f"unavailable: needs {', '.join(sorted(missing))} (pip install {install})"

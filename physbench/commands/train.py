@@ -86,7 +86,9 @@ def main(args: argparse.Namespace) -> int:
     from physbench.experiment import make_renderer
     from physbench.params import ParamSpace
     from physbench.plugins import get_registry
+    from physbench.requirements import require
 
+    require("estimator", "resnet3d", get_registry().get("estimator", "resnet3d"))
     params = tuple(p.strip() for p in args.params.split(",") if p.strip())
     scene = get_registry().get("scene", args.scene)(0)
     ParamSpace.from_scene(scene, params)  # unknown parameter names fail here, listing the known

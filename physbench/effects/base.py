@@ -36,6 +36,7 @@ import numpy as np
 
 from physbench.errors import PhysbenchError, UnknownNameError, counted
 from physbench.parameter import Parameter
+from physbench.requirements import Requirements
 
 if TYPE_CHECKING:
     from physbench.scene import Scene
@@ -66,7 +67,7 @@ def substep(scene: Scene) -> float:
     return scene.dt / scene.substeps
 
 
-class Effect:
+class Effect(Requirements):
     """Base class of every effect (plugin contract).
 
     Subclasses set the class attributes :attr:`name` and :attr:`params` (each

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from physbench.requirements import Requirements
+
 if TYPE_CHECKING:
     import numpy as np
 
@@ -63,7 +65,7 @@ class Step:
     marked: Mapping[str, np.ndarray] = field(default_factory=dict)
 
 
-class CorrectionEstimator:
+class CorrectionEstimator(Requirements):
     """Base class of every correction estimator (plugin contract).
 
     The framework builds it with keyword options (``Cls(**options)``; an unknown option must raise

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from physbench.errors import PhysbenchError
+from physbench.requirements import Requirements
 
 if TYPE_CHECKING:
     from physbench.scene import Scene
@@ -52,7 +53,7 @@ def check_resolution(resolution: object) -> int | tuple[int, int]:
     )
 
 
-class Renderer:
+class Renderer(Requirements):
     """Base class of every renderer (plugin contract).
 
     Subclasses set :attr:`name` and :attr:`modes` (the layouts they can produce), call

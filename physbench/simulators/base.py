@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, ClassVar
 
+from physbench.requirements import Requirements
+
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
     from physbench.scene import Scene
@@ -21,7 +23,7 @@ if TYPE_CHECKING:
 DEFAULT_SIMULATOR = "pymunk"
 
 
-class Simulator:
+class Simulator(Requirements):
     """Base class of every simulator (plugin contract). The framework builds it with keyword
     options (``Cls(**options)``) and calls :meth:`simulate` once per iteration."""
 

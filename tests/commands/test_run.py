@@ -327,3 +327,15 @@ def test_video_and_filmed_observations(capsys: pytest.CaptureFixture[str], tmp_p
     plate = ["--background", str(tmp_path / "plate.png")]
     code, _, err = run(capsys, *FAST, "--video", str(tmp_path / "short.mp4"), *plate)
     assert code == 2 and "short.mp4: has 0.300 s of frames, but the scene needs" in err, err
+
+
+def test_resnet3d_without_torch_names_the_extra_instead_of_a_traceback(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "torch", None)
+    rc, out, err = run(capsys, "--estimator", "resnet3d", "--iterations", "1", "-q")
+    assert rc == 2 and out == ""
+    assert err.strip() == (
+        "physbench run: error: estimator 'resnet3d' needs torch, which is not installed: "
+        "pip install 'physbench[learn]'"
+    )

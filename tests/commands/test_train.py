@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 
 from physbench.cli import main
@@ -23,3 +25,12 @@ def test_bad_arguments_are_named(
     code = main(["train", "--scene", "three_circles", "--out", str(tmp_path), *argv])
     assert code == 2 and message in capsys.readouterr().err
     assert not any(tmp_path.iterdir())  # nothing was written
+
+
+def test_training_without_torch_names_the_extra(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.setitem(sys.modules, "torch", None)
+    assert main(["train", "--out", str(tmp_path / "w")]) == 2
+    assert "pip install 'physbench[learn]'" in capsys.readouterr().err
+    assert not (tmp_path / "w").exists()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any, ClassVar
 
 import numpy as np
@@ -28,6 +30,9 @@ class ResNet3DEstimator(CorrectionEstimator):
 
     name: ClassVar[str] = "resnet3d"
     per_object: ClassVar[bool] = True
+    requires: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {"torch": "physbench[learn]", "safetensors": "physbench[learn]"}
+    )
 
     def __init__(
         self,
