@@ -327,10 +327,15 @@ def run_config(
     *,
     callback: Callable[[Iteration], None] | None = None,
     save_observation: str | Path | None = None,
+    probe: bool = True,
+    notice: Callable[[str], None] | None = None,
 ) -> History:
     """Build the scene, observation, engines, renderers and estimator of ``config`` and run
     :func:`~physbench.loop.refine`. The history's ``meta`` records the observation settings.
-    ``callback`` receives each iteration's record; ``save_observation`` writes the frames used."""
+    ``callback`` receives each iteration's record; ``save_observation`` writes the frames used.
+    ``probe``: first check that every unknown changes the rendered frames
+    (:mod:`physbench.identifiability`; the unseen are in ``History.unseen``, and ``notice``
+    receives one sentence about them before the loop starts)."""
     _check_observation(config)
     from physbench.loop import draw_problem, refine
     from physbench.observation import save_observation as save_obs
@@ -394,6 +399,15 @@ def run_config(
         )
     if save_observation:
         save_obs(save_observation, obs)
+    unseen: tuple[str, ...] = ()
+    if probe:
+        from physbench import identifiability
+
+        probes = identifiability.probe(scene, space, simulator, model_renderer, initial)
+        unseen = identifiability.unseen(probes)
+        sentence = identifiability.describe(probes)
+        if sentence and notice is not None:
+            notice(sentence)
     history = refine(
         obs,
         scene,
@@ -406,6 +420,7 @@ def run_config(
         initial=initial,
         callback=callback,
     )
+    history.unseen = unseen
     observe_engine: str | None = config.observer_engine
     if observed is not None:
         observe_engine = observed.engine or None  # a file's maker, where it says

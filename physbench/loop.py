@@ -105,6 +105,9 @@ class History:
     truth: Params | None = None
     options: dict[str, Any] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
+    #: Unknowns that moved no pixel when probed before the run
+    #: (:mod:`physbench.identifiability`): their estimates are guesses. Empty when not probed.
+    unseen: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return len(self.iterations)
@@ -153,6 +156,7 @@ class History:
             "truth": self.truth,
             "best_nmse": self.best_nmse,
             "min_loss": self.min_loss,
+            "unseen": list(self.unseen),
             "meta": {k: v for k, v in self.meta.items() if timings or not k.startswith("t_")},
             "iterations": recs,
         }
@@ -176,6 +180,7 @@ class History:
             truth=None if d.get("truth") is None else dict(d["truth"]),
             options=dict(d.get("options", {})),
             meta=dict(d.get("meta", {})),
+            unseen=tuple(d.get("unseen", ())),
         )
 
     def to_frame(self) -> pd.DataFrame:

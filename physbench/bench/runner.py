@@ -69,7 +69,7 @@ def run_cell(config: RunConfig) -> dict[str, Any]:
         "history": None,
     }
     try:
-        out["history"] = run_config(config).to_dict()
+        out["history"] = run_config(config, probe=False).to_dict()  # a sweep scores against truth
     except Exception as exc:  # any failure of one cell is data, not the end of the sweep
         out.update(
             status="failed",

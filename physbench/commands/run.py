@@ -275,7 +275,12 @@ def main(args: argparse.Namespace) -> int:
         bar.update(1)
 
     try:
-        history = run_config(config, callback=progress, save_observation=args.save_observation)
+        history = run_config(
+            config,
+            callback=progress,
+            save_observation=args.save_observation,
+            notice=lambda text: bar.write(f"physbench run: warning: {text}", file=sys.stderr),
+        )
     finally:
         bar.close()
 
@@ -307,7 +312,10 @@ def main(args: argparse.Namespace) -> int:
             print("truth:   " + "  ".join(f"{k}={v:.4g}" for k, v in history.truth.items()))
         print(
             f"best (iteration {best.iteration}, by image MSE): "
-            + "  ".join(f"{k}={v:.4g}" for k, v in best.params.items())
+            + "  ".join(
+                f"{k}={v:.4g}" + (" (unseen: a guess)" if k in history.unseen else "")
+                for k, v in best.params.items()
+            )
         )
     if history.best_nmse is not None:
         print(
