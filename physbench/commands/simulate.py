@@ -111,6 +111,14 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(
             f"--plate {args.plate!r}: expected an image file ({', '.join(IMAGE_SUFFIXES)})"
         )
+    if args.preview:
+        from physbench.render.preview import SUFFIXES as PREVIEW_SUFFIXES
+
+        if Path(args.preview).suffix.lower() not in PREVIEW_SUFFIXES:
+            raise PhysbenchError(
+                f"--preview {args.preview!r}: expected {' or '.join(PREVIEW_SUFFIXES)} "
+                "(an animation or a trail picture)"
+            )
     scene = resolve_scene(args.scene, args.seed)
     scene = scene.with_params(parse_overrides(args.set)).validate()
     renderer = make_renderer_from(args)  # a bad renderer or option fails before simulating

@@ -8,6 +8,7 @@ adds folders searched first.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from dataclasses import dataclass
@@ -37,15 +38,18 @@ class WeightsInfo:
 
 
 def save(path: str | Path, state: dict[str, Any], meta: dict[str, Any]) -> Path:
-    """Write ``state`` (name -> tensor) and ``meta`` atomically; returns the .safetensors path."""
-    from safetensors.torch import save_file
+    """Write ``state`` (name -> tensor) and ``meta``; returns the .safetensors path. Each file is
+    replaced atomically and readable as the umask allows; the sidecar records the tensors' SHA-256,
+    so a reader that catches the pair between the two replacements refuses it instead of
+    mixing one save's tensors with another's normalisation."""
+    from safetensors.torch import save as encode
 
     path = Path(path).with_suffix(".safetensors")
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    save_file({k: v.detach().contiguous().cpu() for k, v in state.items()}, str(tmp))
-    side = path.with_suffix(".json")
-    side_tmp = path.with_suffix(".json.tmp")
+    data = encode({k: v.detach().contiguous().cpu() for k, v in state.items()})
+    meta = {**meta, "sha256": hashlib.sha256(data).hexdigest()}
+    tmp, side, side_tmp = (path.with_suffix(s) for s in (".tmp", ".json", ".json.tmp"))
+    tmp.write_bytes(data)
     side_tmp.write_text(json.dumps(meta, indent=2, sort_keys=True))
     os.replace(tmp, path)
     os.replace(side_tmp, side)
@@ -54,14 +58,22 @@ def save(path: str | Path, state: dict[str, Any], meta: dict[str, Any]) -> Path:
 
 def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
     """(tensors, meta) from a .safetensors file and its sidecar; int8 storage comes back as
-    float32."""
-    from safetensors.torch import load_file
+    float32. A sidecar whose ``sha256`` is not the tensors' is refused."""
+    from safetensors.torch import load as decode
 
     path = Path(path).with_suffix(".safetensors")
     side = path.with_suffix(".json")
     if not path.is_file() or not side.is_file():
         raise PhysbenchError(f"weights {str(path)!r} need both {path.name} and {side.name}")
-    tensors, meta = load_file(str(path)), json.loads(side.read_text())
+    data, meta = path.read_bytes(), json.loads(side.read_text())
+    digest = meta.get("sha256")
+    if digest is not None and hashlib.sha256(data).hexdigest() != digest:
+        raise PhysbenchError(
+            f"weights {str(path)!r}: {side.name} describes other tensors (its sha256 "
+            f"{str(digest)[:12]}… is not the file's): the pair comes from two saves, e.g. an "
+            "interrupted one; save or train again"
+        )
+    tensors = decode(data)
     if meta.get("storage") == INT8:
         tensors = dequantize(tensors)
     return tensors, meta

@@ -38,6 +38,33 @@ def test_sidecar_without_tensors_is_refused(tmp_path: Path) -> None:
         weights.load(tmp_path / "w.safetensors")
 
 
+def test_saved_weights_are_readable_by_others_and_refuse_a_mixed_pair(tmp_path: Path) -> None:
+    import os
+    import stat
+
+    old = os.umask(0o022)
+    try:
+        first = weights.save(tmp_path / "w", {"a": torch.ones(3)}, {"run": 1})
+    finally:
+        os.umask(old)
+    for f in (first, first.with_suffix(".json")):
+        assert stat.S_IMODE(f.stat().st_mode) == 0o644, f
+    tensors, meta = weights.load(first)
+    assert meta["run"] == 1 and tensors["a"].tolist() == [1.0, 1.0, 1.0]
+    side = first.with_suffix(".json").read_text()
+    weights.save(tmp_path / "w", {"a": torch.zeros(3)}, {"run": 2})
+    first.with_suffix(".json").write_text(side)  # as if the second save stopped between the two
+    with pytest.raises(PhysbenchError, match=r"describes other tensors .* two saves"):
+        weights.load(first)
+
+
+def test_shipped_sidecars_name_their_tensors() -> None:
+    import hashlib
+
+    for w in shipped():
+        assert w.meta["sha256"] == hashlib.sha256(w.path.read_bytes()).hexdigest(), w.path
+
+
 def shipped() -> list[weights.WeightsInfo]:
     return [w for w in weights.available() if w.path.parent == weights.SHIPPED]
 
