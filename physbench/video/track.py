@@ -452,7 +452,10 @@ class Tracker:
                         continue
                     part = replace(part, u=float(centres[j, 0]), v=float(centres[j, 1]))
                     # Centre from the pixels inside the outline, axes from all the body owns.
-                    wi = self._weights(i, w, d, img, bg)
+                    # Weighed over its own pixels only: a shared blob holds other bodies'
+                    # colours, which would spoil the hue a turning body is unmixed with.
+                    wi = np.zeros_like(w)
+                    wi[mine] = self._weights(i, w[mine], d[mine], img[mine], bg[mine])
                     centre = plane_pose(u[fit], v[fit], wi[fit], self.cal)
                     axes = plane_pose(u[mine], v[mine], wi[mine], self.cal)
                     found[i] = (part, replace(axes, xy=centre.xy))
