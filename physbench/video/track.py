@@ -34,6 +34,7 @@ import numpy as np
 
 from physbench.errors import PhysbenchError, counted
 from physbench.scene import Box, Circle
+from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
     Blob,
     Outline,
@@ -152,6 +153,9 @@ class TrackSummary:
     lost: dict[str, list[tuple[float, float]]]
     reprojection_error: float
     fps: float = 0.0
+    #: Per body, the samples left out because their exposure spans a collision
+    #: (:mod:`physbench.video.contacts`).
+    contacts: dict[str, int] = field(default_factory=dict)
 
     def format(self) -> str:
         """A few lines for a person."""
@@ -164,6 +168,11 @@ class TrackSummary:
         for name, n in self.detections.items():
             gone = self.lost.get(name, [])
             tail = "; lost " + ", ".join(f"{a:.2f}-{b:.2f} s" for a, b in gone) if gone else ""
+            if self.contacts.get(name):
+                tail += (
+                    f"; {counted(self.contacts[name], 'collision frame')} left out (the exposure "
+                    "spans the collision)"
+                )
             lines.append(
                 f"  {name:>8}: seen in {n}/{self.frames} frames, "
                 f"{counted(self.gaps[name], 'gap')}{tail}"
@@ -472,19 +481,25 @@ class Tracker:
         tracks, pixels = {}, {}
         lost: dict[str, list[tuple[float, float]]] = {}
         for s in self.states:
+            pixels[s.body.name] = np.array(s.uv_rows, dtype=float)
+        accuracy = self._accuracy(pixels)
+        contacts: dict[str, int] = {}
+        for s in self.states:
             rows = np.array(s.rows, dtype=float)
+            if s.free:
+                hit = contact_samples(rows[:, 0], rows[:, 1:3], self.g, accuracy)
+                if hit.any():
+                    contacts[s.body.name] = int(hit.sum())
+                    rows = rows[~hit]
             angle = rows[:, 3] if s.k and not np.isnan(rows[:, 3]).any() else None
             tracks[s.body.name] = Track(rows[:, 0], rows[:, 1], rows[:, 2], angle)
-            pixels[s.body.name] = np.array(s.uv_rows, dtype=float)
             gone = list(s.lost)
             if s.missed and s.gap_start is not None and self.t_last - s.gap_start > self.max_gap:
                 gone.append((s.gap_start, self.t_last))
             if gone:
                 lost[s.body.name] = gone
         fields = ("x", "y", "angle") if any(t.angle is not None for t in tracks.values()) else None
-        recording = Recording(
-            tracks, fields=fields, source="video", meta={}, accuracy=self._accuracy(pixels)
-        )
+        recording = Recording(tracks, fields=fields, source="video", meta={}, accuracy=accuracy)
         summary = TrackSummary(
             self.frames,
             self.t_last,
@@ -493,6 +508,7 @@ class Tracker:
             lost,
             self.cal.reprojection_error if calibration_error is None else calibration_error,
             fps,
+            contacts,
         )
         return TrackResult(recording, summary, pixels)
 

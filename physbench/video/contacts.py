@@ -1,0 +1,44 @@
+"""Samples whose exposure spans a collision: left out of a free body's video track.
+
+A frame exposed while a ball bounces averages two motions into one blurred V, whose centre is
+neither pose; fitted as a position, it pulls the restitution and every extrapolation after it (a
+filmed bouncing ball without any hidden effect was fitted 4x better on held-out frames with an
+invented velocity-dependent restitution until its four contact frames were left out). Such a
+sample is where the track's acceleration departs from gravity by more than free flight and
+tracking noise allow: a collision changes the velocity within one frame interval.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: A departure from gravity larger than this many g is a collision, whatever the noise.
+COLLISION_G = 3.0
+#: ... and larger than this many standard deviations of the second difference of the noise.
+COLLISION_SIGMA = 6.0
+
+
+def contact_samples(
+    t: np.ndarray, xy: np.ndarray, gravity: np.ndarray, accuracy: float
+) -> np.ndarray:
+    """Called by the tracker on each free body's track when it writes the recording: a mask of
+    the samples ``(t, xy)`` (s, m) at a collision, given the scene's ``gravity`` (m/s², a
+    vector) and the sensor's ``accuracy`` (m). One sample per collision, the one nearest it (the
+    largest departure among its neighbours); the first and last samples are never marked."""
+    n = len(t)
+    mask = np.zeros(n, dtype=bool)
+    if n < 3:
+        return mask
+    dt = np.diff(t)
+    v = np.diff(xy, axis=0) / dt[:, None]
+    a = 2 * np.diff(v, axis=0) / (dt[1:] + dt[:-1])[:, None]
+    excess = np.hypot(*(a - np.asarray(gravity, dtype=float)).T)
+    noise = accuracy * math.sqrt(6.0) / (dt[1:] * dt[:-1])
+    limit = np.maximum(COLLISION_G * float(np.hypot(*gravity)), COLLISION_SIGMA * noise)
+    over = excess > limit
+    padded = np.concatenate([[0.0], excess, [0.0]])
+    peak = (padded[1:-1] >= padded[:-2]) & (padded[1:-1] >= padded[2:])
+    mask[1:-1] = over & peak
+    return mask
