@@ -20,7 +20,15 @@ CASES = [
     ("constant_force", "two_pucks", "pymunk"),
     ("velocity_dependent_restitution", "bouncer", "box2d"),
 ]
-CONTROLS = [("projectile", "box2d"), ("pendulum", "pymunk")]
+# The last three raised a false alarm before the fixes in docs/video.md (an arm's lopsided blur,
+# two arms in one blob, a bounce's blurred V).
+CONTROLS = [
+    ("projectile", "box2d", 0),
+    ("pendulum", "pymunk", 0),
+    ("pendulum_xy", "box2d", 0),
+    ("double_pendulum", "pymunk", 1),
+    ("bouncer", "pymunk", 1),
+]
 
 
 @pytest.mark.parametrize(("effect", "scene", "engine"), CASES, ids=["/".join(c) for c in CASES])
@@ -34,8 +42,10 @@ def test_a_filmed_hidden_effect_is_named_with_its_magnitude(effect, scene, engin
     assert err <= 0.15, (filmed.cause_results[0].params, case.truth)
 
 
-@pytest.mark.parametrize(("scene", "engine"), CONTROLS, ids=["/".join(c) for c in CONTROLS])
-def test_a_filmed_control_gives_no_cause(scene, engine) -> None:
+@pytest.mark.parametrize(
+    ("scene", "engine", "seed"), CONTROLS, ids=["/".join(map(str, c)) for c in CONTROLS]
+)
+def test_a_filmed_control_gives_no_cause(scene, engine, seed) -> None:
     sim = ENGINES[engine]()
-    disc = discover([filmed_run(make_case(None, scene, 0, sim))], sim, diagnose=False)
+    disc = discover([filmed_run(make_case(None, scene, seed, sim), seed)], sim, diagnose=False)
     assert disc.causes == [], [(c.effect, c.gain) for c in disc.cause_results]
