@@ -271,9 +271,10 @@ def test_a_third_party_renderer_is_chosen_by_name(
     history = json.loads(out)
     assert code == 0 and history["meta"]["renderer"] == "squares"
     assert history["meta"]["renderer_options"] == {"size": 3}
-    # the observation, the shape check (a one-frame still: Squares has no shape()) and 4 model
-    # renders, all by the plugin
-    assert squares_renderer.CALLS.count(None) == 6
+    # the observation, the shape check (a one-frame still: Squares has no shape()), the
+    # identifiability probe (a reference and 2 per unknown: 5) and 4 model renders, all by the
+    # plugin
+    assert squares_renderer.CALLS.count(None) == 11
     code, raster, _ = run(capsys, *FAST, "--json", "-q")
     assert code == 0 and json.loads(raster)["meta"]["renderer"] == "raster"
     losses = [r["loss"] for r in history["iterations"]]

@@ -31,6 +31,11 @@ def test_training_without_torch_names_the_extra(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path
 ) -> None:  # type: ignore[no-untyped-def]
     monkeypatch.setitem(sys.modules, "torch", None)
-    assert main(["train", "--out", str(tmp_path / "w")]) == 2
+    assert (
+        main(
+            ["train", "--scene", "three_circles", "--params", "mass", "--out", str(tmp_path / "w")]
+        )
+        == 2
+    )
     assert "pip install 'physbench[learn]'" in capsys.readouterr().err
     assert not (tmp_path / "w").exists()
