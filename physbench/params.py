@@ -22,6 +22,21 @@ if TYPE_CHECKING:
 Params = dict[str, float]
 
 
+def split_params(value: str | Sequence[str]) -> tuple[str, ...]:
+    """The unknown names of one set as the user spelled it: ``"mass+elasticity"``,
+    ``"mass,elasticity"``, ``"mass elasticity"`` or ``["mass", "elasticity"]`` (each item split the
+    same way). Called by ``run --params``, ``train --params`` and a sweep spec's ``unknowns``;
+    an empty set or a repeated name is a :class:`~physbench.errors.PhysbenchError`."""
+    items = [value] if isinstance(value, str) else list(value)
+    names = tuple(n for item in items for n in item.replace("+", " ").replace(",", " ").split())
+    if not names or len(set(names)) != len(names):
+        raise PhysbenchError(
+            f"unknown-parameter set {value!r}: expected names such as mass, mass+elasticity, "
+            "mass,elasticity or mass elasticity (no repeats)"
+        )
+    return names
+
+
 @dataclass(frozen=True)
 class ParamSpace:
     """An ordered set of unknowns. Order is the vector order everywhere."""

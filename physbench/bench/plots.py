@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -353,16 +353,31 @@ def win_rate(df: pd.DataFrame, out: Path) -> list[Path]:
     return [_save(fig, out / "win_rate.png")]
 
 
+#: the groups of figures :func:`plot_all` draws, in order (the keys of what it returns)
+FIGURE_GROUPS = ("convergence", "trajectories", "win rate", "landscape")
+
+
 def plot_all(
-    df: pd.DataFrame, out: Path, *, seeds: int = 3, landscape_seeds: int = 3
+    df: pd.DataFrame,
+    out: Path,
+    *,
+    seeds: int = 3,
+    landscape_seeds: int = 3,
+    stage: Callable[[str], None] | None = None,
 ) -> dict[str, list[Path]]:
-    """Every figure into ``out`` (created); ``landscape_seeds=0`` skips the simulating one."""
+    """Every figure into ``out`` (created); ``landscape_seeds=0`` skips the simulating one.
+    ``stage`` is called with each name of :data:`FIGURE_GROUPS` as that group begins (a progress
+    display)."""
     out.mkdir(parents=True, exist_ok=True)
     df = upgrade(df)
-    figs = {
-        "convergence": convergence(df, out),
-        "trajectories": trajectories(df, out, seeds=seeds),
-        "win rate": win_rate(df, out),
-    }
+    stage = stage or (lambda name: None)
+    figs: dict[str, list[Path]] = {}
+    stage("convergence")
+    figs["convergence"] = convergence(df, out)
+    stage("trajectories")
+    figs["trajectories"] = trajectories(df, out, seeds=seeds)
+    stage("win rate")
+    figs["win rate"] = win_rate(df, out)
+    stage("landscape")
     figs["landscape"] = landscape(df, out, seeds=landscape_seeds) if landscape_seeds else []
     return figs

@@ -26,7 +26,8 @@ a list::
 
     [[scenes]]
     name = "three_circles"           # a registered scene or a scene TOML (relative to this file)
-    unknowns = ["mass", "elasticity", "mass+elasticity"]
+    unknowns = ["mass", "elasticity", "mass+elasticity"]  # a set: also "mass,elasticity",
+                                     # "mass elasticity" or ["mass", "elasticity"]
     bodies = ["a"]                   # optional: only these bodies' unknowns
 
 Seeds: a cell's run seed *is* the seed value, so every configuration sees the same scene
@@ -49,6 +50,7 @@ from typing import Any
 
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
+from physbench.params import split_params
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
@@ -193,18 +195,18 @@ def _as_list(value: Any) -> list[Any]:
 
 
 def _unknown_set(value: Any, where: str) -> tuple[str, ...]:
-    if isinstance(value, str):
-        parts = [p for p in value.replace("+", " ").replace(",", " ").split() if p]
-    elif isinstance(value, list) and all(isinstance(v, str) for v in value):
-        parts = list(value)
-    else:
-        parts = []
-    if not parts or len(set(parts)) != len(parts):
+    try:
+        if not isinstance(value, str) and not (
+            isinstance(value, list) and all(isinstance(v, str) for v in value)
+        ):
+            raise PhysbenchError(f"{value!r}")
+        return split_params(value)
+    except PhysbenchError:
         raise SpecError(
             f'{where} = {value!r}: expected an unknown-parameter set such as "mass", '
-            '"mass+elasticity" or ["mass", "elasticity"] (no repeats)'
-        )
-    return tuple(parts)
+            '"mass+elasticity", "mass,elasticity", "mass elasticity" or ["mass", "elasticity"] '
+            "(no repeats)"
+        ) from None
 
 
 def _seeds(value: Any, where: str) -> tuple[int, ...]:

@@ -1,6 +1,24 @@
 """Command-line arguments that several commands share, so that one flag means one thing
-everywhere: ``KEY=VALUE`` options and the renderer choice (``--renderer``, ``--renderer-option``,
-``--resolution``, ``--render-mode``)."""
+everywhere: the scene (``--scene NAME|FILE``), the unknowns (``--params``), ``-q/--quiet``,
+``--json``, ``--out``, ``KEY=VALUE`` options and the renderer choice (``--renderer``,
+``--renderer-option``, ``--resolution``, ``--render-mode``).
+
+The vocabulary (tests/commands/test_vocabulary.py walks every parser against it):
+
+- ``--out`` names the file or folder that holds a command's result; other files it can write
+  have flags named for what they are (``--preview``, ``--plot``, ``--report``, ``--plate``,
+  ``--track-out``, ``--save-observation``). Every file written is echoed as ``wrote PATH`` on
+  stderr.
+- ``--json`` is a switch: the result as JSON on stdout, instead of the text. A JSON file goes
+  through ``--out``.
+- ``--scene`` takes a registered name or a scene TOML file. It defaults to
+  :data:`DEFAULT_SCENE` where the command makes its own data (run, simulate, train) and is
+  required where it must describe given data (track, discover).
+- ``--params`` takes one set of unknowns spelled ``mass+elasticity``, ``mass,elasticity`` or
+  ``mass elasticity`` (:func:`physbench.params.split_params`).
+- ``-q/--quiet`` on every command that prints more than its result or shows progress; progress
+  goes to stderr and only on a terminal (:mod:`physbench.commands.console`).
+"""
 
 from __future__ import annotations
 
@@ -10,6 +28,51 @@ from typing import Any
 
 #: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
 RENDER_MODES = ("mark", "instance", "mask", "rgb")
+#: physbench.experiment.DEFAULT_SCENE, for the same reason.
+DEFAULT_SCENE = "three_circles"
+
+
+def add_scene_argument(p: argparse.ArgumentParser, *, required: bool, help: str = "") -> None:
+    """``--scene NAME|FILE``: a registered scene or a scene TOML; ``help`` adds what the command
+    does with it. Not given, it parses as ``None`` (``run`` then takes an observation file's own
+    scene) and stands for :data:`DEFAULT_SCENE`. Read it with
+    :func:`physbench.scenes.resolve_scene`."""
+    p.add_argument(
+        "--scene",
+        required=required,
+        default=None,
+        metavar="NAME|FILE",
+        help="registered scene (see `physbench scenes`) or scene .toml file"
+        + (f"; {help}" if help else "")
+        + ("" if required else f" (default: {DEFAULT_SCENE})"),
+    )
+
+
+def add_params_argument(p: argparse.ArgumentParser, *, help: str = "") -> None:
+    """``--params``: one set of unknowns, as words, or joined by ``+`` or ``,``; read it with
+    :func:`physbench.params.split_params`."""
+    p.add_argument(
+        "--params",
+        nargs="+",
+        default=["mass"],
+        metavar="PARAM",
+        help="unknown parameters to identify: mass, or mass elasticity, mass+elasticity, "
+        "mass,elasticity" + (f"; {help}" if help else "") + " (default: mass)",
+    )
+
+
+def add_quiet_argument(p: argparse.ArgumentParser, help: str) -> None:
+    """``-q/--quiet``: no progress display; ``help`` says what is still printed."""
+    p.add_argument("-q", "--quiet", action="store_true", help=f"no progress display; {help}")
+
+
+def add_json_argument(p: argparse.ArgumentParser, what: str) -> None:
+    """``--json``: ``what`` as JSON on stdout instead of the text."""
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help=f"print {what} as JSON on stdout instead of the text (a file: --out FILE.json)",
+    )
 
 
 def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
@@ -66,9 +129,10 @@ def add_renderer_arguments(
         + ("the frames' width" if from_frames else str(resolution))
         + ")",
     )
+    # The old spelling --mode still parses; hidden so that help shows one name.
+    p.add_argument("--mode", dest="render_mode", choices=RENDER_MODES, help=argparse.SUPPRESS)
     p.add_argument(
         "--render-mode",
-        "--mode",
         dest="render_mode",
         default=None,
         choices=RENDER_MODES,

@@ -11,7 +11,7 @@ import argparse
 import shlex
 import sys
 
-from physbench.commands.arguments import add_renderer_choice
+from physbench.commands.arguments import add_quiet_argument, add_renderer_choice
 
 EPILOG = """\
 A spec is TOML: scenes (each with its unknown sets), estimators, seeds, iterations, and the axes
@@ -73,15 +73,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="resume even when finished cells were produced by other code or settings (a changed "
         "scene generator, estimator default or physbench version); they are kept as they are",
     )
-    p.add_argument(
-        "-q", "--quiet", action="store_true", help="no progress bar or table: only the final line"
-    )
+    add_quiet_argument(p, "no table: only the final line")
 
 
 def main(args: argparse.Namespace) -> int:
     from physbench.bench.runner import run_sweep
     from physbench.bench.spec import load_spec, with_renderer
     from physbench.commands.arguments import parse_key_values
+    from physbench.commands.console import show_progress, wrote
     from physbench.errors import counted
 
     spec = load_spec(args.spec)
@@ -101,7 +100,7 @@ def main(args: argparse.Namespace) -> int:
             fresh=args.fresh,
             retry_failed=args.retry_failed,
             allow_stale=args.allow_stale,
-            progress=not args.quiet,
+            progress=show_progress(args),
             command=command,
         )
     except KeyboardInterrupt:
@@ -115,6 +114,7 @@ def main(args: argparse.Namespace) -> int:
         from physbench.bench.tables import markdown, paper_layout
 
         print(markdown(paper_layout(res.stats)))
+    wrote(res.out)
     print(
         f"{spec.name}: {counted(res.cells, 'cell')} ({res.ran} run, {res.skipped} already done, "
         f"{res.failed} failed) in {res.wall_s:.1f} s with {res.executor}; "

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import argparse
 
+from physbench.commands.arguments import add_quiet_argument
+
 # The same defaults as physbench.bench.compare (argument parsing imports nothing heavy).
 ALPHA, MIN_RATIO = 0.05, 1.25
 
@@ -53,6 +55,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--all", action="store_true", help="list every configuration, not only changed ones"
     )
+    add_quiet_argument(p, "no table: only the summary line (and the regressions)")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -66,7 +69,7 @@ def main(args: argparse.Namespace) -> int:
     )
     t = res.table
     shown = t if args.all else t[t["verdict"].isin(["worse", "better"])]
-    if len(shown):
+    if len(shown) and not args.quiet:
         view = shown[
             [
                 "scene",

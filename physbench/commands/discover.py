@@ -5,7 +5,15 @@ from __future__ import annotations
 
 import argparse
 
-from physbench.commands.arguments import add_renderer_arguments, add_video_input_arguments
+from physbench.commands.arguments import (
+    add_quiet_argument,
+    add_renderer_arguments,
+    add_scene_argument,
+    add_video_input_arguments,
+)
+
+#: what :func:`physbench.discover.discover` reports to its ``stage`` callback, in order
+STAGES = ("base fit", "candidate effects", "verdict")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -16,11 +24,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "(.npz, key 'frames'), or a camera's video (.mp4, .mov, .avi, .mkv, .webm, .gif, or a "
         "folder of images): tracked first, as physbench track does",
     )
-    p.add_argument(
-        "--scene",
-        required=True,
-        metavar="SCENE.toml",
-        help="the setup, with the base model's unknowns",
+    add_scene_argument(
+        p, required=True, help="the setup, with the base model's unknowns (its --seed instance)"
     )
     p.add_argument(
         "--effects",
@@ -28,7 +33,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="NAME",
         help="candidate effects (default: every registered effect that applies)",
     )
-    p.add_argument("--json", metavar="OUT", help="write the verdict as JSON here ('-' for stdout)")
+    p.add_argument(
+        "--out", metavar="FILE.json", help="write the verdict as JSON here (the layout of --json)"
+    )
+    # Before --out existed, --json took the file ('-': stdout); that spelling still works.
+    p.add_argument(
+        "--json",
+        nargs="?",
+        const="-",
+        default=None,
+        metavar="FILE",
+        help="print the verdict as JSON on stdout instead of the text (a file: --out FILE.json; "
+        "--json FILE is the older spelling of --out FILE)",
+    )
     p.add_argument("--report", metavar="DIR", help="write plots and index.html into this folder")
     p.add_argument("--engine", default="pymunk", help="simulator (default pymunk)")
     p.add_argument(
@@ -83,9 +100,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--max-causes", type=int, default=None, help="most effects added (default 3)")
     add_renderer_arguments(p, from_frames=True)
     p.add_argument(
-        "--seed", type=int, default=0, help="seed of a black-box base-fit estimator (default 0)"
+        "--seed",
+        type=int,
+        default=0,
+        help="instance of a registered --scene and seed of a black-box base-fit estimator "
+        "(default 0)",
     )
-    p.add_argument("-q", "--quiet", action="store_true", help="print only the causes and the gain")
+    add_quiet_argument(p, "print only the causes and the gain")
     video = p.add_argument_group("video", "when RECORDING is a video: how to read and track it")
     add_video_input_arguments(video)
     video.add_argument(
@@ -98,25 +119,36 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     import json
-    import sys
     from pathlib import Path
 
     from physbench.commands.arguments import renderer_choice
+    from physbench.commands.console import show_progress, stages, wrote
     from physbench.discover import Settings, discover, load_runs, renderer_for
     from physbench.discover.verdict import text, to_dict
+    from physbench.errors import PhysbenchError
     from physbench.plugins import create
+    from physbench.scenes import resolve_scene
 
+    out, to_stdout = args.out, args.json == "-"
+    if args.json not in (None, "-"):  # the older --json FILE
+        if out is not None:
+            raise PhysbenchError(
+                f"--json {args.json!r} and --out {out!r}: give the file once, as --out"
+            )
+        out = args.json
     runs = load_runs(
         args.recording,
-        args.scene,
+        resolve_scene(args.scene, args.seed),
         run=args.run,
         calibration=args.calibration,
         background=args.background,
         start=args.start,
         end=args.end,
         track_out=args.track_out,
-        progress=not args.quiet,
+        progress=show_progress(args),
     )
+    if args.track_out:
+        wrote(args.track_out)
     nuisance = args.nuisance[0] if args.nuisance in (["auto"], ["none"]) else list(args.nuisance)
     kw = {
         k: v
@@ -144,8 +176,17 @@ def main(args: argparse.Namespace) -> int:
         renderer = renderer_for(
             runs, name, options, resolution=args.resolution, mode=args.render_mode
         )
-    disc = discover(runs, create("simulator", args.engine), settings=settings, renderer=renderer)
-    if args.quiet:
+    with stages(args, STAGES, "discover") as stage:
+        disc = discover(
+            runs,
+            create("simulator", args.engine),
+            settings=settings,
+            renderer=renderer,
+            stage=stage,
+        )
+    if to_stdout:
+        print(json.dumps(to_dict(disc), indent=2))
+    elif args.quiet:
         causes = ", ".join(disc.causes) or "none"
         print(
             f"causes: {causes}; gain {disc.gain:.1%} (held-out error "
@@ -153,17 +194,12 @@ def main(args: argparse.Namespace) -> int:
         )
     else:
         print(text(disc))
-    if args.json:
-        payload = json.dumps(to_dict(disc), indent=2)
-        if args.json == "-":
-            sys.stdout.write(payload + "\n")
-        else:
-            Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-            Path(args.json).write_text(payload + "\n", encoding="utf-8")
-            print(f"wrote {args.json}", file=sys.stderr)
+    if out:
+        Path(out).parent.mkdir(parents=True, exist_ok=True)
+        Path(out).write_text(json.dumps(to_dict(disc), indent=2) + "\n", encoding="utf-8")
+        wrote(out)
     if args.report:
         from physbench.discover.report import write_report
 
-        page = write_report(disc, args.report)
-        print(f"wrote {page}", file=sys.stderr)
+        wrote(write_report(disc, args.report))
     return 0

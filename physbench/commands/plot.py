@@ -1,19 +1,27 @@
 """``physbench plot DIR``: figures and an HTML report for a ``physbench bench`` output folder.
 
-Writes ``DIR/plots/*.png`` (convergence per scene like the paper's Fig. 3, parameter-space
-trajectories for two unknowns like Fig. 5, the image-MSE landscape along each parameter like
-Fig. 4, and the estimators' win-rate matrix), ``DIR/win_rate.csv`` and ``DIR/report.html``
-(self-contained: tables and figures embedded).
+Writes into ``--out`` (default: DIR itself) ``plots/*.png`` (convergence per scene like the
+paper's Fig. 3, parameter-space trajectories for two unknowns like Fig. 5, the image-MSE landscape
+along each parameter like Fig. 4, and the estimators' win-rate matrix), ``win_rate.csv`` and
+``report.html`` (self-contained: tables and figures embedded).
 """
 
 from __future__ import annotations
 
 import argparse
 
+from physbench.commands.arguments import add_quiet_argument
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "dir", metavar="DIR", help="output folder of `physbench bench` (holds results.parquet)"
+    )
+    p.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="write plots/, win_rate.csv and report.html here (default: the input DIR)",
     )
     p.add_argument(
         "--seeds",
@@ -30,6 +38,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="scene instances averaged in the image-MSE landscape, which simulates "
         "(default: 3; 0 skips it)",
     )
+    add_quiet_argument(p, "the files written and the final line")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -49,25 +58,33 @@ def main(args: argparse.Namespace) -> int:
     from physbench.bench.runner import read_table
     from physbench.bench.store import atomic_write
     from physbench.bench.tables import final_rows, win_rate_table
+    from physbench.commands.console import stages, wrote
 
-    out = Path(args.dir)
-    df = read_table(out)
+    source = Path(args.dir)
+    df = read_table(source)
     if df.empty:
         raise PhysbenchError(
-            f"{str(out)!r}: the results table is empty; run `physbench bench SPEC --out {out}` "
-            "first"
+            f"{str(source)!r}: the results table is empty; run `physbench bench SPEC --out "
+            f"{source}` first"
         )
-    figures = plots.plot_all(
-        df, out / "plots", seeds=args.seeds, landscape_seeds=args.landscape_seeds
-    )
-    rate, _ = win_rate_table(final_rows(df))
-    atomic_write(out / "win_rate.csv", rate.to_csv(index_label="estimator").encode())
+    out = Path(args.out) if args.out else source
     try:
-        log = json.loads((out / "run.json").read_text())
-        title = str(log.get("spec", out.name))
+        log = json.loads((source / "run.json").read_text())
+        title = str(log.get("spec", source.name))
     except (OSError, ValueError):
-        log, title = None, out.name
-    page = report.build(df, out, figures, title=title, run_log=log)
+        log, title = None, source.name
+    with stages(args, [*plots.FIGURE_GROUPS, "report"], "plot") as stage:
+        figures = plots.plot_all(
+            df, out / "plots", seeds=args.seeds, landscape_seeds=args.landscape_seeds, stage=stage
+        )
+        stage("report")
+        rate, _ = win_rate_table(final_rows(df))
+        atomic_write(out / "win_rate.csv", rate.to_csv(index_label="estimator").encode())
+        page = report.build(df, out, figures, title=title, run_log=log)
     count = sum(len(v) for v in figures.values())
+    for path in (p for group in figures.values() for p in group):
+        wrote(path)
+    wrote(out / "win_rate.csv")
+    wrote(page)
     print(f"{counted(count, 'figure')} in {out / 'plots'}; report {page}")
     return 0

@@ -13,7 +13,14 @@ import argparse
 import sys
 from typing import Any
 
-from physbench.commands.arguments import add_renderer_arguments, add_video_input_arguments
+from physbench.commands.arguments import (
+    add_json_argument,
+    add_params_argument,
+    add_quiet_argument,
+    add_renderer_arguments,
+    add_scene_argument,
+    add_video_input_arguments,
+)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -32,21 +39,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="estimator option, repeatable, e.g. -o startup=5 or -o sampler=cmaes (values parse as "
         "JSON, else text)",
     )
-    p.add_argument(
-        "--scene",
-        default=None,
-        metavar="NAME|FILE",
-        help="registered scene or scene TOML (default: three_circles; with an --observation file "
-        "that carries its scene, that scene instance, which --scene must name)",
+    add_scene_argument(
+        p,
+        required=False,
+        help="with an --observation file that carries its scene, that scene instance, which "
+        "--scene must name",
     )
-    p.add_argument(
-        "--params",
-        nargs="+",
-        default=["mass"],
-        metavar="PARAM",
-        help="unknown parameters to identify, e.g. mass or mass elasticity (commas work too; "
-        "default: mass)",
-    )
+    add_params_argument(p)
     p.add_argument(
         "--bodies",
         nargs="+",
@@ -134,20 +133,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="write the observation used to FILE (.npz)",
     )
     p.add_argument(
-        "--json", action="store_true", help="print the history as JSON instead of the table"
+        "--out",
+        default=None,
+        metavar="FILE.json",
+        help="write the history as JSON here (the layout of --json)",
     )
+    add_json_argument(p, "the history")
     p.add_argument(
         "--plot",
         default=None,
         metavar="FILE",
         help="convergence plot (best-so-far errors per iteration), e.g. out.png",
     )
-    p.add_argument(
-        "-q",
-        "--quiet",
-        action="store_true",
-        help="no progress display or table: only the final line (or the JSON)",
-    )
+    add_quiet_argument(p, "only the final line (or the JSON)")
 
 
 def _fmt(v: float | None) -> str:
@@ -206,6 +204,8 @@ def describe_observation(history: Any) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from physbench.errors import PhysbenchError, counted
 
     if args.iterations < 1:
@@ -214,6 +214,7 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(f"--seed {args.seed}: expected a whole number >= 0")
 
     from physbench.commands.arguments import parse_key_values, renderer_choice
+    from physbench.commands.console import progress_bar, wrote
     from physbench.experiment import (
         DEFAULT_SCENE,
         RunConfig,
@@ -221,8 +222,9 @@ def main(args: argparse.Namespace) -> int:
         default_render_mode,
         run_config,
     )
+    from physbench.params import split_params
 
-    params = tuple(q for item in args.params for q in item.split(",") if q)
+    params = split_params(args.params)
     bodies = (
         None
         if args.bodies is None
@@ -256,14 +258,11 @@ def main(args: argparse.Namespace) -> int:
     )
     space = check_config(config)  # a bad name or option: fail before the progress bar appears
 
-    from tqdm import tqdm
-
-    bar = tqdm(
+    bar = progress_bar(
+        args,
         total=args.iterations,
         desc=f"{args.estimator} on {args.scene or args.observation or DEFAULT_SCENE}",
         unit="it",
-        file=sys.stderr,
-        disable=True if args.quiet else None,
         leave=False,
     )
 
@@ -283,15 +282,25 @@ def main(args: argparse.Namespace) -> int:
         )
     finally:
         bar.close()
+    if args.save_observation:
+        # numpy adds .npz to a name without it
+        saved = str(args.save_observation)
+        wrote(saved if saved.endswith(".npz") else saved + ".npz")
 
     if args.plot:
         from physbench.plotting.convergence import plot_convergence
 
+        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         plot_convergence(
             {f"{history.estimator}": [history]},
             args.plot,
             title=f"{history.meta['scene']}: {', '.join(space.keys)}",
         )
+        wrote(args.plot)
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(history.to_json(indent=1) + "\n", encoding="utf-8")
+        wrote(args.out)
 
     if args.json:
         print(history.to_json(indent=1))

@@ -5,7 +5,13 @@ from __future__ import annotations
 
 import argparse
 
-from physbench.commands.arguments import add_renderer_arguments, make_renderer_from
+from physbench.commands.arguments import (
+    DEFAULT_SCENE,
+    add_quiet_argument,
+    add_renderer_arguments,
+    add_scene_argument,
+    make_renderer_from,
+)
 
 #: ``--out`` suffixes written as a video file (camera renderer only).
 VIDEO_SUFFIXES = (".mp4", ".mkv", ".avi", ".mov", ".webm", ".gif")
@@ -14,7 +20,7 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--scene", required=True, help="registered scene name or a scene .toml file")
+    add_scene_argument(p, required=False)
     p.add_argument(
         "--engine", default="pymunk", help="simulator (see `physbench plugins`; default pymunk)"
     )
@@ -48,6 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "an image, the clean plate a tracker takes as background",
     )
     p.add_argument("--preview", metavar="FILE.gif|png", help="write a picture of the run")
+    add_quiet_argument(p, "print only the files written")
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
@@ -95,6 +102,7 @@ def main(args: argparse.Namespace) -> int:
 
     import numpy as np
 
+    from physbench.commands.console import wrote
     from physbench.errors import PhysbenchError
     from physbench.plugins import create
     from physbench.render.camera import CameraRenderer
@@ -119,7 +127,7 @@ def main(args: argparse.Namespace) -> int:
                 f"--preview {args.preview!r}: expected {' or '.join(PREVIEW_SUFFIXES)} "
                 "(an animation or a trail picture)"
             )
-    scene = resolve_scene(args.scene, args.seed)
+    scene = resolve_scene(args.scene or DEFAULT_SCENE, args.seed)
     scene = scene.with_params(parse_overrides(args.set)).validate()
     renderer = make_renderer_from(args)  # a bad renderer or option fails before simulating
     camera = renderer if isinstance(renderer, CameraRenderer) else None
@@ -142,20 +150,21 @@ def main(args: argparse.Namespace) -> int:
     # A video is filmed by write() below: no separate render of the frames.
     frames_shape = renderer.shape(scene, traj.frames) if video else None
     frames = None if video else renderer.render(scene, traj)
-    print(
-        f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies "
-        f"{', '.join(traj.bodies)}, "
-        f"frames {frames_shape if frames is None else frames.shape}"
-    )
-    for i, name in enumerate(traj.bodies):
-        (x0, y0), (x1, y1) = traj.states[0, i, :2], traj.states[-1, i, :2]
-        print(f"  {name:>8}: ({x0:6.3f}, {y0:6.3f}) -> ({x1:6.3f}, {y1:6.3f}) m")
+    if not args.quiet:
+        print(
+            f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies "
+            f"{', '.join(traj.bodies)}, "
+            f"frames {frames_shape if frames is None else frames.shape}"
+        )
+        for i, name in enumerate(traj.bodies):
+            (x0, y0), (x1, y1) = traj.states[0, i, :2], traj.states[-1, i, :2]
+            print(f"  {name:>8}: ({x0:6.3f}, {y0:6.3f}) -> ({x1:6.3f}, {y1:6.3f}) m")
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     if args.out and video:
         assert camera is not None
         camera.write(args.out, scene, traj)
-        print(f"wrote {args.out}")
+        wrote(args.out)
     elif args.out:
         from physbench.scene_toml import dumps_scene
 
@@ -166,17 +175,17 @@ def main(args: argparse.Namespace) -> int:
             effects=np.array([repr(e) for e in effects], dtype=str),
             **traj.to_npz_dict(),
         )
-        print(f"wrote {args.out}")
+        wrote(args.out)
     if args.plate:
         from PIL import Image
 
         assert camera is not None
         Path(args.plate).parent.mkdir(parents=True, exist_ok=True)
         Image.fromarray(camera.plate(scene)).save(args.plate)
-        print(f"wrote {args.plate}")
+        wrote(args.plate)
     if args.preview:
         from physbench.render.preview import save_preview
 
         save_preview(scene, traj, args.preview)
-        print(f"wrote {args.preview}")
+        wrote(args.preview)
     return 0

@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from physbench.commands.arguments import add_video_input_arguments
+from physbench.commands.arguments import (
+    add_quiet_argument,
+    add_scene_argument,
+    add_video_input_arguments,
+)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -13,11 +17,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="VIDEO",
         help="a video file (mp4, mov, avi, mkv, webm, gif, ...) or a folder of images",
     )
-    p.add_argument(
-        "--scene",
+    add_scene_argument(
+        p,
         required=True,
-        help="the filmed scene: registered name or .toml file (its initial positions say where "
-        "the bodies start)",
+        help="the filmed scene (its initial positions say where the bodies start)",
     )
     p.add_argument("--seed", type=int, default=0, help="scene instance seed (default 0)")
     p.add_argument("--out", required=True, metavar="REC.csv", help="write the recording here")
@@ -25,12 +28,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--preview", metavar="FILE.mp4|.gif", help="write the video with the tracks drawn on"
     )
     add_video_input_arguments(p)
-    p.add_argument("-q", "--quiet", action="store_true", help="print only where files went")
+    add_quiet_argument(p, "print only the files written")
 
 
 def main(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from physbench.commands.console import show_progress, wrote
     from physbench.errors import PhysbenchError
     from physbench.recording import write_recordings
     from physbench.scenes import resolve_scene
@@ -57,14 +61,14 @@ def main(args: argparse.Namespace) -> int:
         start=args.start,
         end=args.end,
         background=args.background,
-        progress=not args.quiet,
+        progress=show_progress(args),
     )
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     write_recordings(args.out, result.recording)
     if not args.quiet:
         print(result.summary.format())
-    print(f"wrote {args.out}")
+    wrote(args.out)
     if args.preview:
         write_overlay(args.preview, video, result.pixels, start=args.start, end=args.end)
-        print(f"wrote {args.preview}")
+        wrote(args.preview)
     return 0

@@ -4,17 +4,23 @@ from __future__ import annotations
 
 import argparse
 
-from physbench.commands.arguments import add_renderer_choice
+from physbench.commands.arguments import (
+    add_params_argument,
+    add_quiet_argument,
+    add_renderer_choice,
+    add_scene_argument,
+)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--scene", required=True, help="registered scene name")
-    p.add_argument(
-        "--params",
-        required=True,
-        help="comma-separated unknown parameters, e.g. mass or mass,elasticity",
+    add_scene_argument(
+        p,
+        required=False,
+        help="a fresh instance per sample group: a registered generator (a TOML file is one "
+        "instance and is refused)",
     )
-    p.add_argument("--out", help="output folder (default runs/train/SCENE__PARAMS)")
+    add_params_argument(p)
+    p.add_argument("--out", metavar="DIR", help="output folder (default: runs/train/SCENE__PARAMS)")
     p.add_argument(
         "--samples", type=int, default=40_000, help="training budget in samples (default 40000)"
     )
@@ -72,25 +78,35 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--no-resume", action="store_true", help="start over even if a checkpoint exists"
     )
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_quiet_argument(p, "only the result lines")
 
 
 def main(args: argparse.Namespace) -> int:
+    import sys
     from pathlib import Path
 
-    from physbench.commands.arguments import renderer_choice
+    from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
+    from physbench.commands.console import show_progress, wrote
     from physbench.errors import PhysbenchError
     from physbench.estimators.resnet3d.data import DataSpec
     from physbench.estimators.resnet3d.model import NetConfig
     from physbench.estimators.resnet3d.train import TrainConfig, train, weights_name
     from physbench.experiment import make_renderer
-    from physbench.params import ParamSpace
+    from physbench.params import ParamSpace, split_params
     from physbench.plugins import get_registry
     from physbench.requirements import require
 
     require("estimator", "resnet3d", get_registry().get("estimator", "resnet3d"))
-    params = tuple(p.strip() for p in args.params.split(",") if p.strip())
-    scene = get_registry().get("scene", args.scene)(0)
+    params = split_params(args.params)
+    scene_name = args.scene or DEFAULT_SCENE
+    if scene_name.endswith(".toml") or Path(scene_name).is_file():
+        # The data generator draws a new scene instance per sample group by seed.
+        raise PhysbenchError(
+            f"--scene {scene_name!r}: train needs a registered scene generator (a fresh instance "
+            "per sample group), and a scene file is one instance; give a name from "
+            "`physbench scenes`"
+        )
+    scene = get_registry().get("scene", scene_name)(0)
     ParamSpace.from_scene(scene, params)  # unknown parameter names fail here, listing the known
     renderer, renderer_options = renderer_choice(args)
     make_renderer(renderer, renderer_options, resolution=64, mode="mark")  # fail before training
@@ -118,7 +134,7 @@ def main(args: argparse.Namespace) -> int:
                 "GPU, e.g. cuda"
             ) from None
     spec = DataSpec(
-        args.scene,
+        scene_name,
         params,
         engine=args.engine,
         renderer=renderer,
@@ -142,7 +158,22 @@ def main(args: argparse.Namespace) -> int:
         init=args.init,
     )
     out = Path(args.out or f"runs/train/{weights_name(spec)}")
-    path, meta = train(spec, net, cfg, out, resume=not args.no_resume, progress=not args.quiet)
+    checkpoint = out / "checkpoint.safetensors"
+    if not args.no_resume and checkpoint.is_file():
+        import json
+
+        try:
+            done = json.loads(checkpoint.with_suffix(".json").read_text())["samples"]
+            at = f"at {done} of {args.samples} samples"
+        except (OSError, ValueError, KeyError, TypeError):
+            at = "(its sample count unreadable)"
+        print(
+            f"resuming from {checkpoint} {at} (--no-resume starts over)",
+            file=sys.stderr,
+        )
+    path, meta = train(spec, net, cfg, out, resume=not args.no_resume, progress=show_progress(args))
+    wrote(path)
+    wrote(path.with_suffix(".json"))
     print(
         f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: "
         f"{meta['val_mse']:.3g}; "

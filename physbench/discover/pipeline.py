@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 from physbench.discover import diagnostics
@@ -47,19 +47,25 @@ def discover(
     renderer: Renderer | None = None,
     candidates: Sequence[CandidateSpec] | None = None,
     diagnose: bool = True,
+    stage: Callable[[str], None] | None = None,
 ) -> Discovery:
     """Fit the base model to ``runs``, try every candidate effect, and add the significant ones
     greedily. ``candidates`` overrides the automatic choice (:func:`candidate_specs`);
     ``renderer`` the one :func:`renderer_for` picks for frames; ``diagnose=False`` skips the
-    residual statistics of the verdict."""
+    residual statistics of the verdict. ``stage`` is called as each step begins, with ``"base
+    fit"``, ``"candidate effects"`` and ``"verdict"`` (a progress display)."""
     started = time.perf_counter()
     settings = settings or Settings()
+    stage = stage or (lambda name: None)
+    stage("base fit")
     base = fit_base(runs, simulator, settings, renderer=renderer)
     if candidates is None:
         specs, skipped = candidate_specs(base.model.problem.runs[0].scene, settings)
     else:
         specs, skipped = list(candidates), []
+    stage("candidate effects")
     selection = prune_causes(select_causes(base, specs, settings, skipped), settings)
+    stage("verdict")
     return conclude(selection, settings, diagnose=diagnose, started=started)
 
 

@@ -99,7 +99,7 @@ def test_the_camera_films_a_video_file_and_its_plate(tmp_path: Path, capsys) -> 
     clip, plate = tmp_path / "clip.mp4", tmp_path / "plate.png"
     argv = ["simulate", "--scene", "three_circles", "--renderer", "camera", "--resolution", "96"]
     assert main([*argv, "--out", str(clip), "--plate", str(plate)]) == 0
-    assert f"wrote {clip}" in capsys.readouterr().out
+    assert f"wrote {clip}" in capsys.readouterr().err
     scene = resolve_scene("three_circles", 0)
     frames = list(VideoReader(clip).frames())
     assert len(frames) == scene.frames and frames[0].image.shape == (72, 96, 3)

@@ -41,8 +41,8 @@ def test_a_clip_becomes_a_recording_and_a_preview(clip, capsys) -> None:
     args += ["--calibration", str(tmp / "cal.toml"), "--background", str(tmp / "plate.png")]
     args += ["--out", str(tmp / "out" / "rec.csv"), "--preview", str(tmp / "ov.mp4")]
     assert main(args) == 0
-    out = capsys.readouterr().out
-    assert "tracked" in out and "reprojection error" in out and "wrote" in out
+    out, err = capsys.readouterr()
+    assert "tracked" in out and "reprojection error" in out and "wrote" in err
     rec = read_recording(tmp / "out" / "rec.csv", bodies=scene)
     assert rec.bodies == scene.body_names
     tr = rec.track("test")
