@@ -41,8 +41,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--minutes",
         type=float,
         default=0.0,
-        help="wall-clock budget; training ends at this or --samples, whichever comes first "
-        "(default: none)",
+        help="wall-clock budget of this session (a resumed run gets it afresh); training ends at "
+        "this or --samples, whichever comes first (default: none)",
     )
     p.add_argument(
         "--device", default="cpu", help="torch device to train on, e.g. cuda (default cpu)"

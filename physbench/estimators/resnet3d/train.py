@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -29,9 +29,8 @@ class TrainConfig:
     threads: int = 0  # torch threads; 0 = torch's default
     seed: int = 0
     device: str = "cpu"  # "cuda" trains on a GPU; the weights are the same either way
-    minutes: float = (
-        0.0  # wall-clock budget (0 = none); training stops at whichever budget ends first
-    )
+    # Wall-clock budget of this session (0 = none); training stops at whichever budget ends first.
+    minutes: float = 0.0
     init: str = ""  # start from these weights (fine-tuning) instead of a fresh network
 
 
@@ -162,6 +161,11 @@ def train(
             meta["history"],
             meta["wall_s"],
         )
+    if cfg.minutes > 0 and wall0 > 0:
+        # ``minutes`` is this session's budget: the time horizon of the schedule ends that long
+        # after what earlier sessions spent (their time counted against it, a resumed run with
+        # --minutes 10 after 10 minutes stopped at once).
+        cfg = replace(cfg, minutes=cfg.minutes + wall0 / 60.0)
     vx, vy = validation_set(spec, cfg.val_groups)
     loader = torch.utils.data.DataLoader(
         _pairs_dataset(spec, seen),

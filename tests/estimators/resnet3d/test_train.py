@@ -107,3 +107,18 @@ def test_init_fine_tunes_from_weights_and_refuses_another_architecture(tmp_path:
             tmp_path / "c",
             progress=False,
         )
+
+
+def test_a_time_budget_counts_only_this_sessions_time(tmp_path: Path) -> None:
+    import json
+
+    cfg = TrainConfig(samples=48, batch=8, eval_every=48, val_groups=1, workers=0, threads=1)
+    train(TINY_DATA, TINY, cfg, tmp_path, progress=False)
+    side = tmp_path / "checkpoint.json"
+    meta = json.loads(side.read_text())
+    side.write_text(json.dumps({**meta, "wall_s": 600.0}))  # as if earlier sessions took 10 min
+    resumed = TrainConfig(**{**cfg.__dict__, "samples": 96, "minutes": 1.0})
+    _, meta2 = train(TINY_DATA, TINY, resumed, tmp_path, progress=False)
+    # A minute of its own: it trains on (the 10 earlier minutes used to end it at once).
+    assert [h["samples"] for h in meta2["history"]] == [48, 96]
+    assert meta2["history"][-1]["wall_s"] >= 600.0
