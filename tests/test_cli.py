@@ -55,3 +55,24 @@ def test_every_command_has_a_module_with_arguments_and_main(capsys) -> None:  # 
         assert callable(mod.add_arguments) and callable(mod.main) and help_
     assert main([]) == 0 and "COMMAND" in capsys.readouterr().out
     assert main(["--version"]) == 0 and capsys.readouterr().out.startswith("physbench ")
+
+
+def test_a_reader_that_leaves_early_ends_the_command_quietly() -> None:
+    # `physbench run | head -1`: the pipe closes while run still prints its summary.
+    code = (
+        "import sys\n"
+        "from physbench.cli import main\n"
+        "sys.stdout.reconfigure(line_buffering=True)\n"
+        "sys.exit(main(['run', '--iterations', '2', '--resolution', '32', '-q']))\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.close()  # the reader is gone before the first line
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141
+    assert "Traceback" not in err and "BrokenPipeError" not in err, err
