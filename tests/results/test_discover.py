@@ -1,6 +1,7 @@
 """The committed real-data discovery results (``results/discover/``, written by
-``python benchmarks/discover_real.py``): their layout and the claims README and docs/discover.md
-make about them. These tests read the committed files; they do not recompute anything."""
+``python benchmarks/discover_real.py``): their layout and the claims docs/results.md and
+docs/discover.md make about them. These tests read the committed files; they do not recompute
+anything."""
 
 from __future__ import annotations
 

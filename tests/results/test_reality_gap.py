@@ -1,7 +1,7 @@
 """The committed physics-gap sweep (``results/reality_gap``, ``benchmarks/reality_gap.toml``):
 observe with one engine, model with the other, every estimator. The sweep is a benchmark (about
 3 minutes on 2 cores); these tests check that what is committed is the whole sweep the spec
-describes and that the table README quotes is generated from it."""
+describes and that the table docs/results.md quotes is generated from it."""
 
 from __future__ import annotations
 

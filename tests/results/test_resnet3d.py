@@ -3,7 +3,7 @@ from it.
 
 The sweep itself (``physbench bench benchmarks/resnet3d.toml``, minutes on 2 cores) is a benchmark,
 not a test; these tests check that the committed table is generated from the committed results and
-that the claims README makes about them hold.
+that the claims docs/results.md makes about them hold.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
 """The committed tracking benchmarks (``results/track``, ``benchmarks/track_accuracy.py`` and
-``benchmarks/track_speed.py``): the figures README quotes, held against the issue's bars."""
+``benchmarks/track_speed.py``): the figures docs/results.md quotes, held against the issue's
+bars."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """The committed end-to-end discovery-from-video table (``results/video_discover``,
 ``benchmarks/video_discover.py``): the whole grid ran, filmed hidden effects are named as their
-clean tracks are, and no filmed control raises a cause (README, docs/video.md)."""
+clean tracks are, and no filmed control raises a cause (docs/results.md, docs/video.md)."""
 
 from __future__ import annotations
 
