@@ -1,13 +1,17 @@
 """Figures of a sweep, from its long table (matplotlib, Agg backend, imported inside each
 function).
 
-- :func:`convergence`: best-so-far normalized MSE per iteration, mean over seeds and the spread
-  (interquartile band) for every estimator, one panel per unknown set (the paper's Fig. 3).
+- :func:`convergence`: the normalized MSE of the best-so-far iterate by image MSE per iteration,
+  mean over seeds and the spread (interquartile band) for every estimator, one panel per unknown
+  set (the paper's Fig. 3).
 - :func:`trajectories`: the iterates of the first seeds in the plane of two unknowns, as arrows,
   with the truth as a filled circle (Fig. 5).
 - :func:`landscape`: image MSE against the deviation of one parameter from its nominal value,
   per body (Fig. 4), with the sweep's engine and renderer; this one simulates.
 - :func:`win_rate`: how often each estimator ends closer to the truth than each other one.
+
+Axes carry units (:mod:`physbench.plotting.units`), legends sit outside the axes, titles name the
+engine and blur, and iterations are numbered as in the long table (0: the initial guess).
 """
 
 from __future__ import annotations
@@ -31,12 +35,15 @@ from physbench.bench.tables import (
     win_rate_table,
 )
 from physbench.errors import counted
+from physbench.plotting.units import DIMENSIONLESS, IMAGE_MSE_UNIT, with_unit
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
     import pandas as pd
     from matplotlib.figure import Figure
+
+    from physbench.parameter import Parameter
 
 #: Settings that split figures (everything in a configuration but unknowns and estimator).
 SETTINGS = ("scene", *tables.SETTINGS)
@@ -78,8 +85,11 @@ def _name(prefix: str, cfg: dict[str, Any], varying: Sequence[str], extra: str =
 
 
 def _title(cfg: dict[str, Any], varying: Sequence[str]) -> str:
-    bits = [f"{c} {cfg[c]}" for c in varying]
-    return scene_label(str(cfg["scene"])) + (f" ({', '.join(bits)})" if bits else "")
+    """The scene, its engine and blur (always: a reader needs them), then the other settings
+    that vary across the sweep."""
+    bits = [f"engine {cfg['engine']}", f"blur {float(cfg['blur']):g} px"]
+    bits += [f"{c} {cfg[c]}" for c in varying if c not in ("engine", "blur")]
+    return f"{scene_label(str(cfg['scene']))} ({', '.join(bits)})"
 
 
 def _save(fig: Figure, path: Path) -> Path:
@@ -108,14 +118,16 @@ def convergence(df: pd.DataFrame, out: Path) -> list[Path]:
     paths = []
     for cfg, rows in _groups(ok, SETTINGS):
         sets = list(dict.fromkeys(rows.sort_values("cell_index")["unknowns"]))
-        fig, axes = plt.subplots(1, len(sets), figsize=(4.2 * len(sets), 3.4), squeeze=False)
+        fig, axes = plt.subplots(
+            1, len(sets), figsize=(4.2 * len(sets), 3.8), squeeze=False, layout="constrained"
+        )
         for ax, unknowns in zip(axes[0], sets, strict=True):
             sub = rows[rows["unknowns"] == unknowns]
             for est, er in _groups(sub, ["estimator"]):
                 y = er.pivot_table(index="seed", columns="iteration", values="best_nmse").to_numpy(
                     dtype=float
                 )
-                x = np.arange(1, y.shape[1] + 1)
+                x = np.array(er["iteration"].drop_duplicates().sort_values(), dtype=int)
                 lo, hi = np.nanpercentile(y, [25, 75], axis=0)
                 (line,) = ax.plot(
                     x,
@@ -134,29 +146,50 @@ def convergence(df: pd.DataFrame, out: Path) -> list[Path]:
                     )
             ax.set_yscale("log")
             ax.set_title(unknowns_label(unknowns), fontsize="medium")
-            ax.set_xlabel("iterations (simulations)")
+            ax.set_xlabel("iteration (0: initial guess)")
             ax.xaxis.get_major_locator().set_params(integer=True)
             ax.grid(True, which="both", alpha=0.25)
-        axes[0, 0].set_ylabel("best-so-far normalized MSE")
-        axes[0, -1].legend(fontsize="x-small", loc="upper right")
+        axes[0, 0].set_ylabel(f"normalized MSE ({DIMENSIONLESS})")
+        _legend_below(fig, axes[0])
         n = rows["seed"].nunique()
         fig.suptitle(
-            f"{_title(cfg, varying)}: mean over {counted(n, 'seed')}, band = interquartile range",
+            f"{_title(cfg, varying)}\nnormalized MSE of the best-so-far iterate by image MSE: "
+            f"mean over {counted(n, 'seed')}, band = interquartile range",
             fontsize="medium",
         )
-        fig.tight_layout()
         paths.append(_save(fig, out / _name("convergence", cfg, varying)))
     return paths
 
 
-def _ranges(scene: str, seed: int, keys: Sequence[str]) -> dict[str, tuple[float, float]]:
+def _legend_below(fig: Figure, axes: Sequence[Any]) -> None:
+    """One legend for the figure, below the axes so it covers no data (entries of every axes,
+    each label once); needs a constrained layout."""
+    entries: dict[str, Any] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+    if entries:
+        fig.legend(
+            list(entries.values()),
+            list(entries),
+            loc="outside lower center",
+            ncols=min(5, len(entries)),
+            fontsize="x-small",
+        )
+
+
+def _unknowns(scene: str, seed: int) -> dict[str, Parameter]:
+    """The scene's unknowns by key (ranges and units), or nothing for a scene file that moved."""
     try:
         from physbench.scenes import resolve_scene
 
-        sc = resolve_scene(scene, seed)
-        return {k: (sc.unknown(k).low, sc.unknown(k).high) for k in keys}
-    except Exception:  # a scene file that moved: fall back to the data's extent
+        return {u.key: u for u in resolve_scene(scene, seed).unknowns}
+    except Exception:  # a scene file that moved: fall back to the data's extent, no units
         return {}
+
+
+def _param_label(key: str, unknowns: Mapping[str, Parameter]) -> str:
+    return with_unit(key, unknowns[key].unit) if key in unknowns else key
 
 
 def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
@@ -174,8 +207,10 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
         kx, ky = json.loads(next(iter(keys)))
         chosen = sorted(rows["seed"].unique())[:seeds]
         ests = _groups(rows, ["estimator"])
-        fig, axes = plt.subplots(1, len(ests), figsize=(3.3 * len(ests), 3.5), squeeze=False)
-        rng = _ranges(str(cfg["scene"]), int(chosen[0]), [kx, ky])
+        fig, axes = plt.subplots(
+            1, len(ests), figsize=(3.3 * len(ests), 4.2), squeeze=False, layout="constrained"
+        )
+        unknowns = _unknowns(str(cfg["scene"]), int(chosen[0]))
         colors = plt.get_cmap("tab10").colors
         for ax, (est, er) in zip(axes[0], ests, strict=True):
             for i, seed in enumerate(chosen):
@@ -196,20 +231,19 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
                 ax.plot(xs[0], ys[0], "o", mfc="none", mec=c, ms=5)
                 b = int(run["best_iteration"].iloc[-1])
                 ax.plot(xs[b], ys[b], "*", color=c, ms=8, mec="k", mew=0.4)
-                ax.plot(t[kx], t[ky], "o", color=c, ms=8, mec="k", mew=0.6)
-            if rng:
-                ax.set_xlim(*rng[kx])
-                ax.set_ylim(*rng[ky])
+                ax.plot(t[kx], t[ky], "o", color=c, ms=8, mec="k", mew=0.6, label=f"seed {seed}")
+            if kx in unknowns and ky in unknowns:
+                ax.set_xlim(unknowns[kx].low, unknowns[kx].high)
+                ax.set_ylim(unknowns[ky].low, unknowns[ky].high)
             ax.set_title(str(est["estimator"]), fontsize="medium")
-            ax.set_xlabel(kx)
-        axes[0, 0].set_ylabel(ky)
-        seeds_text = ", ".join(map(str, chosen))
+            ax.set_xlabel(_param_label(kx, unknowns))
+        axes[0, 0].set_ylabel(_param_label(ky, unknowns))
+        _legend_below(fig, axes[0])
         fig.suptitle(
-            f"{_title(cfg, varying)}, {unknowns_label(str(cfg['unknowns']))}: seeds {seeds_text} "
-            "(hollow: start, star: best by image MSE, filled: truth)",
+            f"{_title(cfg, varying)}, {unknowns_label(str(cfg['unknowns']))}\n"
+            "hollow: start, star: best by image MSE, filled: truth",
             fontsize="small",
         )
-        fig.tight_layout()
         paths.append(_save(fig, out / _name("trajectories", cfg, varying, str(cfg["unknowns"]))))
     return paths
 
@@ -277,7 +311,12 @@ def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) 
         )
         renderer, options = str(first["renderer_name"]), json.loads(first["renderer_options"])
         params = list(dict.fromkeys(p for u in rows["unknowns"] for p in u.split("+")))
-        fig, axes = plt.subplots(1, len(params), figsize=(4 * len(params), 3.2), squeeze=False)
+        fig, axes = plt.subplots(
+            1, len(params), figsize=(4 * len(params), 3.6), squeeze=False, layout="constrained"
+        )
+        unknowns = _unknowns(scene, 0)
+        units = {u.name: u.unit for u in unknowns.values()}
+        palette, order = plt.get_cmap("tab10").colors, {}  # a colour per body, kept across panels
         try:
             for ax, param in zip(axes[0], params, strict=True):
                 data = landscape_data(
@@ -293,7 +332,15 @@ def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) 
                 )
                 x = data.pop("x")
                 for key, y in data.items():
-                    (line,) = ax.plot(x, np.nanmean(y, axis=0), lw=1.3, label=key)
+                    # a line per body, labelled by body so one figure legend serves every panel
+                    body = key.rsplit(".", 1)[0]
+                    (line,) = ax.plot(
+                        x,
+                        np.nanmean(y, axis=0),
+                        lw=1.3,
+                        color=palette[order.setdefault(body, len(order)) % len(palette)],
+                        label=f"body {body}",
+                    )
                     if y.shape[0] > 1:
                         ax.fill_between(
                             x,
@@ -304,20 +351,21 @@ def landscape(df: pd.DataFrame, out: Path, *, seeds: int = 3, points: int = 21) 
                             lw=0,
                         )
                 ax.axvline(0, color="0.5", ls="--", lw=0.8)
-                ax.set_xlabel(f"Δ{param} from nominal")
+                ax.set_xlabel(with_unit(f"Δ{param} from nominal", units.get(param, "")))
                 ax.set_title(param, fontsize="medium")
-                ax.legend(fontsize="x-small")
                 ax.grid(True, alpha=0.25)
         except Exception:  # e.g. a scene file that moved since the sweep, a renderer now missing
             plt.close(fig)
             continue
-        axes[0, 0].set_ylabel("image MSE vs nominal")
-        shown = f"{engine}, {cfg['renderer']}, {res} px" if several else f"{engine}, {res} px"
+        axes[0, 0].set_ylabel(f"image MSE vs nominal ({IMAGE_MSE_UNIT})")
+        _legend_below(fig, axes[0])
+        shown = f"{cfg['renderer']}, {res} px" if several else f"{res} px"
         fig.suptitle(
-            f"{scene_label(scene)}: image-MSE landscape ({shown}, mean of {seeds} scene instances)",
+            f"{scene_label(scene)}: image-MSE landscape (engine {engine}, {shown}, no blur)\n"
+            f"pixel values in [0, 1]; line: mean of {counted(seeds, 'scene instance')}, "
+            "band: min to max",
             fontsize="medium",
         )
-        fig.tight_layout()
         name = f"landscape_{scene}" + (f"_renderer{cfg['renderer']}" if several else "")
         paths.append(_save(fig, out / f"{re.sub(r'[^A-Za-z0-9_.-]+', '-', name)}.png"))
     return paths
@@ -330,7 +378,7 @@ def win_rate(df: pd.DataFrame, out: Path) -> list[Path]:
     wr, n = win_rate_table(final_rows(df))
     if wr.shape[0] < 2:
         return []
-    fig, ax = plt.subplots(figsize=(1.1 * len(wr) + 2.4, 0.9 * len(wr) + 1.6))
+    fig, ax = plt.subplots(figsize=(1.1 * len(wr) + 2.6, 0.9 * len(wr) + 1.6), layout="constrained")
     im = ax.imshow(wr.to_numpy(dtype=float), cmap="RdBu", vmin=0, vmax=1)
     for i in range(len(wr)):
         for j in range(len(wr)):
@@ -346,10 +394,11 @@ def win_rate(df: pd.DataFrame, out: Path) -> list[Path]:
                 )
     ax.set_xticks(range(len(wr)), wr.columns, rotation=30, ha="right")
     ax.set_yticks(range(len(wr)), wr.index)
-    ax.set_xlabel("opponent")
+    ax.set_xlabel("opponent (column)")
+    ax.set_ylabel("estimator (row)")
     ax.set_title("win rate: row beats column (normalized min MSE)", fontsize="medium")
-    fig.colorbar(im, ax=ax, fraction=0.046)
-    fig.tight_layout()
+    bar = fig.colorbar(im, ax=ax, fraction=0.046)
+    bar.set_label("share won by the row (ties: half)", fontsize="small")
     return [_save(fig, out / "win_rate.png")]
 
 

@@ -4,7 +4,6 @@ can be mailed or committed and opened anywhere."""
 
 from __future__ import annotations
 
-import base64
 import html
 import json
 from collections.abc import Mapping, Sequence
@@ -12,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from physbench.errors import counted
+from physbench.plotting.embed import png_data_uri
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -31,10 +31,7 @@ def _table(df: pd.DataFrame) -> str:
 
 
 def _img(path: Path) -> str:
-    data = base64.b64encode(path.read_bytes()).decode()
-    return (
-        f'<figure><img alt="{html.escape(path.name)}" src="data:image/png;base64,{data}"></figure>'
-    )
+    return f'<figure><img alt="{html.escape(path.name)}" src="{png_data_uri(path)}"></figure>'
 
 
 def build(

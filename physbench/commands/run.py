@@ -256,7 +256,7 @@ def main(args: argparse.Namespace) -> int:
         video_start=args.start,
         video_end=args.end,
     )
-    space = check_config(config)  # a bad name or option: fail before the progress bar appears
+    check_config(config)  # a bad name or option: fail before the progress bar appears
 
     bar = progress_bar(
         args,
@@ -288,14 +288,10 @@ def main(args: argparse.Namespace) -> int:
         wrote(saved if saved.endswith(".npz") else saved + ".npz")
 
     if args.plot:
-        from physbench.plotting.convergence import plot_convergence
+        from physbench.plotting.convergence import plot_convergence, run_title
 
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
-        plot_convergence(
-            {f"{history.estimator}": [history]},
-            args.plot,
-            title=f"{history.meta['scene']}: {', '.join(space.keys)}",
-        )
+        plot_convergence({f"{history.estimator}": [history]}, args.plot, title=run_title(history))
         wrote(args.plot)
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)

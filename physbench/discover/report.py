@@ -1,7 +1,9 @@
 """Plots and an HTML page for a discovery: observed vs simulated trajectories (base and extended
 model), residuals over time, residuals per event, the candidates' held-out errors, and the verdict.
 
-matplotlib (Agg backend) is imported inside :func:`write_report` only.
+The page embeds its figures as ``data:`` URIs, so ``index.html`` alone can be mailed or moved; the
+PNG files are written next to it too. matplotlib (Agg backend) is imported inside
+:func:`write_report` only.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import numpy as np
 from physbench.discover.phrasing import describe
 from physbench.discover.residuals import EVENTS
 from physbench.discover.verdict import params_text, text
+from physbench.plotting.embed import png_data_uri
 
 if TYPE_CHECKING:
     from physbench.discover.diagnostics import RunView
@@ -101,7 +104,7 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
             if disc.causes:
                 axr.plot(t, rf, "-", lw=0.8, color="tab:red", label=ext)
             axr.axhline(0, color="0.6", lw=0.5)
-            axr.set_ylabel("simulated − observed", fontsize=8)
+            axr.set_ylabel(f"simulated − observed ({'rad' if f == 'angle' else 'm'})", fontsize=8)
             for a in (ax, axr):
                 if i in cut:
                     a.axvline(cut[i], color="0.5", ls="--", lw=0.8)
@@ -110,6 +113,7 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         axes[0, 1].legend(fontsize=7, loc="best")
         axes[-1, 0].set_xlabel("t (s); dashed: end of the fitted part", fontsize=8)
         axes[-1, 1].set_xlabel("t (s)", fontsize=8)
+        fig.suptitle(f"engine {disc.engine}: {disc.split.describe(disc.runs)}", fontsize=9)
         fig.tight_layout()
         fig.savefig(out / "trajectories.png", dpi=dpi)
         plt.close(fig)
@@ -127,7 +131,7 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         for label, scored, color in (("base", disc.base, "tab:blue"), (ext, disc.final, "tab:red")):
             if label != "base" and not disc.causes:
                 continue
-            for i in frame_runs:
+            for n, i in enumerate(frame_runs):
                 r = scored.model.residuals("fit" if split.kind == "time" else "held", runs=[i])
                 f = disc.runs[i].frames
                 assert f is not None
@@ -137,10 +141,11 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
                     np.arange(k) / disc.runs[i].scene.fps,
                     np.sqrt(np.mean(r[: k * per].reshape(k, per) ** 2, axis=1)),
                     color=color,
-                    label=label,
+                    label=label if n == 0 else None,  # one legend entry per model, not per run
                 )
         ax.set_xlabel("t (s), fitted part")
-        ax.set_ylabel("pixel RMS residual")
+        ax.set_ylabel("RMS residual (pixel value, in [0, 1])")
+        ax.set_title(f"engine {disc.engine}", fontsize=8)
         ax.legend(fontsize=7)
         fig.tight_layout()
         fig.savefig(out / "frames.png", dpi=dpi)
@@ -171,6 +176,7 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
                     color="tab:red",
                 )
             ax.set_xticks(x, [f"{b}\n{e}" for b, e in labels], fontsize=7)
+            ax.set_xlabel("body, event", fontsize=8)
             ax.set_ylabel(f"RMS residual ({disc.unit})", fontsize=8)
             ax.legend(fontsize=7)
             fig.tight_layout()
@@ -190,6 +196,7 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         )
         ax.axvline(disc.base.heldout, color="tab:blue", ls="--", lw=1, label="base")
         ax.set_yticks(y, [c.effect for c in first], fontsize=7)
+        ax.set_ylabel("candidate effect added to the base model", fontsize=8)
         ax.set_xlabel(f"held-out error ({disc.unit}), round 1", fontsize=8)
         ax.legend(fontsize=7)
         fig.tight_layout()
@@ -198,11 +205,11 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         figures.append(("candidates.png", "Held-out error of base + each candidate (red: chosen)."))
 
     page = out / "index.html"
-    page.write_text(_html(disc, figures), encoding="utf-8")
+    page.write_text(_html(disc, [(out / f, cap) for f, cap in figures]), encoding="utf-8")
     return page
 
 
-def _html(disc: Discovery, figures: list[tuple[str, str]]) -> str:
+def _html(disc: Discovery, figures: list[tuple[Path, str]]) -> str:
     e = html.escape
     rows = [
         "<tr><th>round</th><th>effect</th><th>parameters</th><th>held-out error</th>"
@@ -218,7 +225,8 @@ def _html(disc: Discovery, figures: list[tuple[str, str]]) -> str:
             f"<td>{c.delta_criterion:+.1f}</td><td>{verdict}</td><td>{e(c.note)}</td></tr>"
         )
     figs = "\n".join(
-        f'<figure><img src="{f}" alt="{e(cap)}"><figcaption>{e(cap)}</figcaption></figure>'
+        f'<figure><img src="{png_data_uri(f)}" alt="{e(cap)}"><figcaption>{e(cap)}</figcaption>'
+        "</figure>"
         for f, cap in figures
     )
     findings: dict[str, Any] = disc.findings

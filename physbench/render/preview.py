@@ -1,14 +1,16 @@
 """Pictures of a trajectory for people: an animated GIF or a one-image PNG trail.
 
 Called by the CLI and examples, never in the estimation loop. Unlike the frames an estimator sees,
-previews draw the static geometry, colour the test body and the focus body distinctly and mark
-each body's orientation.
+previews draw the static geometry, colour the test body and the focus body distinctly, mark each
+body's orientation and are captioned (:func:`annotate`): each body's name, the scene and the time,
+and a scale bar in metres, in a band below the picture.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,6 +20,8 @@ from physbench.render.base import DEFAULT_RENDERER, RenderError
 from physbench.scene import Segment
 
 if TYPE_CHECKING:
+    from PIL import Image
+
     from physbench.scene import Scene
     from physbench.trajectory import Trajectory
 
@@ -31,6 +35,53 @@ FOCUS = (214, 39, 40)
 TRAIL_FRAMES = 6
 #: Fraction of the world size added around it, so walls on the bounds stay visible.
 MARGIN = 0.03
+TEXT = (0, 0, 0)
+
+
+def scale_length(width: float) -> float:
+    """The scale bar's length (m): the largest 1, 2 or 5 × 10^k that is at most a quarter of the
+    world's ``width`` (m)."""
+    top = width / 4
+    power = 10.0 ** math.floor(math.log10(top))
+    return max(m * power for m in (1, 2, 5) if m * power <= top)
+
+
+def annotate(
+    img: Image.Image,
+    scene: Scene,
+    positions: np.ndarray,
+    caption: str,
+    px: Callable[[float, float], tuple[float, float]],
+    metres_per_pixel: float,
+) -> Image.Image:
+    """``img`` with each body's name beside its centre (``positions (N, 2)``, m) and, in a white
+    band added below the scene so nothing covers it, ``caption`` and a scale bar with its length
+    in metres. ``px`` maps world coordinates to pixels. Called for every GIF frame and once for a
+    PNG trail."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    w, h = img.size
+    size = max(9, w // 24)
+    font = ImageFont.load_default(size=size)
+    d = ImageDraw.Draw(img)
+    for b, (x, y) in zip(scene.bodies, positions, strict=True):
+        r = b.shape.extent()
+        at = px(x + 0.7 * r, y + 0.7 * r)
+        d.text(
+            at, b.name, fill=TEXT, font=font, anchor="lb", stroke_width=2, stroke_fill=BACKGROUND
+        )
+    pad = max(2, size // 3)
+    row = size + pad
+    out = Image.new("RGB", (w, h + 2 * row + pad), BACKGROUND)
+    out.paste(img, (0, 0))
+    d = ImageDraw.Draw(out)
+    d.text((pad, h + pad), caption, fill=TEXT, font=font, anchor="lt")
+    length = scale_length(metres_per_pixel * w)
+    bar = round(length / metres_per_pixel)
+    y = h + row + pad + size // 2
+    d.rectangle([pad, y - 1, pad + bar, y + 1], fill=TEXT)
+    d.text((2 * pad + bar, y), f"{length:g} m", fill=TEXT, font=font, anchor="lm")
+    return out
 
 
 def _colours(scene: Scene, focus: str | None) -> np.ndarray:
@@ -56,8 +107,8 @@ def save_preview(
     scene: Scene, traj: Trajectory, path: str | Path, *, size: int = 256, focus: str | None = None
 ) -> Path:
     """Write ``path``: ``.gif`` animates the frames at the scene's frame rate; ``.png`` overlays
-    every frame as a fading trail with each body's path. ``size`` is the image width in pixels.
-    Returns the path."""
+    every frame as a fading trail with each body's path. Both are captioned by :func:`annotate`
+    in a band below the scene. ``size`` is the image width in pixels. Returns the path."""
     from PIL import Image, ImageDraw
 
     path = Path(path)
@@ -111,7 +162,8 @@ def save_preview(
         for t in range(cover.shape[0]):
             img = Image.fromarray(_composite(cover[t], colours, base).round().astype(np.uint8))
             markers(img, t)
-            frames.append(img)
+            caption = f"{scene.name}   t = {traj.times[t]:.2f} s"
+            frames.append(annotate(img, scene, states[t, :, :2], caption, px, 1 / sx))
         frames[0].save(
             path,
             save_all=True,
@@ -135,6 +187,11 @@ def save_preview(
         pts = [px(x, y) for x, y in states[:, i, :2]]
         if len(pts) > 1:
             d.line(pts, fill=tuple(int(c * 0.6) for c in colours[i]), width=1)
-    markers(img, cover.shape[0] - 1)
-    img.save(path)
+    last = cover.shape[0] - 1
+    markers(img, last)
+    caption = (
+        f"{scene.name}   t = {traj.times[keys[0]]:.2f} to {traj.times[last]:.2f} s "
+        f"({len(keys)} snapshots, faint: early)"
+    )
+    annotate(img, scene, states[last, :, :2], caption, px, 1 / sx).save(path)
     return path

@@ -1,11 +1,13 @@
 """The sweep figures: win rates count ties as half, the landscape is zero at the nominal value and
 draws with the table's renderer, and tables from before renderer columns plot (``physbench plot``
-itself: tests/commands/test_plot.py)."""
+itself: tests/commands/test_plot.py). Every axis says its unit, legends lie outside the axes, titles
+name the engine and blur, and iterations are numbered as in the long table."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -110,3 +112,92 @@ def test_a_table_without_renderer_columns_plots(tmp_path: Path) -> None:
     figures = plot_all(old, tmp_path / "plots", seeds=1, landscape_seeds=1)
     assert [p.name for p in figures["landscape"]] == ["landscape_three_circles.png"]
     assert all(figures.values()), figures
+
+
+@pytest.fixture(scope="module")
+def figures(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """Every figure ``plot_all`` draws for a two-estimator sweep (3 iterations, blur 0.5 px),
+    by file name, kept for inspection."""
+    from physbench.bench import plots
+
+    out = tmp_path_factory.mktemp("sweep")
+    spec = parse_spec(
+        {
+            "name": "figs",
+            "estimators": ["random", "tpe"],
+            "seeds": 2,
+            "iterations": 3,
+            "resolution": 16,
+            "blur": 0.5,
+            "scenes": [{"name": "three_circles", "unknowns": ["mass", "elasticity"]}],
+        }
+    )
+    df = run_sweep(spec, out, executor="serial", progress=False).table
+    drawn: dict[str, Any] = {}
+    save = plots._save
+
+    def keep(fig: Any, path: Path) -> Path:
+        drawn[path.name] = fig
+        return save(fig, path)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(plots, "_save", keep)
+        plot_all(df, out / "plots", seeds=2, landscape_seeds=1)
+    return drawn
+
+
+def _legend_outside_the_axes(fig: Any) -> bool:
+    """One figure legend, overlapping no axes (and no per-axes legend)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)  # the figure was closed when saved
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    (legend,) = fig.legends
+    box = legend.get_window_extent(renderer)
+    return all(ax.get_legend() is None for ax in fig.axes) and not any(
+        box.overlaps(ax.get_window_extent(renderer)) for ax in fig.axes
+    )
+
+
+def test_the_convergence_figure_says_what_it_plots_with_units(figures: dict[str, Any]) -> None:
+    fig = figures["convergence_three_circles.png"]
+    mass, _ = fig.axes
+    assert mass.get_ylabel() == "normalized MSE (dimensionless)"
+    assert mass.get_xlabel() == "iteration (0: initial guess)"
+    # iterations as numbered in the long table: 0 (the initial guess) to 2
+    assert all(line.get_xdata().tolist() == [0, 1, 2] for line in mass.lines[:2])
+    title = fig.get_suptitle()
+    assert "engine pymunk" in title and "blur 0.5 px" in title
+    assert "best-so-far iterate by image MSE" in title
+    assert _legend_outside_the_axes(fig)
+
+
+def test_trajectory_axes_carry_the_unknowns_units(figures: dict[str, Any]) -> None:
+    fig = figures["trajectories_three_circles_mass.png"]
+    tpe_or_random = fig.axes
+    assert [ax.get_xlabel() for ax in tpe_or_random] == ["a.mass (kg)"] * 2
+    assert tpe_or_random[0].get_ylabel() == "b.mass (kg)"
+    assert "engine pymunk" in fig.get_suptitle() and "blur 0.5 px" in fig.get_suptitle()
+    assert [t.get_text() for t in fig.legends[0].get_texts()] == ["seed 0", "seed 1"]
+    assert _legend_outside_the_axes(fig)
+
+
+def test_the_landscape_axes_carry_units_and_its_legend_names_bodies(
+    figures: dict[str, Any],
+) -> None:
+    fig = figures["landscape_three_circles.png"]
+    mass, elasticity = fig.axes
+    assert mass.get_xlabel() == "Δmass from nominal (kg)"
+    assert elasticity.get_xlabel() == "Δelasticity from nominal (dimensionless)"
+    assert mass.get_ylabel() == "image MSE vs nominal (pixel value²)"
+    assert "engine pymunk" in fig.get_suptitle()
+    assert [t.get_text() for t in fig.legends[0].get_texts()] == ["body a", "body b"]
+    assert _legend_outside_the_axes(fig)
+
+
+def test_the_win_rate_colour_bar_is_labelled(figures: dict[str, Any]) -> None:
+    fig = figures["win_rate.png"]
+    heat = fig.axes[0]
+    assert heat.images[0].colorbar.ax.get_ylabel() == "share won by the row (ties: half)"
+    assert heat.get_ylabel() == "estimator (row)" and heat.get_xlabel() == "opponent (column)"
