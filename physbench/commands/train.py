@@ -95,18 +95,12 @@ def main(args: argparse.Namespace) -> int:
     from physbench.params import ParamSpace, split_params
     from physbench.plugins import get_registry
     from physbench.requirements import require
+    from physbench.scenes.generator import resolve_scene
 
     require("estimator", "resnet3d", get_registry().get("estimator", "resnet3d"))
     params = split_params(args.params)
-    scene_name = args.scene or DEFAULT_SCENE
-    if scene_name.endswith(".toml") or Path(scene_name).is_file():
-        # The data generator draws a new scene instance per sample group by seed.
-        raise PhysbenchError(
-            f"--scene {scene_name!r}: train needs a registered scene generator (a fresh instance "
-            "per sample group), and a scene file is one instance; give a name from "
-            "`physbench scenes`"
-        )
-    scene = get_registry().get("scene", scene_name)(0)
+    scene_name = args.scene or DEFAULT_SCENE  # a registered generator or a scene TOML file
+    scene = resolve_scene(scene_name, 0)
     ParamSpace.from_scene(scene, params)  # unknown parameter names fail here, listing the known
     renderer, renderer_options = renderer_choice(args)
     make_renderer(renderer, renderer_options, resolution=64, mode="mark")  # fail before training

@@ -30,9 +30,14 @@ def scene_generator(
     return wrap
 
 
+def is_scene_file(name_or_path: str) -> bool:
+    """Whether a ``--scene`` value names a scene TOML file rather than a registered generator."""
+    return name_or_path.endswith(".toml") or Path(name_or_path).is_file()
+
+
 def resolve_scene(name_or_path: str, seed: int = 0) -> Scene:
     """A registered scene generator's instance for ``seed``, or a scene loaded from a TOML path."""
-    if name_or_path.endswith(".toml") or Path(name_or_path).is_file():
+    if is_scene_file(name_or_path):
         from physbench.scene_toml import load_scene
 
         return load_scene(name_or_path)

@@ -39,3 +39,29 @@ def test_training_without_torch_names_the_extra(
     )
     assert "pip install 'physbench[learn]'" in capsys.readouterr().err
     assert not (tmp_path / "w").exists()
+
+
+def test_a_scene_file_trains_weights_that_run_on_it(
+    capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    pytest.importorskip("torch")
+    from physbench.scene_toml import dumps_scene
+    from physbench.scenes.generator import resolve_scene
+
+    scene = resolve_scene("three_circles", 3)
+    toml = tmp_path / "my_table.toml"
+    toml.write_text(dumps_scene(scene))
+    tiny = ["--samples", "16", "--batch", "8", "--eval-every", "16", "--val-groups", "1"]
+    tiny += ["--eval-seeds", "0", "--widths", "4,8,8,8", "--resolution", "16", "--frames", "6"]
+    out = tmp_path / "w"
+    argv = ["train", "--scene", str(toml), "--params", "mass", "--out", str(out), "-q", *tiny]
+    assert main([*argv, "--workers", "0", "--threads", "1"]) == 0
+    weights = out / f"{scene.name}__mass.safetensors"
+    assert weights.is_file(), sorted(p.name for p in out.iterdir())
+    capsys.readouterr()
+    run = ["run", "--scene", str(toml), "--estimator", "resnet3d", "--iterations", "2"]
+    assert main([*run, "-o", f"weights={weights}", "--json", "-q"]) == 0
+    import json
+
+    history = json.loads(capsys.readouterr().out)
+    assert history["meta"]["scene"] == scene.name and len(history["iterations"]) == 2

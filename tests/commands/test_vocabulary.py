@@ -154,16 +154,6 @@ def test_discover_resolves_a_registered_scene_name(
     assert "recording file" in err and "does not exist" in err, err
 
 
-def test_train_refuses_a_scene_file_with_the_reason(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    pytest.importorskip("torch")
-    toml = tmp_path / "s.toml"
-    toml.write_text("")
-    assert main(["train", "--scene", str(toml), "--out", str(tmp_path / "w")]) == 2
-    assert "needs a registered scene generator" in capsys.readouterr().err
-
-
 class Terminal(io.StringIO):
     def isatty(self) -> bool:
         return True

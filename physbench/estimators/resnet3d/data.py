@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -19,13 +19,18 @@ from physbench.estimators.resnet3d.inputs import make_input
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
+if TYPE_CHECKING:
+    from physbench.scene import Scene
+
 TRAIN_SEED0 = 1 << 24
 VAL_SEED0 = 1 << 30
 
 
 @dataclass(frozen=True)
 class DataSpec:
-    """What to simulate for training; stored in the weights' sidecar."""
+    """What to simulate for training; stored in the weights' sidecar. ``scene``: a registered
+    scene generator (a fresh instance per sample group) or a scene TOML file (one instance, only
+    the unknowns vary)."""
 
     scene: str
     params: tuple[str, ...]
@@ -42,6 +47,25 @@ class DataSpec:
     # the render resolution, the blur of the loop's observation model.
     blur_max: float = 0.0
     blur_prob: float = 0.5
+
+    def instance(self, seed: int, **options: Any) -> Scene:
+        """Called for each sample group, validation group and evaluation run: the scene instance
+        ``seed`` (a file's scene for every seed), built with :attr:`scene_options` and
+        ``options``."""
+        from physbench.errors import PhysbenchError
+        from physbench.plugins import get_registry
+        from physbench.scene_toml import load_scene
+        from physbench.scenes.generator import is_scene_file
+
+        merged = {**self.scene_options, **options}
+        if is_scene_file(self.scene):
+            if merged:
+                raise PhysbenchError(
+                    f"scene options {merged} for the scene file {self.scene!r}: a file is one "
+                    "instance and takes none; edit the file instead"
+                )
+            return load_scene(self.scene)
+        return get_registry().get("scene", self.scene)(seed, **merged)
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -60,10 +84,10 @@ class PairMaker:
 
     def __init__(self, spec: DataSpec) -> None:
         from physbench.experiment import make_renderer
-        from physbench.plugins import create, get_registry
+        from physbench.plugins import create
 
         self.spec = spec
-        self.generator = get_registry().get("scene", spec.scene)
+        spec.instance(0)  # an unknown name or a bad file fails here, not in a worker
         self.sim = create("simulator", spec.engine)
         self.renderer = make_renderer(
             spec.renderer, spec.renderer_options, resolution=spec.render_resolution, mode="mark"
@@ -75,7 +99,7 @@ class PairMaker:
         from physbench.params import ParamSpace
 
         spec = self.spec
-        scene = self.generator(seed, **spec.scene_options)
+        scene = spec.instance(seed)
         space = ParamSpace.from_scene(scene, spec.params)
         rng = np.random.default_rng([seed, 7])
         # Per simulation: its parameters and, per unknown body, the frames with that body marked.

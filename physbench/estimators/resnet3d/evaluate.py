@@ -33,12 +33,11 @@ def evaluate_weights(
     from physbench.loop import draw_problem, refine
     from physbench.observation import simulate_observation
     from physbench.params import ParamSpace
-    from physbench.plugins import create, get_registry
+    from physbench.plugins import create
     from physbench.render.observe import ObservationModel
 
     _, meta = weights.load(path)
     spec = DataSpec.from_dict(meta["data"])
-    generator = get_registry().get("scene", spec.scene)
     sim = create("simulator", engine)
 
     def renderer():  # the renderer the weights were trained on
@@ -50,7 +49,7 @@ def evaluate_weights(
     camera = ObservationModel(blur=blur)
     rows = []
     for seed in seeds:
-        scene = generator(seed, **{**spec.scene_options, **(scene_options or {})})
+        scene = spec.instance(seed, **(scene_options or {}))
         space = ParamSpace.from_scene(scene, spec.params, bodies)
         truth, initial = draw_problem(space, seed)
         obs = simulate_observation(scene, truth, sim, observer, marked=space.bodies, camera=camera)

@@ -60,15 +60,14 @@ def learning_rate(cfg: TrainConfig, seen: int, wall_s: float = 0.0) -> float:
 
 
 def weights_name(spec: DataSpec) -> str:
-    return f"{spec.scene}__{'+'.join(sorted(spec.params))}"
+    """``SCENE__PARAMS``, SCENE the scene's name (a file's ``name``, not its path)."""
+    return f"{spec.instance(0).name}__{'+'.join(sorted(spec.params))}"
 
 
 def _ranges(spec: DataSpec) -> dict[str, list[float]]:
     from physbench.params import ParamSpace
-    from physbench.plugins import get_registry
 
-    scene = get_registry().get("scene", spec.scene)(0, **spec.scene_options)
-    space = ParamSpace.from_scene(scene, spec.params)
+    space = ParamSpace.from_scene(spec.instance(0), spec.params)
     return {u.name: [u.low, u.high] for u in space.unknowns}
 
 
@@ -231,6 +230,7 @@ def train(
     bar.close()
     best_state, _ = weights.load(out / "best.safetensors")
     meta = {
+        "scene": spec.instance(0).name,  # what the estimator looks weights up by
         "data": spec.to_dict(),
         "net": net_cfg.to_dict(),
         "ranges": _ranges(spec),

@@ -30,7 +30,8 @@ class WeightsInfo:
 
     @property
     def scene(self) -> str:
-        return str(self.meta["data"]["scene"])
+        """The scene's name (weights trained on a scene file record it beside the file's path)."""
+        return str(self.meta.get("scene") or self.meta["data"]["scene"])
 
     @property
     def params(self) -> tuple[str, ...]:
