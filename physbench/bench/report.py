@@ -93,7 +93,7 @@ def build(
     ]
     parts += ["<h2>Next to the paper</h2>", _table(side_by_side(st))]
     parts += [
-        "<h2>Per configuration</h2><p class='note'>median and 95 % percentile-bootstrap interval "
+        "<h2>Per configuration</h2><p class='note'>median and 95 % BCa bootstrap interval "
         "of the mean over seeds.</p>",
         _table(detail(st)),
     ]

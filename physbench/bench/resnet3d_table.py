@@ -3,10 +3,11 @@
 1. The criteria, for ``resnet3d`` per Table 1 row: the paper's NN value, normalized min MSE after
    2 and after 11 iterations, their ratio, and the ratio of blurred to sharp after 11 iterations.
    Ratios are ratios of means over the same seeds (same scene instances and initial guesses), with
-   a 90 % paired bootstrap interval over seeds, so a reader can tell a real miss from the spread of
-   heavy-tailed errors. Two more blur columns: the ratio on seeds 0-9 only (the issue's 10 runs),
-   and a diagnostic, the ratio of the *final* iterates' errors: the metric picks the best iterate
-   by image MSE, which under blur compares blurred with sharp frames and can keep a worse iterate.
+   a 90 % paired BCa bootstrap interval over seeds (:func:`~physbench.bench.tables.ratio_ci`), so a
+   reader can tell a real miss from the spread of heavy-tailed errors. Two more blur columns: the
+   ratio on seeds 0-9 only (the issue's 10 runs), and a diagnostic, the ratio of the *final*
+   iterates' errors: the metric picks the best iterate by image MSE, which under blur compares
+   blurred with sharp frames and can keep a worse iterate.
 2. Every estimator: mean ± std after 2 and after 11 iterations, per scene, unknowns, bodies, blur.
 
 ``benchmarks/resnet3d_table.py`` prints :func:`table` of a sweep folder (results/resnet3d/table.md).

@@ -267,21 +267,57 @@ def paper_value(scene: str, unknowns: str, which: str) -> tuple[float, float] | 
     return PAPER.get((scene, frozenset(unknowns.split("+"))), {}).get(which)
 
 
+def _bca(
+    data: tuple[np.ndarray, ...], statistic: Any, *, level: float, n: int, seed: int
+) -> tuple[float, float]:
+    """BCa interval of ``statistic`` over the seeds (resampled together when ``data`` holds more
+    than one sample). BCa needs a spread of resampled statistics: where they are all equal (equal
+    values, or a ratio that pairing makes constant) it is undefined, and the percentile interval
+    of the same resamples, that one value, is returned instead."""
+    import warnings
+
+    from scipy.stats import DegenerateDataWarning, bootstrap
+
+    with warnings.catch_warnings(), np.errstate(divide="ignore", invalid="ignore"):
+        warnings.simplefilter("ignore", DegenerateDataWarning)
+        res = bootstrap(
+            data,
+            statistic,
+            n_resamples=n,
+            paired=len(data) > 1,
+            vectorized=True,
+            confidence_level=level,
+            method="BCa",
+            rng=np.random.default_rng(seed),
+        )
+    lo, hi = res.confidence_interval
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        a = (1 - level) / 2
+        lo, hi = np.quantile(res.bootstrap_distribution, [a, 1 - a])
+    return float(lo), float(hi)
+
+
+def _mean(x: np.ndarray, axis: int = -1) -> np.ndarray:
+    return x.mean(axis=axis)
+
+
+def _ratio_of_means(x: np.ndarray, y: np.ndarray, axis: int = -1) -> np.ndarray:
+    return x.mean(axis=axis) / y.mean(axis=axis)
+
+
 def bootstrap_ci(
     values: Sequence[float], *, level: float = 0.95, n: int = BOOTSTRAP, seed: int = 0
 ) -> tuple[float, float]:
-    """Percentile bootstrap interval of the mean (resampling seeds; a fixed generator, so the
-    same values always give the same interval)."""
+    """BCa bootstrap interval of the mean, resampling seeds with a fixed generator (the same
+    values always give the same interval). BCa rather than percentile: errors here are
+    heavy-tailed (std ≈ mean) and the mean's resampling distribution is skewed. No values give
+    NaNs; one value, or values all equal, give that value at both ends."""
     v = np.asarray(values, dtype=float)
     if v.size == 0:
         return math.nan, math.nan
     if v.size == 1:
         return float(v[0]), float(v[0])
-    idx = np.random.default_rng(seed).integers(0, v.size, size=(n, v.size))
-    means = v[idx].mean(axis=1)
-    a = (1 - level) / 2
-    lo, hi = np.quantile(means, [a, 1 - a])
-    return float(lo), float(hi)
+    return _bca((v,), _mean, level=level, n=n, seed=seed)
 
 
 def ratio_ci(
@@ -292,14 +328,15 @@ def ratio_ci(
     n: int = BOOTSTRAP,
     seed: int = 0,
 ) -> tuple[float, float, float]:
-    """``mean(num) / mean(den)`` of paired values (the same seeds) and its percentile-bootstrap
-    interval, resampling the pairs together so shared per-seed difficulty cancels."""
+    """``mean(num) / mean(den)`` of paired values (the same seeds) and its BCa bootstrap
+    interval, resampling the pairs together so shared per-seed difficulty cancels. A single pair,
+    or pairs whose resampled ratio never varies (``num`` proportional to ``den``), give the ratio
+    at both ends."""
     a, b = np.asarray(num, dtype=float), np.asarray(den, dtype=float)
-    idx = np.random.default_rng(seed).integers(0, a.size, size=(n, a.size))
-    lo, hi = np.quantile(
-        a[idx].mean(axis=1) / b[idx].mean(axis=1), [(1 - level) / 2, (1 + level) / 2]
-    )
-    return float(a.mean() / b.mean()), float(lo), float(hi)
+    point = float(a.mean() / b.mean())
+    if a.size == 1:
+        return point, point, point
+    return (point, *_bca((a, b), _ratio_of_means, level=level, n=n, seed=seed))
 
 
 def _ordered_groups(df: pd.DataFrame, cols: Sequence[str]) -> list[tuple[Any, ...]]:
@@ -567,7 +604,7 @@ def write_summary(df: pd.DataFrame, out: Path, *, title: str) -> pd.DataFrame:
         markdown(side_by_side(st)),
         "\n## Per configuration\n",
         "Normalized min MSE after N iterations over seeds: mean ± sample std, median, "
-        f"95 % percentile-bootstrap interval of the mean ({BOOTSTRAP} resamples), cells that ran "
+        f"95 % BCa bootstrap interval of the mean ({BOOTSTRAP} resamples), cells that ran "
         "(n) and failed.\n",
         markdown(detail(st)),
     ]

@@ -16,7 +16,7 @@ import pytest
 
 from physbench.bench.runner import run_sweep
 from physbench.bench.spec import parse_spec
-from physbench.bench.tables import SCHEMA, TIMINGS, bootstrap_ci, without_timings
+from physbench.bench.tables import SCHEMA, TIMINGS, without_timings
 from physbench.errors import PhysbenchError
 from physbench.estimators.base import CorrectionEstimator
 from physbench.hookspecs import hookimpl
@@ -121,14 +121,6 @@ def test_long_table_summary_and_failed_cells(tmp_path: Path, flaky_registry: Non
     assert (retried.ran, retried.failed) == (4, 4)
     log = json.loads((tmp_path / "run.json").read_text())
     assert [r["ran"] for r in log["runs"]] == [8, 0, 4]
-
-
-def test_bootstrap_interval_is_deterministic() -> None:
-    v = [1.0, 2.0, 3.0, 10.0]
-    assert bootstrap_ci(v) == bootstrap_ci(v)
-    lo, hi = bootstrap_ci(v)
-    assert 1.0 <= lo < np.mean(v) < hi <= 10.0
-    assert bootstrap_ci([5.0]) == (5.0, 5.0)
 
 
 @pytest.mark.slow

@@ -17,6 +17,7 @@ KINDS = ("simulator", "renderer", "effect", "estimator")
 SETTINGS: dict[str, dict[str, Any]] = {
     "tpe": {"kit": {"bad_options": [{"startup": -1}, {"candidates": 0}, {"gamma": 1.5}]}},
     "cmaes": {"kit": {"bad_options": [{"sigma": 0.0}, {"popsize": 1}, {"elitist": "yes"}]}},
+    "nevergrad": {"kit": {"bad_options": [{"optimizer": "NoSuchOptimizer"}]}},
     "optuna": {"kit": {"bad_options": [{"sampler": "grid"}, {"startup": 2.5}]}},
     "resnet3d": {
         # Shipped weights for mass; the toy task's frames are resampled to the network's input.
@@ -53,7 +54,7 @@ def test_every_kind_has_builtins() -> None:
         "camera",
     }
     assert by_kind["effect"] == {cls.name for cls in BUILTIN_EFFECTS}
-    assert {"random", "tpe", "cmaes", "optuna", "resnet3d"} <= by_kind["estimator"]
+    assert {"random", "tpe", "cmaes", "nevergrad", "optuna", "resnet3d"} <= by_kind["estimator"]
     assert "scipy" not in by_kind["estimator"]  # the example plugin tests itself
     assert set(SETTINGS) <= by_kind["estimator"]
 
