@@ -38,11 +38,17 @@ def test_every_file_of_the_package_besides_its_code_is_package_data():
     assert "estimators/resnet3d/weights/stacked_boxes__mass.safetensors" in shipped
 
 
-def test_the_licence_is_declared_for_the_wheel():
+def test_the_licences_are_declared_for_the_wheel():
+    # physbench is MIT; the billiards data set it redistributes is Apache-2.0, whose text must
+    # travel with it.
     project = PYPROJECT["project"]
-    assert project["license"] == "MIT"
-    assert project["license-files"] == ["LICENSE"]
+    assert project["license"] == "MIT AND Apache-2.0"
+    billiards = "physbench/datasets/data/billiards_dogan/LICENSE"
+    assert project["license-files"] == ["LICENSE", billiards]
     assert "MIT License" in (ROOT.parent / "LICENSE").read_text(encoding="utf-8")
+    apache = (ROOT.parent / billiards).read_text(encoding="utf-8")
+    assert "Apache License" in apache and "Version 2.0, January 2004" in apache
+    assert "Apache-2.0" in (ROOT / "datasets/data/billiards_dogan/PROVENANCE.md").read_text()
 
 
 def test_the_version_has_one_source():
