@@ -7,6 +7,7 @@ import argparse
 import importlib
 import os
 import sys
+import traceback
 from collections.abc import Sequence
 
 #: subcommand -> (module in physbench.commands, one-line help)
@@ -40,6 +41,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         "the methods.",
     )
     parser.add_argument("--version", action="store_true", help="print the version and exit")
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of an unexpected error"
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (module, help_) in COMMANDS.items():
         p = sub.add_parser(name, help=help_, description=help_)
@@ -50,7 +54,32 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; every way it can end is an exit status and at most one line on stderr
+    (``--debug`` adds the traceback): 2 for errors physbench or a plugin reports, 70 for a bug,
+    130 for Ctrl-C, 141 when the reader of stdout left."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    command = next((a for a in argv if not a.startswith("-")), None)
+    debug = "--debug" in argv
+    try:
+        return _run(argv, debug)
+    except KeyboardInterrupt:
+        if debug:
+            raise
+        print("physbench: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # the last guard: physbench's own bug, never a plugin's
+        if debug:
+            raise
+        where = f"physbench {command}" if command in COMMANDS else "physbench"
+        print(
+            f"{where}: internal error: {type(exc).__name__}: {exc} (please report it at "
+            f"{issue_tracker()} with the command; rerun with --debug for the traceback)",
+            file=sys.stderr,
+        )
+        return 70  # EX_SOFTWARE
+
+
+def _run(argv: list[str], debug: bool) -> int:
     chosen = next((a for a in argv if not a.startswith("-")), None)
     parser = build_parser(chosen if chosen in COMMANDS else "")
     args = parser.parse_args(argv)
@@ -66,8 +95,14 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     module = importlib.import_module(f"physbench.commands.{COMMANDS[args.command][0]}")
     try:
-        return int(module.main(args) or 0)
+        try:
+            return int(module.main(args) or 0)
+        except (Exception, SystemExit) as exc:
+            _blame_plugin(exc)
+            raise
     except PhysbenchError as exc:
+        if debug:
+            traceback.print_exc()
         print(f"physbench {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:
@@ -75,6 +110,36 @@ def main(argv: Sequence[str] | None = None) -> int:
         # report the failed flush of stdout again at exit.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141  # 128 + SIGPIPE, what a shell reports for a tool killed by the signal
+
+
+def _blame_plugin(exc: BaseException) -> None:
+    """Raise a :class:`~physbench.plugins.ComponentError` from ``exc`` when a third party's
+    plugin raised it where no explicit guard stood (physbench's own errors pass)."""
+    from physbench.errors import PhysbenchError
+
+    if isinstance(exc, PhysbenchError | BrokenPipeError) or "physbench.plugins" not in sys.modules:
+        return
+    from physbench.plugins import ComponentError, blame
+
+    culprit = blame(exc)
+    if culprit is not None:
+        raise ComponentError(*culprit, exc) from exc
+
+
+def issue_tracker() -> str:
+    """Where to report a bug: the ``Issues``/``Bug``/``Tracker`` URL of physbench's metadata
+    (``[project.urls]``), else a plain description."""
+    from importlib.metadata import PackageNotFoundError, metadata
+
+    try:
+        urls = metadata("physbench").get_all("Project-URL") or []
+    except PackageNotFoundError:
+        urls = []
+    for entry in urls:
+        label, _, url = entry.partition(",")
+        if any(w in label.lower() for w in ("issue", "bug", "tracker")) and url.strip():
+            return url.strip()
+    return "the physbench issue tracker"
 
 
 if __name__ == "__main__":

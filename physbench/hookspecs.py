@@ -1,9 +1,10 @@
 """The only hook definitions. A plugin module implements any of them with ``@hookimpl``.
 
-Every hook returns a list of components; the core builds one name-keyed registry per kind and
-fails loudly on a duplicate name. Components subclass the base class of their kind (the contract:
-what the framework calls, and the defaults of every optional member). Register a plugin through the
-entry-point group ``physbench``::
+Every hook returns a list of components; the core builds one name-keyed registry per kind. A name
+that several plugins claim is a conflict that ``physbench plugins`` reports: physbench's own
+component is kept, and between third parties none is used. Components subclass the base class of
+their kind (the contract: what the framework calls, and the defaults of every optional member).
+Register a plugin through the entry-point group ``physbench``::
 
     [project.entry-points.physbench]
     myplugin = "my_package.my_module"

@@ -27,6 +27,7 @@ from physbench.estimators.base import Step, Task
 from physbench.metrics import image_mse
 from physbench.observation import Observation, expected_shape, validate
 from physbench.params import Params, ParamSpace
+from physbench.plugins import guard
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -307,7 +308,8 @@ def refine(
         marked_observation=obs.marked,
     )
     t = time.perf_counter()
-    estimator.start(task, seed=seeds.estimator)
+    with guard("estimator", estimator, "start()"):
+        estimator.start(task, seed=seeds.estimator)
     t_start = time.perf_counter() - t
 
     records: list[Iteration] = []
@@ -317,7 +319,8 @@ def refine(
         traj: Trajectory | None = None
         t0 = time.perf_counter()
         try:
-            traj = simulator.simulate(scene, params, effects=effects)
+            with guard("simulator", simulator, "simulate()"):
+                traj = simulator.simulate(scene, params, effects=effects)
         except SimulationError as exc:
             failed = str(exc)
         t1 = time.perf_counter()
@@ -327,13 +330,15 @@ def refine(
             marked = dict.fromkeys(space.bodies, frames) if per_object else {}
             loss = FAILED_LOSS
         else:
-            frames = renderer.render(scene, traj)
-            if per_object:
-                marked = {b: renderer.render(scene, traj, focus=b) for b in space.bodies}
+            with guard("renderer", renderer, "render()"):
+                frames = renderer.render(scene, traj)
+                if per_object:
+                    marked = {b: renderer.render(scene, traj, focus=b) for b in space.bodies}
             loss = image_mse(frames, obs.frames)
         t2 = time.perf_counter()
         step = Step(k, dict(params), frames, loss, traj, marked=marked)
-        proposal = estimator.propose(step)
+        with guard("estimator", estimator, "propose()"):
+            proposal = estimator.propose(step)
         t3 = time.perf_counter()
         nxt = _check_proposal(name, space, proposal, k)
 

@@ -2,8 +2,11 @@
 
 Built-ins are declared in physbench's own ``[project.entry-points.physbench]``, the same path a
 third party uses. A plugin that fails to import (or whose hooks fail, or that returns a class that
-does not subclass its kind's base class) is recorded in :attr:`Registry.failed` and skipped; two
-components of one kind with the same name raise :class:`~physbench.errors.PluginError`.
+does not subclass its kind's base class) is recorded in :attr:`Registry.failed` and skipped. Two
+components of one kind with the same name are a :class:`Conflict`: physbench's own wins over a third
+party's, and between third parties neither is used, so one bad package never stops the command.
+What a third party's component raises when the framework calls it becomes a
+:class:`ComponentError` naming the component, its plugin and its package (:func:`guard`).
 ``PHYSBENCH_PLUGINS="pkg.mod,other.mod"`` registers modules explicitly, without packaging
 (Gymnasium's ``module:Name`` idea, as a fallback).
 """
@@ -13,7 +16,8 @@ from __future__ import annotations
 import importlib
 import importlib.metadata as md
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any
@@ -21,7 +25,11 @@ from typing import Any
 import pluggy
 
 from physbench import hookspecs
-from physbench.errors import PluginError, UnknownNameError
+from physbench.errors import PhysbenchError, PluginError, UnknownNameError
+
+#: The package name of physbench's own components: a conflict keeps them, and what they raise is
+#: physbench's bug, not a plugin's.
+OWN = "physbench"
 
 #: Hook name -> component kind.
 KINDS: dict[str, str] = {
@@ -51,12 +59,55 @@ class FailedPlugin:
     error: str
 
 
+def _who(c: Component) -> str:
+    return f"plugin {c.plugin!r} ({c.package} {c.version})"
+
+
+@dataclass(frozen=True)
+class Conflict:
+    """Components of one kind that share a name. ``kept`` is physbench's own, or ``None`` when
+    every side is a third party's (then none of them is used)."""
+
+    kind: str
+    name: str
+    kept: Component | None
+    ignored: tuple[Component, ...]
+
+    def describe(self) -> str:
+        if self.kept is not None:
+            return (
+                f"{self.kind} {self.name!r} is physbench's own; the one of "
+                f"{', '.join(_who(c) for c in self.ignored)} is ignored: rename it in that package "
+                "or uninstall it"
+            )
+        return (
+            f"{self.kind} {self.name!r} is provided by "
+            f"{' and by '.join(_who(c) for c in self.ignored)}; none of them is used: rename it "
+            "in all but one package or uninstall all but one"
+        )
+
+
+class ComponentError(PluginError):
+    """A third party's component raised (or called ``sys.exit``) where the framework called
+    it; the message names the component, its plugin and its package."""
+
+    def __init__(self, component: Component, call: str, exc: BaseException) -> None:
+        self.component, self.call = component, call
+        what = type(exc).__name__ + (f": {exc}" if str(exc) else "")
+        super().__init__(
+            f"{component.kind} {component.name!r} of {_who(component)} failed in {call}: {what}; "
+            "this is a fault of that plugin: report it to its authors (rerun with --debug for the "
+            "traceback)"
+        )
+
+
 @dataclass
 class Registry:
     components: dict[str, dict[str, Component]] = field(
         default_factory=lambda: {k: {} for k in KINDS.values()}
     )
     failed: list[FailedPlugin] = field(default_factory=list)
+    conflicts: list[Conflict] = field(default_factory=list)
 
     def names(self, kind: str) -> list[str]:
         return sorted(self.components[kind])
@@ -67,6 +118,9 @@ class Registry:
         try:
             return self.components[kind][name].obj
         except KeyError:
+            for c in self.conflicts:
+                if (c.kind, c.name) == (kind, name):
+                    raise PluginError(c.describe()) from None
             raise UnknownNameError(kind, name, self.components[kind]) from None
 
     def info(self, kind: str, name: str) -> Component:
@@ -77,6 +131,8 @@ class Registry:
         return [c for kind in KINDS.values() for _, c in sorted(self.components[kind].items())]
 
     def add(self, comp: Component) -> None:
+        """Add one component; a name already taken raises :class:`PluginError`
+        (:func:`build_registry` turns those into conflicts before adding)."""
         known = self.components[comp.kind]
         if comp.name in known:
             old = known[comp.name]
@@ -87,6 +143,45 @@ class Registry:
                 "rename one of them or uninstall one package"
             )
         known[comp.name] = comp
+
+    def owner(self, kind: str, obj: object) -> Component | None:
+        """The registered component ``obj`` is (a scene generator) or is an instance of."""
+        for comp in self.components[kind].values():
+            if comp.obj is obj or comp.obj is type(obj):
+                return comp
+        return None
+
+    def _resolve(self, candidates: list[Component]) -> None:
+        """Add every candidate; a name that several share becomes a :class:`Conflict`."""
+        by_name: dict[tuple[str, str], list[Component]] = {}
+        for comp in candidates:
+            by_name.setdefault((comp.kind, comp.name), []).append(comp)
+        for (kind, name), comps in by_name.items():
+            own = [c for c in comps if c.package == OWN]
+            if len(comps) == 1:
+                self.add(comps[0])
+                continue
+            kept = own[0] if len(own) == 1 else None
+            if kept is not None:
+                self.add(kept)
+            ignored = tuple(c for c in comps if c is not kept)
+            self.conflicts.append(Conflict(kind, name, kept, ignored))
+
+
+@contextmanager
+def guard(kind: str, obj: object, call: str) -> Iterator[None]:
+    """Around each call the framework makes into a component: what a third party's component
+    raises, ``SystemExit`` included, becomes a :class:`ComponentError`. Physbench's own errors and
+    those of physbench's own components (its bugs) pass unchanged."""
+    try:
+        yield
+    except PhysbenchError:
+        raise
+    except (Exception, SystemExit) as exc:
+        comp = get_registry().owner(kind, obj)  # looked up only on failure: the call stays cheap
+        if comp is None or comp.package == OWN:
+            raise
+        raise ComponentError(comp, call, exc) from exc
 
 
 def _dist_of(ep: md.EntryPoint) -> tuple[str, str]:
@@ -102,7 +197,7 @@ def _register(
     try:
         pm.register(plugin, name=name)
         pm.check_pending()
-    except Exception as exc:  # a plugin may fail in any way; it must never be fatal
+    except (Exception, SystemExit) as exc:  # a plugin may fail in any way; never fatal
         if pm.is_registered(plugin):
             pm.unregister(plugin)
         reg.failed.append(FailedPlugin(name, pkg, ver, f"{type(exc).__name__}: {exc}"))
@@ -152,7 +247,7 @@ def build_registry(
             pkg, ver = _dist_of(ep)
             try:
                 plugin = ep.load()
-            except Exception as exc:
+            except (Exception, SystemExit) as exc:  # sys.exit() at import included
                 reg.failed.append(FailedPlugin(ep.name, pkg, ver, f"{type(exc).__name__}: {exc}"))
                 continue
             if _register(pm, reg, plugin, ep.name, pkg, ver):
@@ -165,7 +260,7 @@ def build_registry(
                 modname, _, attr = spec.partition(":")
                 mod: ModuleType | Any = importlib.import_module(modname)
                 plugin = getattr(mod, attr) if attr else mod
-            except Exception as exc:
+            except (Exception, SystemExit) as exc:
                 reg.failed.append(
                     FailedPlugin(spec, "PHYSBENCH_PLUGINS", "-", f"{type(exc).__name__}: {exc}")
                 )
@@ -177,12 +272,13 @@ def build_registry(
             origin[name] = (name, "-")
 
     bases = _bases()
+    candidates: list[Component] = []
     for hook, kind in KINDS.items():
         for impl in getattr(pm.hook, hook).get_hookimpls():
             pkg, ver = origin.get(impl.plugin_name, ("?", "?"))
             try:
                 items = list(impl.function() or [])
-            except Exception as exc:
+            except (Exception, SystemExit) as exc:
                 reg.failed.append(
                     FailedPlugin(
                         impl.plugin_name, pkg, ver, f"{hook} raised {type(exc).__name__}: {exc}"
@@ -197,7 +293,8 @@ def build_registry(
                 if breach is not None:
                     reg.failed.append(FailedPlugin(impl.plugin_name, pkg, ver, f"{hook} {breach}"))
                     continue
-                reg.add(Component(kind, name, obj, impl.plugin_name, pkg, ver))
+                candidates.append(Component(kind, name, obj, impl.plugin_name, pkg, ver))
+    reg._resolve(candidates)
     return reg
 
 
@@ -216,6 +313,28 @@ def reset_registry(registry: Registry | None = None) -> None:
     """Forget (or replace) the cached registry; for tests and long-lived hosts."""
     global _REGISTRY
     _REGISTRY = registry
+
+
+def blame(exc: BaseException) -> tuple[Component, str] | None:
+    """The third party's component whose package raised ``exc`` and the function that raised it
+    (the innermost frame in such a package's modules); ``None`` when none did or no registry
+    was built. For the CLI's last guard, behind the explicit :func:`guard` calls."""
+    if _REGISTRY is None:
+        return None
+    tops = {
+        str(getattr(c.obj, "__module__", "")).partition(".")[0]: c
+        for c in _REGISTRY.all()
+        if c.package != OWN
+    }
+    tops.pop("", None)
+    found = None
+    tb = exc.__traceback__
+    while tb is not None:  # outermost to innermost: the last match is where it was raised
+        top = str(tb.tb_frame.f_globals.get("__name__", "")).partition(".")[0]
+        if top in tops:
+            found = tops[top], f"{tb.tb_frame.f_code.co_name}()"
+        tb = tb.tb_next
+    return found
 
 
 def create(kind: str, name: str, **options: Any) -> Any:

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
+
+import pytest
 
 from physbench.cli import COMMANDS, main
 
@@ -76,3 +79,68 @@ def test_a_reader_that_leaves_early_ends_the_command_quietly() -> None:
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=120) == 141
     assert "Traceback" not in err and "BrokenPipeError" not in err, err
+
+
+@pytest.mark.parametrize("delay", [0.3, 1.5])  # while importing and building, and while running
+def test_ctrl_c_ends_the_command_with_one_line_and_status_130(delay: float) -> None:
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "physbench", "run", "--iterations", "100000", "--resolution", "32"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=os.environ,
+    )
+    time.sleep(delay)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.endswith("physbench: interrupted\n") and "Traceback" not in err, err
+
+
+def test_an_unexpected_error_is_one_line_saying_where_to_report_it(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import physbench.commands.plugins as command
+    from physbench.cli import issue_tracker
+
+    def broken(args: object) -> int:
+        raise ValueError("an internal slip")
+
+    monkeypatch.setattr(command, "main", broken)
+    assert main(["plugins"]) == 70
+    assert capsys.readouterr().err == (
+        "physbench plugins: internal error: ValueError: an internal slip (please report it at "
+        f"{issue_tracker()} with the command; rerun with --debug for the traceback)\n"
+    )
+    with pytest.raises(ValueError, match="an internal slip"):
+        main(["--debug", "plugins"])
+
+
+def test_debug_shows_the_traceback_behind_a_reported_error(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["--debug", "run", "--estimator", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("Traceback (most recent call last):")
+    assert err.splitlines()[-1].startswith("physbench run: error: unknown estimator 'nope'")
+
+
+def test_the_issue_tracker_comes_from_the_package_metadata(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import importlib.metadata as md
+
+    from physbench.cli import issue_tracker
+
+    class Meta:
+        def __init__(self, urls: list[str]) -> None:
+            self.urls = urls
+
+        def get_all(self, key: str) -> list[str]:
+            return self.urls if key == "Project-URL" else []
+
+    urls = ["Homepage, https://example.org/pb", "Issues, https://example.org/pb/issues"]
+    monkeypatch.setattr(md, "metadata", lambda name: Meta(urls))
+    assert issue_tracker() == "https://example.org/pb/issues"
+    monkeypatch.setattr(md, "metadata", lambda name: Meta(urls[:1]))
+    assert issue_tracker() == "the physbench issue tracker"

@@ -58,6 +58,7 @@ def site(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 def test_builtins_register_through_entry_points() -> None:
     reg = build_registry(env=False)
     assert not reg.failed, reg.failed
+    assert not reg.conflicts, reg.conflicts
     assert {"pymunk", "box2d"} <= set(reg.names("simulator"))
     assert "raster" in reg.names("renderer")
     assert {
@@ -136,16 +137,84 @@ def test_a_component_outside_its_contract_is_reported_and_skipped(site: Path) ->
     assert "echo_duck" not in reg.names("estimator")
 
 
-def test_duplicate_component_name_fails_loudly(site: Path) -> None:
-    src = (
-        "from physbench.hookspecs import hookimpl\nfrom physbench.simulators.base import "
-        "Simulator\n"
-        "class S(Simulator):\n    name = 'pymunk'\n@hookimpl\ndef register_simulators():\n    "
-        "return [S]\n"
+DUP_PYMUNK = (
+    "from physbench.hookspecs import hookimpl\nfrom physbench.simulators.base import "
+    "Simulator\n"
+    "class S(Simulator):\n    name = 'pymunk'\n@hookimpl\ndef register_simulators():\n    "
+    "return [S]\n"
+)
+
+
+def test_a_third_party_claiming_a_builtin_name_is_a_conflict_and_the_builtin_is_kept(
+    site: Path,
+) -> None:
+    make_dist(site, "pbtest-dup", "0.1", {"dup": "pbtest_dup"}, {"pbtest_dup": DUP_PYMUNK})
+    reg = build_registry(env=False)
+    assert reg.info("simulator", "pymunk").package == "physbench"
+    (conflict,) = reg.conflicts
+    assert conflict.kept is not None and conflict.kept.package == "physbench"
+    assert [(c.plugin, c.package, c.version) for c in conflict.ignored] == [
+        ("dup", "pbtest-dup", "0.1")
+    ]
+    assert "simulator 'pymunk' is physbench's own" in conflict.describe()
+    assert "plugin 'dup' (pbtest-dup 0.1) is ignored" in conflict.describe()
+
+
+def test_third_parties_sharing_a_name_are_all_refused(site: Path) -> None:
+    for tag in ("one", "two"):
+        make_dist(
+            site,
+            f"pbtest-{tag}",
+            "1.0",
+            {tag: f"pbtest_{tag}"},
+            {f"pbtest_{tag}": GOOD.format(tag="twin")},
+        )
+    reg = build_registry(env=False)
+    assert "echo_twin" not in reg.names("estimator")
+    (conflict,) = reg.conflicts
+    assert conflict.kept is None
+    assert sorted(c.package for c in conflict.ignored) == ["pbtest-one", "pbtest-two"]
+    with pytest.raises(PluginError, match=r"estimator 'echo_twin' is provided by .*none of them"):
+        reg.get("estimator", "echo_twin")
+
+
+def test_registry_add_still_refuses_a_taken_name() -> None:
+    reg = build_registry(env=False)
+    with pytest.raises(PluginError, match=r"duplicate simulator name 'pymunk'"):
+        reg.add(reg.info("simulator", "pymunk"))
+
+
+def test_sys_exit_at_import_or_in_a_hook_is_a_failed_plugin(site: Path) -> None:
+    hook = (
+        "import sys\nfrom physbench.hookspecs import hookimpl\n"
+        "@hookimpl\ndef register_scenes():\n    sys.exit('no scenes today')\n"
     )
-    make_dist(site, "pbtest-dup", "0.1", {"dup": "pbtest_dup"}, {"pbtest_dup": src})
-    with pytest.raises(PluginError, match=r"duplicate simulator name 'pymunk'.*pbtest-dup"):
-        build_registry(env=False)
+    make_dist(site, "pbtest-quit", "0.1", {"quit": "pbtest_quit"}, {"pbtest_quit": "exit(4)\n"})
+    make_dist(site, "pbtest-hook", "0.1", {"hook": "pbtest_hook"}, {"pbtest_hook": hook})
+    reg = build_registry(env=False)
+    errors = {f.plugin: (f.package, f.error) for f in reg.failed}
+    assert errors["quit"] == ("pbtest-quit", "SystemExit: 4")
+    assert errors["hook"] == ("pbtest-hook", "register_scenes raised SystemExit: no scenes today")
+    assert "three_circles" in reg.names("scene")
+
+
+def test_what_an_installed_plugin_raises_names_its_distribution(
+    site: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from physbench.cli import main
+    from physbench.plugins import reset_registry
+
+    src = GOOD.format(tag="boom").replace("return dict(step.params)", "raise OSError('disk')")
+    make_dist(site, "pbtest-boom", "0.3", {"boomer": "pbtest_boom"}, {"pbtest_boom": src})
+    reset_registry()
+    try:
+        assert main(["run", "--estimator", "echo_boom", "--iterations", "1", "-q"]) == 2
+    finally:
+        reset_registry()
+    assert capsys.readouterr().err.startswith(
+        "physbench run: error: estimator 'echo_boom' of plugin 'boomer' (pbtest-boom 0.3) failed "
+        "in propose(): OSError: disk"
+    )
 
 
 def test_explicit_module_fallback_via_environment(

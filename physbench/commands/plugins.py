@@ -1,8 +1,13 @@
-"""``physbench plugins``: every discovered component, and plugins that failed to load."""
+"""``physbench plugins``: every discovered component, the plugins that failed to load, and the
+names that several plugins claim."""
 
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from physbench.plugins import Component
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -36,6 +41,16 @@ def main(args: argparse.Namespace) -> int:
                         for r in rows
                     ],
                     "failed": [f.__dict__ for f in reg.failed],
+                    "conflicts": [
+                        {
+                            "kind": c.kind,
+                            "name": c.name,
+                            "kept": None if c.kept is None else _origin(c.kept),
+                            "ignored": [_origin(i) for i in c.ignored],
+                            "message": c.describe(),
+                        }
+                        for c in reg.conflicts
+                    ],
                 },
                 indent=2,
             )
@@ -49,7 +64,15 @@ def main(args: argparse.Namespace) -> int:
         print("\nFailed to load (skipped):")
         for f in reg.failed:
             print(f"  {f.plugin} ({f.package} {f.version}): {f.error}")
+    if reg.conflicts:
+        print("\nName conflicts:")
+        for c in reg.conflicts:
+            print(f"  {c.describe()}")
     return 0
+
+
+def _origin(c: Component) -> dict[str, str]:
+    return {"plugin": c.plugin, "package": c.package, "version": c.version}
 
 
 def _status(missing: dict[str, str]) -> str:

@@ -41,6 +41,8 @@ def resolve_scene(name_or_path: str, seed: int = 0) -> Scene:
         from physbench.scene_toml import load_scene
 
         return load_scene(name_or_path)
-    from physbench.plugins import get_registry
+    from physbench.plugins import get_registry, guard
 
-    return get_registry().get("scene", name_or_path)(seed)
+    generate = get_registry().get("scene", name_or_path)
+    with guard("scene", generate, f"the call for seed {seed}"):
+        return generate(seed)
