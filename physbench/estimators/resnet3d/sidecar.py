@@ -16,12 +16,14 @@ from physbench.errors import PhysbenchError
 #: Sidecar ``storage`` value of weights kept as int8 with one float32 scale per output channel.
 INT8 = "int8-per-output-channel"
 
-# Input layout limits. Resolution: the stem (stride 2) and three strided stages shrink the frames
-# 16x, so below 8 pixels the stem already averages the few-pixel-wide objects away; above 512 one
-# sample's stem activations (widths[0] x 2·frames x R/2 x R/2 float32) pass a gigabyte even at the
-# CPU widths, more memory than inference has. Frames: the net infers parameters from motion, which
-# takes at least 2 frames; the scenes record 30-60 frames, and time_indices feeds all of a shorter
-# recording, so a net "trained" on more than 64 never saw the layout it claims.
+# Input layout limits, the same for training (physbench train) and loading. Resolution: the
+# stem (stride 2) and three strided stages shrink a frame 16x, so at 8 pixels the deepest stages
+# already see one pixel, and the objects (a few pixels wide at the 64-pixel renders) are below a
+# pixel after resizing; at 512, one sample's stem activations (widths[0] x 2·frames x R/2 x R/2
+# float32) are 0.1-0.5 GB at the CPU widths and grow with R², so 4096 cannot fit in memory.
+# Frames: parameters show in motion, which takes 2 frames at least; 64 is twice the default
+# scenes' 30 (ball_drop records 60). A net claiming far more frames than a recording has gets
+# all of it from time_indices: a layout it never saw.
 RESOLUTION = (8, 512)
 FRAMES = (2, 64)
 _WIDTH = (1, 2048)  # the paper's full widths top out at 512
