@@ -88,6 +88,7 @@ def main(args: argparse.Namespace) -> int:
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
     from physbench.commands.console import show_progress, wrote
     from physbench.errors import PhysbenchError
+    from physbench.estimators.resnet3d import sidecar
     from physbench.estimators.resnet3d.data import DataSpec
     from physbench.estimators.resnet3d.model import NetConfig
     from physbench.estimators.resnet3d.train import TrainConfig, train, weights_name
@@ -111,9 +112,13 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(
             f"--widths {args.widths!r}: expected 4 positive integers, e.g. 16,32,64,128"
         ) from None
-    for name in ("samples", "batch", "resolution", "frames"):
+    for name in ("samples", "batch"):
         if getattr(args, name) < 1:
             raise PhysbenchError(f"--{name} {getattr(args, name)}: must be >= 1")
+    # The limits loading enforces: weights outside them could be trained but never loaded.
+    for name, (lo, hi) in (("resolution", sidecar.RESOLUTION), ("frames", sidecar.FRAMES)):
+        if not lo <= getattr(args, name) <= hi:
+            raise PhysbenchError(f"--{name} {getattr(args, name)}: expected {lo}..{hi}")
     for name in ("minutes", "blur_max"):
         if not getattr(args, name) >= 0:
             raise PhysbenchError(f"--{name.replace('_', '-')} {getattr(args, name)}: must be >= 0")

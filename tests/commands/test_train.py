@@ -16,7 +16,9 @@ from physbench.cli import main
         (["--params", "mass", "--renderer", "nope"], "unknown renderer 'nope'"),
         (["--params", "mass", "-R", "colour=red"], "renderer 'raster' does not take options"),
         (["--params", "mass", "--widths", "1,2"], "--widths '1,2': expected 4 positive integers"),
-        (["--params", "mass", "--frames", "0"], "--frames 0: must be >= 1"),
+        (["--params", "mass", "--frames", "0"], "--frames 0: expected 2..64"),
+        (["--params", "mass", "--frames", "1000"], "--frames 1000: expected 2..64"),
+        (["--params", "mass", "--resolution", "4096"], "--resolution 4096: expected 8..512"),
     ],
 )
 def test_bad_arguments_are_named(

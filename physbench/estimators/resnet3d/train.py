@@ -149,7 +149,7 @@ def train(
             )
         net.load_state_dict({k: v.float() for k, v in state.items()})
     if resume and ckpt.is_file():
-        tensors, meta = weights.load(ckpt)
+        tensors, meta = weights.read(ckpt)
         net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
         _load_optimizer(
             opt, {k: v for k, v in tensors.items() if k.startswith("opt.")}, meta["optimizer"]
@@ -228,7 +228,7 @@ def train(
             loss=f"{ema:.4f}", val=f"{best:.4f}", rate=f"{bar.format_dict.get('rate') or 0:.0f}/s"
         )
     bar.close()
-    best_state, _ = weights.load(out / "best.safetensors")
+    best_state, _ = weights.read(out / "best.safetensors")
     meta = {
         "scene": spec.instance(0).name,  # what the estimator looks weights up by
         "data": spec.to_dict(),

@@ -11,15 +11,16 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from physbench.errors import PhysbenchError
+from physbench.estimators.resnet3d import sidecar
+from physbench.estimators.resnet3d.sidecar import INT8
 
 SHIPPED = Path(__file__).with_name("weights")
-#: Sidecar ``storage`` value of weights kept as int8 with one float32 scale per output channel.
-INT8 = "int8-per-output-channel"
 _SCALE = ".int8_scale"
 
 
@@ -57,16 +58,34 @@ def save(path: str | Path, state: dict[str, Any], meta: dict[str, Any]) -> Path:
     return path
 
 
-def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(tensors, meta) from a .safetensors file and its sidecar; int8 storage comes back as
-    float32. A sidecar whose ``sha256`` is not the tensors' is refused."""
-    from safetensors.torch import load as decode
+def read(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(tensors, meta) of any pair :func:`save` wrote (training checkpoints too); int8 storage
+    comes back as float32. Called where the sidecar is not a model's: :func:`load` checks that.
+    A sidecar whose ``sha256`` is not the tensors' is refused, and so is a file that is not
+    safetensors (truncated, or a pickle renamed): it is never unpickled."""
+    return _pair(path, model=False)
 
+
+def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(tensors, meta) of model weights, checked before anything builds a net from them: the
+    sidecar's schema (:mod:`.sidecar`) and that the tensors are exactly the architecture's,
+    names and shapes, finite floats. Called by the estimator's start, evaluation and
+    ``train --init``."""
+    return _pair(path, model=True)
+
+
+def _pair(path: str | Path, *, model: bool) -> tuple[dict[str, Any], dict[str, Any]]:
     path = Path(path).with_suffix(".safetensors")
     side = path.with_suffix(".json")
     if not path.is_file() or not side.is_file():
         raise PhysbenchError(f"weights {str(path)!r} need both {path.name} and {side.name}")
-    data, meta = path.read_bytes(), json.loads(side.read_text())
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise PhysbenchError(f"weights {str(path)!r} cannot be read: {exc}") from None
+    meta = read_sidecar(side)
+    if model:  # the schema first: its message says more than a tensor-level symptom would
+        sidecar.check(meta, f"weights sidecar {str(side)!r}")
     digest = meta.get("sha256")
     if digest is not None and hashlib.sha256(data).hexdigest() != digest:
         raise PhysbenchError(
@@ -74,10 +93,82 @@ def load(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
             f"{str(digest)[:12]}… is not the file's): the pair comes from two saves, e.g. an "
             "interrupted one; save or train again"
         )
-    tensors = decode(data)
+    tensors = _decode(data, path)
     if meta.get("storage") == INT8:
-        tensors = dequantize(tensors)
+        tensors = dequantize(tensors, where=f"weights {str(path)!r}")
+    elif meta.get("storage") is not None:
+        raise PhysbenchError(
+            f"weights {str(path)!r}: {side.name} has storage {meta['storage']!r}, expected "
+            f"{INT8!r} or none (float tensors)"
+        )
+    elif any(name.endswith(_SCALE) for name in tensors):
+        raise PhysbenchError(
+            f"weights {str(path)!r} hold int8 tensors with scales but {side.name} has no "
+            f"storage; expected storage {INT8!r}"
+        )
+    if model:
+        _match(tensors, meta["net"], path)
     return tensors, meta
+
+
+def read_sidecar(side: Path) -> dict[str, Any]:
+    """The JSON object in ``side``, or a PhysbenchError saying why it is not one."""
+    try:
+        meta = json.loads(side.read_bytes())
+    except OSError as exc:
+        raise PhysbenchError(f"weights sidecar {str(side)!r} cannot be read: {exc}") from None
+    except (ValueError, RecursionError) as exc:  # invalid JSON or text, or nested too deep
+        raise PhysbenchError(
+            f"weights sidecar {str(side)!r} is not valid JSON ({exc}); expected the object "
+            "physbench train writes beside NAME.safetensors"
+        ) from None
+    if not isinstance(meta, dict):
+        raise PhysbenchError(
+            f"weights sidecar {str(side)!r} holds a JSON {type(meta).__name__}, expected an object"
+        )
+    return meta
+
+
+def _decode(data: bytes, path: Path) -> dict[str, Any]:
+    from safetensors import SafetensorError
+    from safetensors.torch import load as decode
+
+    try:
+        return decode(data)
+    except (SafetensorError, ValueError, OverflowError) as exc:
+        raise PhysbenchError(
+            f"weights {str(path)!r} ({len(data)} bytes) is not a readable safetensors file "
+            f"({exc}); expected the tensors physbench train or weights.save wrote, complete"
+        ) from None
+
+
+def _match(tensors: dict[str, Any], net: dict[str, Any], path: Path) -> None:
+    """Refuses tensors that are not the state of the net ``net`` describes, before
+    ``load_state_dict`` would fail (or, for shapes it broadcasts, not)."""
+    import torch
+
+    from physbench.estimators.resnet3d.model import NetConfig, build_net
+
+    with torch.device("meta"):  # shapes only: no memory, no initialisation cost
+        want = {
+            k: tuple(v.shape) for k, v in build_net(NetConfig.from_dict(net)).state_dict().items()
+        }
+    where = f"weights {str(path)!r}"
+    missing, extra = sorted(set(want) - set(tensors)), sorted(set(tensors) - set(want))
+    if missing or extra:
+        raise PhysbenchError(
+            f"{where} do not fit the architecture in their sidecar's net: missing tensors "
+            f"{missing[:5] or 'none'}, unexpected {extra[:5] or 'none'}"
+        )
+    for name, shape in want.items():
+        t = tensors[name]
+        if tuple(t.shape) != shape:
+            raise PhysbenchError(
+                f"{where}: tensor {name!r} has shape {tuple(t.shape)}, the sidecar's net "
+                f"expects {shape}"
+            )
+        if not t.is_floating_point() or not bool(torch.isfinite(t).all()):
+            raise PhysbenchError(f"{where}: tensor {name!r} ({t.dtype}) is not all finite floats")
 
 
 def quantize(state: dict[str, Any]) -> dict[str, Any]:
@@ -98,17 +189,27 @@ def quantize(state: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def dequantize(tensors: dict[str, Any]) -> dict[str, Any]:
-    """Float32 tensors back from :func:`quantize`'s output."""
+def dequantize(tensors: dict[str, Any], where: str = "weights") -> dict[str, Any]:
+    """Float32 tensors back from :func:`quantize`'s output; a scale without its tensor, or one
+    that is not a float per output channel, is refused (naming ``where``)."""
     out: dict[str, Any] = {}
     for name, t in tensors.items():
         if name.endswith(_SCALE):
+            if name[: -len(_SCALE)] not in tensors:
+                raise PhysbenchError(
+                    f"{where}: scale {name!r} has no tensor {name[: -len(_SCALE)]!r}"
+                )
             continue
         scale = tensors.get(name + _SCALE)
         if scale is None:
             out[name] = t.float()
-        else:
-            out[name] = t.float() * scale.float().view((-1,) + (1,) * (t.dim() - 1))
+            continue
+        if t.dim() < 1 or not scale.is_floating_point() or tuple(scale.shape) != t.shape[:1]:
+            raise PhysbenchError(
+                f"{where}: scale of {name!r} has shape {tuple(scale.shape)} ({scale.dtype}), "
+                f"expected ({t.shape[0] if t.dim() else 1},) floats, one per output channel"
+            )
+        out[name] = t.float() * scale.float().view((-1,) + (1,) * (t.dim() - 1))
     return out
 
 
@@ -118,13 +219,21 @@ def search_dirs() -> list[Path]:
 
 
 def available() -> list[WeightsInfo]:
-    """Every weights file found, searched folders first to last."""
+    """Every weights file found, searched folders first to last; called by :func:`find` and
+    listings. A file whose sidecar is not a weights sidecar is skipped with a warning naming it,
+    so one bad file in a ``PHYSBENCH_WEIGHTS`` folder does not break lookups of the others."""
     out = []
     for d in search_dirs():
         for side in sorted(d.glob("*.json")) if d.is_dir() else []:
             st = side.with_suffix(".safetensors")
-            if st.is_file():
-                out.append(WeightsInfo(st, json.loads(side.read_text())))
+            if not st.is_file():
+                continue
+            try:
+                meta = sidecar.check(read_sidecar(side), f"weights sidecar {str(side)!r}")
+            except PhysbenchError as exc:
+                warnings.warn(f"skipping weights {str(st)!r}: {exc}", UserWarning, stacklevel=2)
+                continue
+            out.append(WeightsInfo(st, meta))
     return out
 
 

@@ -49,13 +49,13 @@ def test_saved_weights_are_readable_by_others_and_refuse_a_mixed_pair(tmp_path: 
         os.umask(old)
     for f in (first, first.with_suffix(".json")):
         assert stat.S_IMODE(f.stat().st_mode) == 0o644, f
-    tensors, meta = weights.load(first)
+    tensors, meta = weights.read(first)  # a pair that is not a model's: read, not load
     assert meta["run"] == 1 and tensors["a"].tolist() == [1.0, 1.0, 1.0]
     side = first.with_suffix(".json").read_text()
     weights.save(tmp_path / "w", {"a": torch.zeros(3)}, {"run": 2})
     first.with_suffix(".json").write_text(side)  # as if the second save stopped between the two
     with pytest.raises(PhysbenchError, match=r"describes other tensors .* two saves"):
-        weights.load(first)
+        weights.read(first)
 
 
 def test_shipped_sidecars_name_their_tensors() -> None:
@@ -91,7 +91,7 @@ def test_int8_storage_round_trips_within_a_step_and_is_a_quarter_of_float32(tmp_
         )
         assert torch.all((back[k] - v).abs() <= step / 2 + 1e-6), k
     path = weights.save(tmp_path / "w", q, {"storage": weights.INT8, "net": TINY.to_dict()})
-    loaded, _ = weights.load(path)
+    loaded, _ = weights.read(path)
     assert all(loaded[k].dtype == torch.float32 and torch.equal(loaded[k], back[k]) for k in back)
     # On the shipped architecture int8 is about a quarter of float32 (scales and biases add little).
     big = dict(build_net(NetConfig(n_outputs=1)).state_dict())
