@@ -81,6 +81,19 @@ def run_cell(config: RunConfig) -> dict[str, Any]:
     return out
 
 
+def died_cell(config: RunConfig, error: str) -> dict[str, Any]:
+    """The failed cell for a ``config`` whose process died running it (see
+    :mod:`~physbench.bench.executors`); called by the executor in the main process."""
+    return {
+        "config": config.to_dict(),
+        "status": "failed",
+        "error": f"WorkerDied: {error}",
+        "history": None,
+        "t_cell": None,
+        "versions": versions(),
+    }
+
+
 @dataclass
 class SweepResult:
     """What :func:`run_sweep` did and produced."""
@@ -206,7 +219,7 @@ def run_sweep(
     try:
         if todo:
             with ex:
-                for config, data in ex.map_unordered(run_cell, [c.config for c in todo]):
+                for config, data in ex.map_unordered(run_cell, [c.config for c in todo], died_cell):
                     key = by_config[id(config)].key
                     store.save(key, {**data, "stamp": stamps[key]})
                     if data["status"] != "ok":
