@@ -5,12 +5,21 @@ they finish, in any order; the runner writes each result and orders the table by
 the table does not depend on the executor or the number of workers. Results come back to this
 process (nothing is written by workers), so Dask workers need no shared file system, only the
 same physbench installation.
+
+A cell that kills its interpreter (``os._exit``, a segfault in an extension) is contained by the
+``processes`` executor: it is retried once alone, then handed to the caller's ``died`` with what
+happened, and the sweep goes on. ``serial`` runs cells in this very process, so it cannot contain
+that. Local worker processes die with the process that started them.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator, Sequence
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable, Generator, Iterator, Sequence
 from typing import Any, Protocol, TypeVar
 
 from physbench.errors import PhysbenchError, counted
@@ -26,7 +35,9 @@ class Executor(Protocol):
 
     def __enter__(self) -> Executor: ...
     def __exit__(self, *exc: object) -> None: ...
-    def map_unordered(self, fn: Callable[[T], R], items: Sequence[T]) -> Iterator[tuple[T, R]]: ...
+    def map_unordered(
+        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+    ) -> Iterator[tuple[T, R]]: ...
     def describe(self) -> str: ...
 
 
@@ -38,8 +49,57 @@ def default_workers() -> int:
         return os.cpu_count() or 1
 
 
+def die_with_parent(parent: int) -> None:
+    """Make this process end when ``parent`` does; called first thing in every local worker, so
+    that killing a sweep's main process does not leave its workers computing for minutes. Linux
+    asks the kernel (``PR_SET_PDEATHSIG``); elsewhere a thread watches the parent's pid."""
+    if sys.platform == "linux":
+        import ctypes
+
+        try:
+            pr_set_pdeathsig = 1
+            libc = ctypes.CDLL(None, use_errno=True)
+            if libc.prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0) == 0:
+                if os.getppid() != parent:  # it died before prctl took effect
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):
+            pass
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="physbench-parent-watch", daemon=True).start()
+
+
+def how_it_died(exitcode: int | None) -> str:
+    """``exit code 3`` or ``signal 11 (SIGSEGV)``, from a process's ``exitcode``."""
+    if exitcode is not None and exitcode < 0:
+        try:
+            return f"signal {-exitcode} ({signal.Signals(-exitcode).name})"
+        except ValueError:
+            return f"signal {-exitcode}"
+    return f"exit code {exitcode}"
+
+
+def _run_alone(conn: Any, fn: Callable[[T], R], item: T, parent: int) -> None:
+    """The body of a process that runs one suspect item on its own (see
+    :meth:`ProcessExecutor.map_unordered`) and sends back ``(ok, result or exception)``."""
+    die_with_parent(parent)
+    try:
+        msg: tuple[bool, Any] = (True, fn(item))
+    except Exception as exc:
+        msg = (False, exc)
+    conn.send(msg)
+    conn.close()
+
+
 class SerialExecutor:
-    """One cell after another in this process (debugging, tiny sweeps, exact tracebacks)."""
+    """One cell after another in this process (debugging, tiny sweeps, exact tracebacks). A cell
+    that kills the interpreter ends the command here (``died`` is never called); the cells
+    finished before it are saved."""
 
     name = "serial"
     workers = 1
@@ -50,7 +110,9 @@ class SerialExecutor:
     def __exit__(self, *exc: object) -> None:
         pass
 
-    def map_unordered(self, fn: Callable[[T], R], items: Sequence[T]) -> Iterator[tuple[T, R]]:
+    def map_unordered(
+        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+    ) -> Iterator[tuple[T, R]]:
         for item in items:
             yield item, fn(item)
 
@@ -60,7 +122,12 @@ class SerialExecutor:
 
 class ProcessExecutor:
     """A pool of ``workers`` local processes, started with ``spawn`` (a fork would copy this
-    process's threads, e.g. the progress bar's monitor, into a half-initialised child)."""
+    process's threads, e.g. the progress bar's monitor, into a half-initialised child).
+
+    At most ``workers`` items are handed to the pool at a time, so when a worker dies (and the
+    pool with it) the items in flight are known: each is run again alone in a fresh process; one
+    that kills that process too is given to ``died``, the others yield their results, and the
+    remaining items go on in a fresh pool."""
 
     name = "processes"
 
@@ -68,12 +135,19 @@ class ProcessExecutor:
         self.workers = workers or default_workers()
         self._pool: Any = None
 
-    def __enter__(self) -> ProcessExecutor:
+    def _context(self) -> Any:
         import multiprocessing
+
+        return multiprocessing.get_context("spawn")
+
+    def __enter__(self) -> ProcessExecutor:
         from concurrent.futures import ProcessPoolExecutor
 
         self._pool = ProcessPoolExecutor(
-            self.workers, mp_context=multiprocessing.get_context("spawn")
+            self.workers,
+            mp_context=self._context(),
+            initializer=die_with_parent,
+            initargs=(os.getpid(),),
         )
         return self
 
@@ -82,23 +156,101 @@ class ProcessExecutor:
             self._pool.shutdown(wait=exc[0] is None, cancel_futures=True)
             self._pool = None
 
-    def map_unordered(self, fn: Callable[[T], R], items: Sequence[T]) -> Iterator[tuple[T, R]]:
-        from concurrent.futures import as_completed
+    def map_unordered(
+        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+    ) -> Iterator[tuple[T, R]]:
+        from collections import deque
+
+        pending = deque(items)
+        while pending:
+            if self._pool is None:
+                self.__enter__()
+            suspects = yield from self._until_broken(fn, pending)
+            if suspects is not None:
+                self._pool.shutdown(wait=True)
+                self._pool = None
+                yield from self._each_alone(fn, suspects, died)
+
+    def _until_broken(
+        self, fn: Callable[[T], R], pending: Any
+    ) -> Generator[tuple[T, R], None, list[T] | None]:
+        """Yield results from the pool until ``pending`` is empty (then return ``None``) or the
+        pool breaks (then return the items that were in flight, maybe none)."""
+        from concurrent.futures import FIRST_COMPLETED, wait
         from concurrent.futures.process import BrokenProcessPool
 
-        futures = {self._pool.submit(fn, item): item for item in items}
+        window: dict[Any, T] = {}
         try:
-            for fut in as_completed(futures):
-                yield futures[fut], fut.result()
-        except BrokenProcessPool as exc:
-            raise PhysbenchError(
-                f"a worker process died ({exc}); finished cells are saved: re-run the same "
-                "command to resume, or use --executor serial to see which cell crashes the "
-                "interpreter"
-            ) from None
+            while pending or window:
+                while pending and len(window) < self.workers:
+                    item = pending.popleft()
+                    try:
+                        window[self._pool.submit(fn, item)] = item
+                    except BrokenProcessPool:
+                        pending.appendleft(item)
+                        break
+                done, _ = wait(window, return_when=FIRST_COMPLETED)
+                if not done or any(isinstance(f.exception(), BrokenProcessPool) for f in done):
+                    wait(window)  # a broken pool fails every future it holds
+                    for fut, item in list(window.items()):
+                        if not isinstance(fut.exception(), BrokenProcessPool):
+                            del window[fut]
+                            yield item, fut.result()
+                    suspects = list(window.values())
+                    window.clear()
+                    return suspects
+                for fut in done:
+                    yield window.pop(fut), fut.result()
+            return None
         finally:
-            for fut in futures:
+            for fut in window:
                 fut.cancel()
+
+    def _each_alone(
+        self, fn: Callable[[T], R], items: list[T], died: Callable[[T, str], R]
+    ) -> Iterator[tuple[T, R]]:
+        """Run every item in a process of its own, all at once (``items`` are at most
+        ``workers``), yielding its result or, if that process dies too, ``died``'s."""
+        from multiprocessing.connection import wait
+
+        ctx = self._context()
+        running: dict[Any, tuple[Any, T]] = {}
+        try:
+            for item in items:
+                recv, send = ctx.Pipe(duplex=False)
+                proc = ctx.Process(
+                    target=_run_alone, args=(send, fn, item, os.getpid()), daemon=True
+                )
+                proc.start()
+                send.close()  # so that recv sees the end of the pipe when proc dies
+                running[recv] = (proc, item)
+            while running:
+                for conn in wait(list(running)):
+                    proc, item = running.pop(conn)
+                    try:
+                        ok, value = conn.recv()
+                    except EOFError:
+                        proc.join()
+                        how = how_it_died(proc.exitcode)
+                        yield (
+                            item,
+                            died(
+                                item,
+                                f"the worker process died: {how}, also when run again alone in "
+                                "a fresh process",
+                            ),
+                        )
+                        continue
+                    finally:
+                        conn.close()
+                    proc.join()
+                    if not ok:
+                        raise value
+                    yield item, value
+        finally:
+            for proc, _ in running.values():
+                proc.kill()
+                proc.join()
 
     def describe(self) -> str:
         return f"processes ({counted(self.workers, 'worker')})"
@@ -106,7 +258,10 @@ class ProcessExecutor:
 
 class DaskExecutor:
     """A Dask ``distributed`` cluster: the scheduler at ``address`` (``tcp://host:8786``), or a
-    LocalCluster of ``workers`` single-threaded worker processes when no address is given."""
+    LocalCluster of ``workers`` single-threaded worker processes when no address is given.
+
+    The address is a trust boundary: results arrive pickled, and unpickling runs code of the
+    sender's choosing, so whoever controls that cluster can run code in this process."""
 
     name = "dask"
 
@@ -158,7 +313,9 @@ class DaskExecutor:
             self._cluster.close()
         self._client = self._cluster = None
 
-    def map_unordered(self, fn: Callable[[T], R], items: Sequence[T]) -> Iterator[tuple[T, R]]:
+    def map_unordered(
+        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+    ) -> Iterator[tuple[T, R]]:
         from distributed import as_completed
 
         futures = [self._client.submit(fn, item, pure=False) for item in items]

@@ -4,8 +4,11 @@ A cell that raises (an exploding simulation that the loop does not absorb, an es
 weights, ...) is stored as failed with its error and the sweep goes on. Re-running on the same
 output folder runs only the cells without a stored result, and the long table is rebuilt from the
 stored cells in spec order, so an interrupted-and-resumed sweep ends with exactly the rows of an
-uninterrupted one. Every stored cell carries a stamp of what produced it
-(:mod:`physbench.bench.stamp`); a resume refuses finished cells whose stamp differs from now.
+uninterrupted one. A cell whose worker process dies (``os._exit``, a segfault) is retried once on
+its own, then stored as failed (executor ``processes``). One sweep at a time writes an output
+folder: a second one refuses, or waits with ``wait``. Every stored cell carries a stamp of what
+produced it (:mod:`physbench.bench.stamp`); a resume refuses finished cells whose stamp differs
+from now.
 """
 
 from __future__ import annotations
@@ -27,6 +30,8 @@ from physbench.experiment import RunConfig
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from physbench.bench.executors import Executor
 
 #: Distributions whose versions are recorded with every cell (those installed).
 VERSIONED = (
@@ -79,6 +84,19 @@ def run_cell(config: RunConfig) -> dict[str, Any]:
     out["t_cell"] = time.perf_counter() - t0
     out["versions"] = versions()
     return out
+
+
+def died_cell(config: RunConfig, error: str) -> dict[str, Any]:
+    """The failed cell for a ``config`` whose process died running it (see
+    :mod:`~physbench.bench.executors`); called by the executor in the main process."""
+    return {
+        "config": config.to_dict(),
+        "status": "failed",
+        "error": f"WorkerDied: {error}",
+        "history": None,
+        "t_cell": None,
+        "versions": versions(),
+    }
 
 
 @dataclass
@@ -154,23 +172,52 @@ def run_sweep(
     fresh: bool = False,
     retry_failed: bool = False,
     allow_stale: bool = False,
+    wait: bool = False,
     progress: bool = True,
     command: str = "",
 ) -> SweepResult:
     """Run the cells of ``spec`` that ``out`` lacks, then write ``results.parquet``, the summary
     tables and ``run.json`` (one entry per invocation: executor, workers, cells run, wall time).
     Before anything runs, refuses (:class:`~physbench.bench.stamp.StaleCellsError`) to keep
-    finished cells whose stamp differs from now, unless ``allow_stale``."""
-    from tqdm import tqdm
-
+    finished cells whose stamp differs from now, unless ``allow_stale``. Holds the folder's lock
+    throughout: another sweep writing ``out`` is refused (:class:`~.store.FolderBusyError`), or
+    waited for with ``wait``."""
     from physbench.bench.executors import make_executor
-    from physbench.bench.stamp import StaleCellsError, Stamper, describe, find_stale
-    from physbench.bench.tables import write_summary
 
     out = Path(out)
     ex = make_executor(executor, workers=workers, address=address)
+    with CellStore(out).writing(wait=wait) as store:
+        return _run_locked(
+            spec,
+            store,
+            ex,
+            fresh=fresh,
+            retry_failed=retry_failed,
+            allow_stale=allow_stale,
+            progress=progress,
+            command=command,
+        )
+
+
+def _run_locked(
+    spec: Spec,
+    store: CellStore,
+    ex: Executor,
+    *,
+    fresh: bool,
+    retry_failed: bool,
+    allow_stale: bool,
+    progress: bool,
+    command: str,
+) -> SweepResult:
+    """:func:`run_sweep` once it holds the lock on ``store``'s folder."""
+    from tqdm import tqdm
+
+    from physbench.bench.stamp import StaleCellsError, Stamper, describe, find_stale
+    from physbench.bench.tables import write_summary
+
+    out = store.out
     cells = spec.cells()
-    store = CellStore(out)
     store.prepare(fresh=fresh)
 
     stored = {c.key: data for c in cells if (data := store.load(c.key)) is not None}
@@ -206,7 +253,7 @@ def run_sweep(
     try:
         if todo:
             with ex:
-                for config, data in ex.map_unordered(run_cell, [c.config for c in todo]):
+                for config, data in ex.map_unordered(run_cell, [c.config for c in todo], died_cell):
                     key = by_config[id(config)].key
                     store.save(key, {**data, "stamp": stamps[key]})
                     if data["status"] != "ok":

@@ -4,13 +4,20 @@
 the same folder, flushed to disk, then renamed over the target), so a sweep killed at any moment
 leaves only whole cells, and a re-run skips them. Tables, summaries and plots are derived from the
 cells and rewritten atomically the same way.
+
+One sweep at a time writes a folder: it holds ``DIR/.lock`` (a :class:`filelock.FileLock`, released
+by the system if the process is killed) and records its pid in ``DIR/.lock.pid``, so a second sweep
+on the same folder is refused with that pid (or waits) instead of repeating cells and deleting the
+first one's temporary files.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +46,13 @@ def atomic_write(path: Path, data: bytes) -> None:
     os.replace(tmp, path)
 
 
+LOCK = ".lock"
+
+
+class FolderBusyError(PhysbenchError):
+    """Another sweep holds the lock on the output folder."""
+
+
 class CellStore:
     """Finished cells of one output folder, keyed by :attr:`physbench.bench.spec.Cell.key`."""
 
@@ -46,21 +60,51 @@ class CellStore:
         self.out = Path(out)
         self.dir = self.out / "cells"
 
-    def prepare(self, *, fresh: bool = False) -> None:
-        """Create the folder (refusing one that cannot be written), drop temporary files left by
-        a killed run, and with ``fresh`` forget every finished cell and derived file."""
+    @contextlib.contextmanager
+    def writing(self, *, wait: bool = False) -> Iterator[CellStore]:
+        """Create the folder (refusing one that cannot be written) and hold its lock while the
+        block runs; called by the runner around a whole sweep. When another process holds it,
+        refuses (:class:`FolderBusyError`) or, with ``wait``, waits for it."""
+        from filelock import FileLock, Timeout
+
+        self._make()
+        lock = FileLock(self.out / LOCK, timeout=-1 if wait else 0)
+        try:
+            lock.acquire()
+        except Timeout:
+            try:
+                pid = f" (pid {int((self.out / f'{LOCK}.pid').read_text())})"
+            except (OSError, ValueError):
+                pid = ""
+            raise FolderBusyError(
+                f"--out {str(self.out)!r}: another physbench bench is writing this folder{pid}; "
+                "wait for it (--wait) or use another --out"
+            ) from None
+        try:
+            atomic_write(self.out / f"{LOCK}.pid", str(os.getpid()).encode())
+            yield self
+        finally:
+            (self.out / f"{LOCK}.pid").unlink(missing_ok=True)
+            lock.release()
+
+    def _make(self) -> None:
         try:
             if self.out.exists() and not self.out.is_dir():
                 raise NotADirectoryError(f"{self.out} is a file")
             self.dir.mkdir(parents=True, exist_ok=True)
             probe = self.dir / f".probe.{os.getpid()}.tmp"
             probe.write_bytes(b"")
-            probe.unlink()
+            probe.unlink(missing_ok=True)
         except OSError as exc:
             raise PhysbenchError(
                 f"--out {str(self.out)!r}: cannot write results there ({exc.strerror or exc}); "
                 "expected a writable folder (it is created if missing)"
             ) from None
+
+    def prepare(self, *, fresh: bool = False) -> None:
+        """Drop temporary files left by a killed run, and with ``fresh`` forget every finished
+        cell and derived file; called under :meth:`writing`'s lock, so no live writer's
+        temporary files are dropped."""
         for tmp in [*self.dir.glob(".*.tmp"), *self.out.glob(".*.tmp")]:
             tmp.unlink(missing_ok=True)
         if fresh:

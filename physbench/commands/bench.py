@@ -23,7 +23,13 @@ Re-running the same command on the same DIR resumes: finished cells are skipped.
 what produced it (a hash of its scene as generated for its seed, the estimator's resolved options,
 the physbench version); a resume refuses, before running anything, when that changed for any
 finished cell (or a cell predates these records): --allow-stale keeps such cells, --fresh starts
-over."""
+over.
+
+One run at a time writes a DIR: a second run on the same DIR refuses (naming the first one's pid),
+or waits for it with --wait. With --executor processes (the default), a cell that kills its worker
+process (os._exit, a segfault in an extension) is run once more alone, then recorded as failed, and
+the sweep goes on; --executor serial runs cells in this process, so such a cell ends the command
+(finished cells are saved). Worker processes end when this process does."""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -40,7 +46,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--executor",
         default="processes",
         choices=("serial", "processes", "dask"),
-        help="where cells run: this process, local worker processes (default), or a Dask cluster",
+        help="where cells run: this process, local worker processes (default; a cell that kills "
+        "its process is recorded as failed), or a Dask cluster (trusted: it sends back pickles)",
     )
     p.add_argument(
         "--workers",
@@ -54,7 +61,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="tcp://HOST:PORT",
         help="Dask scheduler address (with --executor dask; default: start a LocalCluster of "
-        "--workers processes)",
+        "--workers processes); only a cluster you trust: results arrive as pickles, which can "
+        "run code here",
     )
     add_renderer_choice(
         p,
@@ -72,6 +80,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="resume even when finished cells were produced by other code or settings (a changed "
         "scene generator, estimator default or physbench version); they are kept as they are",
+    )
+    p.add_argument(
+        "--wait",
+        action="store_true",
+        help="when another run is writing DIR, wait for it to finish (default: refuse)",
     )
     add_quiet_argument(p, "no table: only the final line")
 
@@ -100,6 +113,7 @@ def main(args: argparse.Namespace) -> int:
             fresh=args.fresh,
             retry_failed=args.retry_failed,
             allow_stale=args.allow_stale,
+            wait=args.wait,
             progress=show_progress(args),
             command=command,
         )

@@ -1,11 +1,15 @@
 """Where cells run: ``make_executor`` builds each executor by name with its worker count and
 refuses bad names, counts and addresses; ``map_unordered`` yields every item once with its result,
-and a worker process that dies is a clear error. (That every executor gives the same table:
-``test_executors_give_identical_tables`` in test_runner.py.)"""
+and an item whose worker process dies is run again alone once, then given to ``died``. (That every
+executor gives the same table: ``test_executors_give_identical_tables`` in test_runner.py.)"""
 
 from __future__ import annotations
 
 import os
+from collections import Counter
+from collections.abc import Callable
+from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -20,6 +24,10 @@ from physbench.bench.executors import (
 from physbench.errors import PhysbenchError
 
 ITEMS = [-3, 1, -4, 1, -5, 9, -2, 6]
+
+
+def _never(item: object, error: str) -> object:
+    raise AssertionError(f"no process died, yet died({item!r}, {error!r}) was called")
 
 
 def test_names_build_their_executor_with_all_cores_by_default() -> None:
@@ -68,16 +76,49 @@ def test_bad_settings_are_named(name: str, kwargs: dict[str, object], message: s
 
 def test_serial_maps_in_order() -> None:
     with make_executor("serial") as ex:
-        assert list(ex.map_unordered(abs, ITEMS)) == [(x, abs(x)) for x in ITEMS]
+        assert list(ex.map_unordered(abs, ITEMS, _never)) == [(x, abs(x)) for x in ITEMS]
 
 
 def test_processes_yield_every_item_once_with_its_result() -> None:
     with make_executor("processes", workers=2) as ex:
-        got = list(ex.map_unordered(abs, ITEMS))
+        got = list(ex.map_unordered(abs, ITEMS, _never))
     assert sorted(got) == sorted((x, abs(x)) for x in ITEMS)
 
 
-def test_a_worker_that_dies_is_a_clear_error() -> None:
-    died = r"^a worker process died \(.*\); finished cells are saved: re-run the same command"
-    with pytest.raises(PhysbenchError, match=died), make_executor("processes", workers=1) as ex:
-        list(ex.map_unordered(os._exit, [3]))
+#: A worker function that kills its process for some items, and logs every call to ``LOG``.
+DYING = """
+import os
+import signal
+
+LOG = os.environ["PB_DYING_LOG"]
+
+
+def crash_on(x):
+    with open(LOG, "a") as f:
+        f.write(f"{x}\\n")
+    if x == 3:
+        os._exit(3)
+    if x == 11:
+        os.kill(os.getpid(), signal.SIGSEGV)
+    return -x
+"""
+
+
+def test_items_that_kill_their_worker_are_retried_once_then_given_to_died(
+    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    log = tmp_path / "calls.txt"
+    monkeypatch.setenv("PB_DYING_LOG", str(log))
+    dying = plugin("pb_dying", DYING)
+    items = [1, 3, 2, 11, 4, 5, 6, 7]
+    with make_executor("processes", workers=2) as ex:
+        got = dict(ex.map_unordered(dying.crash_on, items, lambda x, error: error))
+    again = ", also when run again alone in a fresh process"
+    assert got == {
+        **{x: -x for x in items if x not in (3, 11)},
+        3: "the worker process died: exit code 3" + again,
+        11: "the worker process died: signal 11 (SIGSEGV)" + again,
+    }
+    calls = Counter(int(line) for line in log.read_text().split())
+    assert calls[3] == calls[11] == 2  # once in the pool, once alone
+    assert set(calls) == set(items) and max(calls.values()) == 2

@@ -123,6 +123,67 @@ def test_long_table_summary_and_failed_cells(tmp_path: Path, flaky_registry: Non
     assert [r["ran"] for r in log["runs"]] == [8, 0, 4]
 
 
+#: An estimator ``exiting`` (random search) whose process exits in ``propose`` in the cell of
+#: seed 1.
+EXITING = """
+import os
+from typing import ClassVar
+
+import numpy as np
+
+from physbench.estimators.base import CorrectionEstimator
+from physbench.hookspecs import hookimpl
+from physbench.loop import derive_seeds
+
+
+class Exiting(CorrectionEstimator):
+    name: ClassVar[str] = "exiting"
+
+    def __init__(self):
+        self.options = {}
+
+    def start(self, task, *, seed):
+        self.space, self.rng, self.seed = task.space, np.random.default_rng(seed), seed
+
+    def propose(self, step):
+        if self.seed == derive_seeds(1).estimator:
+            os._exit(3)
+        return self.space.from_unit(self.rng.random(len(self.space)))
+
+
+@hookimpl
+def register_estimators():
+    return [Exiting]
+"""
+
+
+def test_a_cell_that_kills_its_worker_is_recorded_failed_and_the_sweep_goes_on(
+    tmp_path: Path, plugin: Any
+) -> None:
+    plugin("pb_exiting", EXITING)
+    spec = parse_spec(
+        {
+            "name": "exits",
+            "estimators": ["random", "exiting"],
+            "seeds": 3,
+            "iterations": 2,
+            "resolution": 16,
+            "scenes": [{"name": "second_order", "unknowns": ["elasticity"]}],
+        }
+    )
+    res = run_sweep(spec, tmp_path, executor="processes", workers=2, progress=False)
+    assert (res.ran, res.failed) == (6, 1)
+    df = pd.read_parquet(tmp_path / "results.parquet")
+    cells = df.drop_duplicates("cell").set_index(["estimator", "seed"])
+    assert cells.loc[("exiting", 1), "status"] == "failed"
+    assert cells.loc[("exiting", 1), "error"] == (
+        "WorkerDied: the worker process died: exit code 3, also when run again alone in a fresh "
+        "process"
+    )
+    assert (cells.drop(index=("exiting", 1))["status"] == "ok").all() and len(cells) == 6
+    assert "WorkerDied" in (tmp_path / "summary.md").read_text()
+
+
 @pytest.mark.slow
 def test_executors_give_identical_tables(tmp_path: Path) -> None:
     pytest.importorskip("distributed")

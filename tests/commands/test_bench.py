@@ -157,3 +157,150 @@ def test_an_interrupt_says_the_finished_cells_are_saved(
 def test_argument_parsing_imports_nothing_heavy(heavy_imports: Callable[..., list[str]]) -> None:
     then = "physbench.cli.build_parser('bench')"
     assert heavy_imports("physbench.cli", then=then, heavy=PARSING_HEAVY) == []
+
+
+#: An estimator ``gated`` (random search) that, in each cell, records its process in the folder
+#: ``PB_GATE`` (``started-<pid>-<n>``) and then waits (at most 30 s) for the file ``PB_GATE/go``.
+GATED = """
+import os
+import time
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+
+from physbench.estimators.base import CorrectionEstimator
+from physbench.hookspecs import hookimpl
+
+GATE = Path(os.environ["PB_GATE"])
+
+
+class Gated(CorrectionEstimator):
+    name: ClassVar[str] = "gated"
+
+    def __init__(self):
+        self.options = {}
+
+    def start(self, task, *, seed):
+        self.space, self.rng = task.space, np.random.default_rng(seed)
+        n = len(list(GATE.glob("started-*")))
+        (GATE / f"started-{os.getpid()}-{n}").write_text("")
+        deadline = time.monotonic() + 30
+        while not (GATE / "go").exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+
+    def propose(self, step):
+        return self.space.from_unit(self.rng.random(len(self.space)))
+
+
+@hookimpl
+def register_estimators():
+    return [Gated]
+"""
+
+GATED_SPEC = (
+    'name = "gated"\nestimators = ["gated"]\nseeds = 4\niterations = 1\nresolution = 16\n'
+    '[[scenes]]\nname = "second_order"\nunknowns = ["elasticity"]\n'
+)
+
+
+def _gated_bench(
+    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+) -> tuple[list[str], dict[str, str], Path]:
+    """The ``physbench bench`` arguments of a sweep of 4 ``gated`` cells into ``tmp_path/out``,
+    the environment that finds the plugin in a child process, and the gate folder."""
+    import os
+    import sys
+
+    import physbench
+
+    gate = tmp_path / "gate"
+    gate.mkdir()
+    monkeypatch.setenv("PB_GATE", str(gate))
+    plugin("pb_gated", GATED)
+    (tmp_path / "spec.toml").write_text(GATED_SPEC)
+    paths = [tmp_path / "plugins", Path(physbench.__file__).parents[1]]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(map(str, paths))}
+    argv = ["bench", str(tmp_path / "spec.toml"), "--out", str(tmp_path / "out"), "-q"]
+    return [sys.executable, "-m", "physbench", *argv], env, gate
+
+
+def _until(condition: Callable[[], bool], what: str, seconds: float = 60) -> None:
+    import time
+
+    deadline = time.monotonic() + seconds
+    while not condition():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.05)
+
+
+def test_killing_the_main_process_ends_its_workers(
+    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import signal
+    import subprocess
+
+    import psutil
+
+    command, env, gate = _gated_bench(tmp_path, plugin, monkeypatch)
+    main_proc = subprocess.Popen([*command, "--workers", "2"], env=env, stderr=subprocess.DEVNULL)
+    try:
+        _until(lambda: len(list(gate.glob("started-*"))) == 2, "both workers to start a cell")
+        family = psutil.Process(main_proc.pid).children(recursive=True)
+        workers = {int(f.name.split("-")[1]) for f in gate.glob("started-*")}
+        assert workers <= {p.pid for p in family} and len(workers) == 2
+    finally:
+        main_proc.send_signal(signal.SIGKILL)
+        main_proc.wait()
+
+    def alive() -> list[psutil.Process]:
+        out = []
+        for p in family:
+            try:
+                if p.status() != psutil.STATUS_ZOMBIE:
+                    out.append(p)
+            except psutil.NoSuchProcess:
+                pass
+        return out
+
+    try:
+        _until(lambda: not alive(), "the workers to end", seconds=10)
+    finally:
+        for p in alive():
+            p.kill()
+
+
+def test_a_second_run_on_the_same_folder_refuses_or_waits(
+    tmp_path: Path,
+    plugin: Callable[..., ModuleType],
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import subprocess
+    import threading
+
+    command, env, gate = _gated_bench(tmp_path, plugin, monkeypatch)
+    first = subprocess.Popen([*command, "--executor", "serial"], env=env)
+    waited: list[int] = []
+    try:
+        _until(lambda: any(gate.glob("started-*")), "the first run to start a cell")
+        assert main([*command[3:], "--executor", "serial"]) == 2
+        out = tmp_path / "out"
+        assert capsys.readouterr().err == (
+            f"physbench bench: error: --out {str(out)!r}: another physbench bench is writing "
+            f"this folder (pid {first.pid}); wait for it (--wait) or use another --out\n"
+        )
+        second = threading.Thread(
+            target=lambda: waited.append(main([*command[3:], "--executor", "serial", "--wait"]))
+        )
+        second.start()
+        second.join(1)
+        assert second.is_alive()  # waiting for the first run
+    finally:
+        (gate / "go").write_text("")
+        assert first.wait(60) == 0
+    second.join(60)
+    assert waited == [0] and "(0 run, 4 already done, 0 failed)" in capsys.readouterr().out
+    runs = json.loads((out / "run.json").read_text())["runs"]
+    assert [r["ran"] for r in runs] == [4, 0]
+    assert len(list((out / "cells").glob("*.json"))) == 4 and len(list(gate.iterdir())) == 5
