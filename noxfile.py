@@ -1,5 +1,5 @@
 """Developer sessions: ``nox -s tests``, ``nox -s lint``, ``nox -s bench``,
-``nox -s regression``."""
+``nox -s regression``, ``nox -s fuzz``."""
 
 from __future__ import annotations
 
@@ -17,6 +17,16 @@ def tests(session: nox.Session) -> None:
     session.install("-e", ".[all]")
     session.install("./plugins/physbench-scipy")
     session.run("pytest", "tests", "plugins/physbench-scipy/tests", *session.posargs)
+
+
+@nox.session
+def fuzz(session: nox.Session) -> None:
+    """The property tests of tests/test_fuzz_inputs.py (scene files, recordings, observation
+    files) with 10x the examples the normal test run tries."""
+    session.install("-e", ".[test]")
+    session.run(
+        "pytest", "tests/test_fuzz_inputs.py", *session.posargs, env={"PHYSBENCH_FUZZ_SCALE": "10"}
+    )
 
 
 @nox.session

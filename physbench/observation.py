@@ -81,8 +81,6 @@ def check_frames(
     """``frames`` as float32 ``(T, C, H, W)``, or :class:`ObservationError` naming expected vs
     got."""
     arr = np.asarray(frames)
-    if arr.dtype.kind not in "fiub":
-        raise ObservationError(f"{what}: expected numeric frames, got dtype {arr.dtype}")
     exp = tuple(int(v) for v in expected)
     if arr.shape != exp:
         names = "(T, C, H, W)"
@@ -98,14 +96,25 @@ def check_frames(
             "frame count, C, H, W the renderer's channels and image size (check --resolution and "
             "the render mode)"
         )
-    arr = arr.astype(np.float32, copy=False)
-    if not np.isfinite(arr).all():
-        raise ObservationError(f"{what}: frames contain NaN or inf")
-    lo, hi = float(arr.min()), float(arr.max())
-    if lo < -1e-6 or hi > 1 + 1e-6:
+    return check_values(arr, what=what)
+
+
+def check_values(frames: np.ndarray, *, what: str = "observation") -> np.ndarray:
+    """``frames`` as float32, or :class:`ObservationError` unless they are finite numbers in
+    [0, 1]. Called on loading a file and by :func:`check_frames`."""
+    if frames.dtype.kind not in "fiub":
         raise ObservationError(
-            f"{what}: frame values span [{lo:g}, {hi:g}], expected values in [0, 1]"
+            f"{what}: expected numeric frames (floats in [0, 1]), got dtype {frames.dtype}"
         )
+    arr = frames.astype(np.float32, copy=False)
+    if not np.isfinite(arr).all():
+        raise ObservationError(f"{what}: frames contain NaN or inf; expected values in [0, 1]")
+    if arr.size:
+        lo, hi = float(arr.min()), float(arr.max())
+        if lo < -1e-6 or hi > 1 + 1e-6:
+            raise ObservationError(
+                f"{what}: frame values span [{lo:g}, {hi:g}], expected values in [0, 1]"
+            )
     return arr
 
 
@@ -197,6 +206,12 @@ def load_observation(path: str | Path) -> Observation:
             arrays = {k: data[k] for k in data.files}
     except Exception as exc:  # zip, pickle and format errors all mean "not a usable .npz"
         raise ObservationError(f"{p}: cannot read as .npz ({type(exc).__name__}: {exc})") from None
+    for k, v in arrays.items():
+        if not isinstance(v, np.ndarray):  # numpy hands a member that is not .npy over as bytes
+            raise ObservationError(
+                f"{p}: member {k!r} is not a .npy array; an observation .npz holds only arrays "
+                "(as numpy.savez writes them)"
+            )
     if "frames" not in arrays:
         raise ObservationError(
             f"{p}: no 'frames' array (found: {', '.join(sorted(arrays)) or 'none'}); expected key "
@@ -208,7 +223,12 @@ def load_observation(path: str | Path) -> Observation:
         raise ObservationError(
             f"{p}: 'frames' has shape {frames.shape}; expected 4 axes (T, C, H, W)"
         )
-    marked = {k[len(MARK_PREFIX) :]: v for k, v in arrays.items() if k.startswith(MARK_PREFIX)}
+    frames = check_values(frames, what=f"{p} ['frames']")
+    marked = {
+        k[len(MARK_PREFIX) :]: check_values(v, what=f"{p} [{k!r}]")
+        for k, v in arrays.items()
+        if k.startswith(MARK_PREFIX)
+    }
     obs = Observation(frames, None, marked, source=str(p))
     if SCENE_KEY not in arrays:
         return obs  # frames only: no truth
@@ -216,5 +236,5 @@ def load_observation(path: str | Path) -> Observation:
 
     scene = loads_scene(str(arrays[SCENE_KEY]), source=f"{p} [{SCENE_KEY}]")
     engine = str(arrays[ENGINE_KEY]) if ENGINE_KEY in arrays else ""
-    effects = tuple(str(e) for e in arrays.get(EFFECTS_KEY, ()))
+    effects = tuple(str(e) for e in np.ravel(arrays.get(EFFECTS_KEY, ())))
     return replace(obs, truth=true_params(scene), scene=scene, engine=engine, effects=effects)

@@ -28,7 +28,7 @@ import io
 import json
 import math
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -401,6 +401,23 @@ def _declared_fields(
     return out, "\n" * text.count("\n", 0, skipped) + text[skipped:]
 
 
+def _csv_rows(reader: Iterator[list[str]], source: str) -> Iterator[list[str]]:
+    """The rows of ``reader``, with its ``csv.Error`` (a field over the csv module's size limit)
+    raised as a :class:`RecordingError` naming the line."""
+    while True:
+        try:
+            yield next(reader)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            line = getattr(reader, "line_num", 0)
+            raise RecordingError(
+                f"line {line}: not readable as CSV ({exc}); a cell holds at most "
+                f"{csv.field_size_limit()} characters",
+                source=source,
+            ) from None
+
+
 def parse_recordings(
     text: str, *, bodies: Scene | Iterable[str] | None = None, source: str = "<string>"
 ) -> list[Recording]:
@@ -424,7 +441,7 @@ def parse_recordings(
     def err(msg: str, column: str | None, line: int, row: int | None) -> RecordingError:
         return RecordingError(msg, source=source, line=line, row=row, column=column)
 
-    for cells in reader:
+    for cells in _csv_rows(reader, source):
         line = reader.line_num
         if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
             continue

@@ -26,6 +26,20 @@ BODY_PARAMS: dict[str, tuple[float, float]] = {
     "moment": (0.0, math.inf),  # exclusive lower bound; None means "from shape and mass"
 }
 
+# Limits a scene must keep, so that a typo fails when the scene is loaded rather than deep inside
+# an engine or the rasteriser (pixel coordinates that overflow, areas that underflow to 0, an
+# allocation per substep).
+#: m: the largest |coordinate| of a bound, position, anchor or vertex; far beyond any lab set-up.
+MAX_COORDINATE = 1e6
+#: m: the smallest radius, width and height (and square root of a polygon's area); a smaller shape
+#: has an area and a moment that underflow.
+MIN_SIZE = 1e-6
+#: Recorded frames: about an hour of video at 30 fps.
+MAX_FRAMES = 100_000
+#: Physics steps per recorded frame; more only costs time (1e4 steps per frame at 30 fps is a
+#: 3 microsecond step).
+MAX_SUBSTEPS = 10_000
+
 
 @dataclass(frozen=True)
 class Circle:
@@ -300,6 +314,37 @@ def _vec(key: str, value: object) -> Vec:
     return (_finite(f"{key}[0]", value[0]), _finite(f"{key}[1]", value[1]))
 
 
+def _coordinate(key: str, value: object) -> float:
+    v = _finite(key, value)
+    if abs(v) > MAX_COORDINATE:
+        raise SceneError(
+            f"must lie in [-{MAX_COORDINATE:g}, {MAX_COORDINATE:g}] m", key=key, value=value
+        )
+    return v
+
+
+def _point(key: str, value: object) -> Vec:
+    x, y = _vec(key, value)
+    return (_coordinate(f"{key}[0]", x), _coordinate(f"{key}[1]", y))
+
+
+def _size(key: str, value: object) -> float:
+    v = _finite(key, value)
+    if not MIN_SIZE <= v <= MAX_COORDINATE:
+        raise SceneError(f"must lie in [{MIN_SIZE:g}, {MAX_COORDINATE:g}] m", key=key, value=value)
+    return v
+
+
+def _name(key: str, value: object, seen: set[str], *, world: bool = False) -> str:
+    """``value`` when it names one of the bodies ``seen`` (or, with ``world``, is ``None``)."""
+    if (world and value is None) or (isinstance(value, str) and value in seen):
+        return value  # type: ignore[return-value]
+    extra = " (or 'world' for b)" if world else ""
+    raise SceneError(
+        f"no such body; bodies: {', '.join(sorted(seen))}{extra}", key=key, value=value
+    )
+
+
 def _check_param(key: str, param: str, value: float) -> None:
     lo, hi = BODY_PARAMS[param]
     value = _finite(key, value)
@@ -313,7 +358,9 @@ def _check_param(key: str, param: str, value: float) -> None:
 def validate_scene(scene: Scene) -> None:
     if not scene.name or not isinstance(scene.name, str):
         raise SceneError("must be a non-empty string", key="name", value=scene.name)
-    xmin, ymin, xmax, ymax = (_finite(f"bounds[{i}]", v) for i, v in enumerate(scene.bounds))
+    if not isinstance(scene.bounds, tuple | list) or len(scene.bounds) != 4:
+        raise SceneError("must be [xmin, ymin, xmax, ymax]", key="bounds", value=scene.bounds)
+    xmin, ymin, xmax, ymax = (_coordinate(f"bounds[{i}]", v) for i, v in enumerate(scene.bounds))
     if not (xmin < xmax and ymin < ymax):
         raise SceneError(
             "bounds must be [xmin, ymin, xmax, ymax] with min < max",
@@ -323,10 +370,10 @@ def validate_scene(scene: Scene) -> None:
     _vec("gravity", scene.gravity)
     if _finite("fps", scene.fps) <= 0:
         raise SceneError("must be > 0", key="fps", value=scene.fps)
-    for key in ("frames", "substeps"):
+    for key, most in (("frames", MAX_FRAMES), ("substeps", MAX_SUBSTEPS)):
         v = getattr(scene, key)
-        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-            raise SceneError("must be a whole number >= 1", key=key, value=v)
+        if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= most:
+            raise SceneError(f"must be a whole number in [1, {most}]", key=key, value=v)
     if not scene.bodies:
         raise SceneError("a scene needs at least one dynamic body", key="bodies", value=[])
 
@@ -341,7 +388,7 @@ def validate_scene(scene: Scene) -> None:
             raise SceneError("duplicate body name", key=f"{k}.name", value=b.name)
         seen.add(b.name)
         _check_shape(f"{k}.shape", b.shape)
-        x, y = _vec(f"{k}.position", b.position)
+        x, y = _point(f"{k}.position", b.position)
         hx, hy = b.shape.half_extents(_finite(f"{k}.angle", b.angle))
         eps = 1e-9
         if not (
@@ -356,7 +403,7 @@ def validate_scene(scene: Scene) -> None:
         _finite(f"{k}.angle", b.angle)
         _vec(f"{k}.velocity", b.velocity)
         _finite(f"{k}.angular_velocity", b.angular_velocity)
-        _vec(f"{k}.com_offset", b.com_offset)
+        _point(f"{k}.com_offset", b.com_offset)
         for p in ("mass", "elasticity", "friction"):
             _check_param(f"{k}.{p}", p, getattr(b, p))
         if b.moment is not None:
@@ -365,11 +412,13 @@ def validate_scene(scene: Scene) -> None:
     for i, s in enumerate(scene.statics):
         k = f"statics[{i}]"
         if isinstance(s, Segment):
-            a, bb = _vec(f"{k}.a", s.a), _vec(f"{k}.b", s.b)
+            a, bb = _point(f"{k}.a", s.a), _point(f"{k}.b", s.b)
             if a == bb:
                 raise SceneError("segment end points must differ", key=f"{k}.b", value=s.b)
-            if _finite(f"{k}.radius", s.radius) < 0:
-                raise SceneError("must be >= 0", key=f"{k}.radius", value=s.radius)
+            if not 0 <= _finite(f"{k}.radius", s.radius) <= MAX_COORDINATE:
+                raise SceneError(
+                    f"must lie in [0, {MAX_COORDINATE:g}] m", key=f"{k}.radius", value=s.radius
+                )
         elif isinstance(s, StaticPolygon):
             _check_points(f"{k}.points", s.points)
         else:
@@ -379,10 +428,7 @@ def validate_scene(scene: Scene) -> None:
 
     for i, f in enumerate(scene.forces):
         k = f"forces[{i}]"
-        if f.body not in seen:
-            raise SceneError(
-                f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=f.body
-            )
+        _name(f"{k}.body", f.body, seen)
         if f.kind not in ("force", "impulse"):
             raise SceneError(
                 "unknown force kind; known: force, impulse", key=f"{k}.kind", value=f.kind
@@ -398,28 +444,17 @@ def validate_scene(scene: Scene) -> None:
         k = f"joints[{i}]"
         if j.kind != "pivot":
             raise SceneError("unknown joint kind; known: pivot", key=f"{k}.kind", value=j.kind)
-        for side in ("a", "b"):
-            name = getattr(j, side)
-            if name is None and side == "b":
-                continue
-            if name not in seen:
-                raise SceneError(
-                    f"no such body; bodies: {', '.join(sorted(seen))} (or 'world' for b)",
-                    key=f"{k}.{side}",
-                    value=name,
-                )
+        _name(f"{k}.a", j.a, seen)
+        _name(f"{k}.b", j.b, seen, world=True)
         if j.a == j.b:
             raise SceneError("a joint needs two different bodies", key=f"{k}.b", value=j.b)
-        _vec(f"{k}.anchor", j.anchor)
+        _point(f"{k}.anchor", j.anchor)
 
     keys: set[str] = set()
     for i, u in enumerate(scene.unknowns):
         k = f"unknowns[{i}]"
-        if u.owner not in seen:
-            raise SceneError(
-                f"no such body; bodies: {', '.join(sorted(seen))}", key=f"{k}.body", value=u.owner
-            )
-        if u.name not in BODY_PARAMS:
+        _name(f"{k}.body", u.owner, seen)
+        if not isinstance(u.name, str) or u.name not in BODY_PARAMS:
             raise SceneError(
                 f"unknown parameter; known: {', '.join(BODY_PARAMS)}",
                 key=f"{k}.param",
@@ -440,22 +475,16 @@ def validate_scene(scene: Scene) -> None:
                 "the test body's parameters are fixed by definition", key=f"{k}.body", value=u.owner
             )
 
-    if scene.test_body is not None and scene.test_body not in seen:
-        raise SceneError(
-            f"no such body; bodies: {', '.join(sorted(seen))}",
-            key="test_body",
-            value=scene.test_body,
-        )
+    if scene.test_body is not None:
+        _name("test_body", scene.test_body, seen)
 
 
 def _check_shape(key: str, shape: object) -> None:
     if isinstance(shape, Circle):
-        if _finite(f"{key}.radius", shape.radius) <= 0:
-            raise SceneError("must be > 0", key=f"{key}.radius", value=shape.radius)
+        _size(f"{key}.radius", shape.radius)
     elif isinstance(shape, Box):
         for d in ("width", "height"):
-            if _finite(f"{key}.{d}", getattr(shape, d)) <= 0:
-                raise SceneError("must be > 0", key=f"{key}.{d}", value=getattr(shape, d))
+            _size(f"{key}.{d}", getattr(shape, d))
     elif isinstance(shape, Polygon):
         _check_points(f"{key}.points", shape.points)
     else:
@@ -465,8 +494,10 @@ def _check_shape(key: str, shape: object) -> None:
 def _check_points(key: str, points: object) -> None:
     if not isinstance(points, tuple | list) or len(points) < 3:
         raise SceneError("a polygon needs at least 3 points", key=key, value=points)
-    pts = tuple(_vec(f"{key}[{i}]", p) for i, p in enumerate(points))
+    pts = tuple(_point(f"{key}[{i}]", p) for i, p in enumerate(points))
     if not _is_convex_ccw(pts):
         raise SceneError(
             "polygon must be convex with counter-clockwise points", key=key, value=points
         )
+    if _signed_area(pts) < MIN_SIZE**2:
+        raise SceneError(f"polygon area must be >= {MIN_SIZE**2:g} m^2", key=key, value=points)

@@ -89,9 +89,18 @@ def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except OSError as exc:
         raise SceneError(f"cannot read scene file: {exc.strerror}", source=str(path)) from exc
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise SceneError(
+            f"byte {exc.start} ({data[exc.start : exc.start + 1]!r}) is not UTF-8; scene files "
+            "are UTF-8 TOML text",
+            source=str(path),
+            line=data.count(b"\n", 0, exc.start) + 1,
+        ) from None
     return loads_scene(text, source=str(path))
 
 
@@ -104,6 +113,11 @@ def loads_scene(text: str, *, source: str = "<scene>") -> Scene:
         raise SceneError(
             f"not valid TOML: {exc}", source=source, line=int(m.group(1)) if m else None
         ) from exc
+    except RecursionError:  # tomllib recurses once per nesting level of arrays and tables
+        raise SceneError(
+            "arrays or tables nested too deeply to parse; a scene nests at most 3 levels",
+            source=source,
+        ) from None
     try:
         return scene_from_dict(data).validate()
     except SceneError as exc:
@@ -141,7 +155,7 @@ def _shape(key: str, raw: object) -> Shape:
             'must be a table like { kind = "circle", radius = 0.3 }', key=key, value=raw
         )
     kind = raw.get("kind")
-    if kind not in _SHAPE_KEYS:
+    if not isinstance(kind, str) or kind not in _SHAPE_KEYS:
         raise SceneError(
             f"unknown shape; known: {', '.join(SHAPE_KINDS)}", key=f"{key}.kind", value=kind
         )
@@ -283,6 +297,8 @@ def locate(text: str, key: str) -> int | None:
         header = re.compile(rf"^\s*\[\[\s*{re.escape(first)}\s*\]\]")
         hits = [i for i, ln in enumerate(lines) if header.match(ln)]
         n = int(index)
+        if not hits:  # an element of an array value, such as bounds[3]: the array's line
+            return locate(text, ".".join([first, *rest]))
         if n >= len(hits):
             return None
         start = hits[n] + 1

@@ -59,3 +59,34 @@ def test_a_simulated_observation_file_carries_its_scene_truth_and_engine(tmp_pat
     # every other body parameter at the scene's value (a moment from shape and mass)
     assert back.truth["b.mass"] == scene.bodies[2].mass == 5.0
     assert back.truth["a.moment"] == scene.with_params(truth).bodies[1].inertia()
+
+
+def test_a_zip_member_that_is_not_npy_is_an_observation_error(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    import zipfile
+
+    path = tmp_path / "obs.npz"
+    np.savez(path, frames=np.zeros((2, 1, 4, 4), np.float32))
+    with zipfile.ZipFile(path, "a") as z:
+        z.writestr("notes.txt", b"hello")
+    with pytest.raises(ObservationError, match=r"member 'notes.txt' is not a .npy array"):
+        load_observation(path)
+
+
+@pytest.mark.parametrize(
+    ("frames", "fragment"),
+    [
+        (np.full((2, 1, 4, 4), np.nan, np.float32), "NaN or inf"),
+        (np.full((2, 1, 4, 4), np.inf, np.float32), "NaN or inf"),
+        (np.full((2, 1, 4, 4), 2.0, np.float32), r"span \[2, 2\], expected values in \[0, 1\]"),
+        (np.zeros((2, 1, 4, 4), "M8[s]"), "expected numeric frames"),
+        (np.zeros((2, 1, 4, 4), [("a", "f4"), ("b", "i4")]), "expected numeric frames"),
+    ],
+    ids=["nan", "inf", "above 1", "datetime64", "structured"],
+)
+def test_discover_checks_npz_frame_values_on_loading(tmp_path, frames, fragment) -> None:  # type: ignore[no-untyped-def]
+    from physbench.discover.data import load_runs
+
+    path = tmp_path / "obs.npz"
+    np.savez(path, frames=frames)
+    with pytest.raises(ObservationError, match=rf"obs.npz \['frames'\]: .*{fragment}"):
+        load_runs(path, toy_task().scene)

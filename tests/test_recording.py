@@ -373,3 +373,9 @@ def test_the_accuracy_a_recording_states_survives_its_csv():
     assert parse_recordings("# accuracy: 0.004 m\nt,body,x,y\n0,b,0,0\n")[0].accuracy == 0.004
     with pytest.raises(RecordingError, match=r"line 1 \(comment\): accuracy 'x'"):
         parse_recordings("# accuracy: x\nt,body,x,y\n0,b,0,0\n")
+
+
+def test_a_cell_over_the_csv_field_limit_is_a_recording_error() -> None:
+    text = "t,body,x,y\n0,a,0,0\n0.1,a," + "9" * 140_000 + ",0\n"
+    with pytest.raises(RecordingError, match=r"rec.csv: line 3: not readable as CSV .*131072"):
+        parse_recordings(text, source="rec.csv")

@@ -85,7 +85,13 @@ def test_builtin_scene_round_trip_is_exact(name: str, seed: int, tmp_path: Path)
 
 # (replace this, with that, expected key, expected line, message fragment)
 BAD = [
-    ("radius = 0.3 }", "radius = -0.3 }", "bodies[0].shape.radius", 11, "must be > 0"),
+    (
+        "radius = 0.3 }",
+        "radius = -0.3 }",
+        "bodies[0].shape.radius",
+        11,
+        "must lie in [1e-06, 1e+06] m",
+    ),
     (
         'kind = "circle"',
         'kind = "ellipse"',
@@ -105,7 +111,7 @@ BAD = [
     ),
     ("position = [1.0, 2.0]", "position = [1.0]", "bodies[0].position", 12, "pair of numbers"),
     ('name = "a"', 'name = "test"', "bodies[1].name", 16, "duplicate body name"),
-    ("frames = 20", "frames = 0", "frames", 5, "whole number >= 1"),
+    ("frames = 20", "frames = 0", "frames", 5, "whole number in"),
     ("fps = 30.0", "fps = -30.0", "fps", 4, "must be > 0"),
     ("bounds = [0.0, 0.0, 4.0, 4.0]", "bounds = [4.0, 0.0, 0.0, 4.0]", "bounds", 2, "min < max"),
     ('test_body = "test"', 'test_body = "nobody"', "test_body", 7, "no such body"),
@@ -135,6 +141,28 @@ BAD = [
     ("gravity = [0.0, -9.81]", 'gravity = "down"', "gravity", 3, "pair of numbers"),
     ("substeps = 8", "substeps = 2.5", "substeps", 6, "whole number"),
     ('name = "demo"', 'title = "demo"', "title", 1, "unknown key"),
+    # Found by fuzzing (issue 14): each raised TypeError, OverflowError, ZeroDivisionError or
+    # MemoryError, in loading or later in a simulator or the rasteriser.
+    ('kind = "circle"', 'kind = ["circle"]', "bodies[0].shape.kind", 11, "unknown shape"),
+    ('body = "a"\nparam', 'body = ["a"]\nparam', "unknowns[0].body", 44, "no such body"),
+    ('test_body = "test"', 'test_body = { name = "test" }', "test_body", 7, "no such body"),
+    ('a = "tri"', 'a = { name = "tri" }', "joints[0].a", 40, "no such body"),
+    ("bounds = [0.0, 0.0, 4.0, 4.0]", "bounds = 0", "bounds", 2, "[xmin, ymin, xmax, ymax]"),
+    (
+        "bounds = [0.0, 0.0, 4.0, 4.0]",
+        "bounds = [0.0, 0.0, 4.0, 1e30]",
+        "bounds[3]",
+        2,
+        "must lie in [-1e+06, 1e+06] m",
+    ),
+    (
+        "height = 0.4",
+        "height = 5e-324",
+        "bodies[1].shape.height",
+        17,
+        "must lie in [1e-06, 1e+06] m",
+    ),
+    ("substeps = 8", f"substeps = {2**62}", "substeps", 6, "whole number in [1, 10000]"),
 ]
 
 
@@ -158,6 +186,19 @@ def test_bad_scene_file_names_key_value_and_line(
 def test_syntax_error_reports_line() -> None:
     with pytest.raises(SceneError, match=r"bad.toml:3: not valid TOML"):
         loads_scene('name = "x"\nfps = 30\nframes = = 3\n', source="bad.toml")
+
+
+def test_file_that_is_not_utf8_is_a_scene_error_naming_the_byte(tmp_path: Path) -> None:
+    path = tmp_path / "latin1.toml"
+    path.write_bytes(GOOD.encode() + b'description = "caf\xe9"\n')
+    with pytest.raises(SceneError, match=r"latin1.toml:47: byte \d+ \(b'\\xe9'\) is not UTF-8"):
+        load_scene(path)
+
+
+def test_deeply_nested_arrays_are_a_scene_error() -> None:
+    deep = "[" * 2000 + "]" * 2000
+    with pytest.raises(SceneError, match="nested too deeply"):
+        loads_scene(f"name = {deep}\n" + GOOD, source="deep.toml")
 
 
 def test_missing_file_is_a_scene_error(tmp_path: Path) -> None:

@@ -48,12 +48,16 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from physbench.commands.arguments import MAX_RESOLUTION, MAX_SEED
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
 from physbench.params import split_params
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
+#: The most seeds a spec may list: each is a cell per scene x estimator x axis value, so more is
+#: a typo (``seeds = 2**62`` would build the list before anything runs).
+MAX_SEEDS = 100_000
 AXES = ("engine", "observe_engine", "blur", "noise", "resolution", "render_mode", "iterations")
 TOP_KEYS = (
     "name",
@@ -211,9 +215,12 @@ def _unknown_set(value: Any, where: str) -> tuple[str, ...]:
 
 def _seeds(value: Any, where: str) -> tuple[int, ...]:
     def ok(v: Any) -> bool:
-        return isinstance(v, int) and not isinstance(v, bool) and v >= 0
+        return isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= MAX_SEED
 
-    if ok(value):
+    def count(v: Any) -> bool:
+        return ok(v) and v <= MAX_SEEDS
+
+    if count(value):
         seeds = list(range(value))
     elif isinstance(value, list) and all(ok(v) for v in value):
         seeds = list(value)
@@ -221,13 +228,14 @@ def _seeds(value: Any, where: str) -> tuple[int, ...]:
         isinstance(value, dict)
         and set(value) <= {"start", "count"}
         and ok(value.get("start", 0))
-        and ok(value.get("count"))
+        and count(value.get("count"))
+        and value.get("start", 0) + value["count"] - 1 <= MAX_SEED
     ):
         seeds = list(range(value.get("start", 0), value.get("start", 0) + value["count"]))
     else:
         raise SpecError(
             f"{where} = {value!r}: expected a count (50 -> seeds 0..49), a list of whole numbers "
-            ">= 0, or {start = S, count = N}"
+            f"in [0, {MAX_SEED}], or {{start = S, count = N}}, at most {MAX_SEEDS} seeds"
         )
     if len(set(seeds)) != len(seeds):
         raise SpecError(f"{where} = {value!r}: seeds repeat")
@@ -248,14 +256,16 @@ def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
                 isinstance(v, bool)
                 or not isinstance(v, int | float)
                 or not math.isfinite(v)
-                or v < 0
+                or not 0 <= v <= MAX_RESOLUTION
             ):
-                raise bad(v, "a finite number >= 0")
+                raise bad(v, f"a finite number in [0, {MAX_RESOLUTION}]")
             v = float(v)
         elif name in ("resolution", "iterations") and (
             isinstance(v, bool) or not isinstance(v, int) or v < 1
         ):
             raise bad(v, "a whole number >= 1")
+        elif name == "resolution" and v > MAX_RESOLUTION:
+            raise bad(v, f"a whole number in [1, {MAX_RESOLUTION}]")
         out.append(v)
     if len(set(out)) != len(out):
         raise SpecError(f"{where} = {values!r}: values repeat")
@@ -443,11 +453,21 @@ def load_spec(path: str | Path) -> Spec:
     p = Path(path)
     if not p.is_file():
         raise SpecError(f"spec file {str(p)!r} does not exist")
-    text = p.read_text()
+    raw = p.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise SpecError(
+            f"{p}: byte {exc.start} ({raw[exc.start : exc.start + 1]!r}) on line {line} is not "
+            "UTF-8; spec files are UTF-8 TOML text"
+        ) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(f"{p}: not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses once per nesting level
+        raise SpecError(f"{p}: arrays or tables nested too deeply to parse") from None
     return parse_spec(data, path=str(p), source=text)
 
 

@@ -622,3 +622,37 @@ def _atomic(path: Path, text: str) -> None:
     from physbench.bench.store import atomic_write
 
     atomic_write(path, text.encode())
+
+
+def read_results(path: str | Path) -> pd.DataFrame:
+    """A finished sweep's long table from its folder or its ``results.parquet``, with the columns
+    :func:`upgrade` adds; called by the commands that read a sweep (``plot``, ``compare``). A file
+    that is not Parquet, or lacks a column of :data:`SCHEMA`, is a :class:`PhysbenchError` that
+    names it."""
+    import pandas as pd
+
+    from physbench.bench.store import RESULTS
+    from physbench.errors import PhysbenchError
+
+    p = Path(path)
+    f = p / RESULTS if p.is_dir() else p
+    if not f.is_file():
+        raise PhysbenchError(
+            f"{str(p)!r}: no {RESULTS} there; expected the --out folder of a finished "
+            "`physbench bench` run"
+        )
+    try:
+        df = pd.read_parquet(f)
+    except Exception as exc:  # pyarrow raises several types for a file that is not Parquet
+        raise PhysbenchError(
+            f"{str(f)!r}: not a Parquet table ({type(exc).__name__}: {exc}); expected the "
+            f"{RESULTS} that `physbench bench` writes"
+        ) from None
+    missing = [c for c in SCHEMA if c not in ADDED and c not in df.columns]
+    if missing:
+        raise PhysbenchError(
+            f"{str(f)!r}: not a sweep's results table: no column {', '.join(missing[:5])}"
+            f"{', ...' if len(missing) > 5 else ''} ({len(missing)} of {len(SCHEMA)} missing); "
+            f"expected the {RESULTS} that `physbench bench` writes"
+        )
+    return upgrade(df)

@@ -24,12 +24,76 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+from collections.abc import Callable
 from typing import Any
 
 #: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
 RENDER_MODES = ("mark", "instance", "mask", "rgb")
 #: physbench.experiment.DEFAULT_SCENE, for the same reason.
 DEFAULT_SCENE = "three_circles"
+#: The widest frame in pixels: a (T, C, H, W) float32 sequence at 4096 px already takes GiBs.
+MAX_RESOLUTION = 4096
+#: Seeds go to numpy, random, torch and optuna; this is the range all of them accept.
+MAX_SEED = 2**32 - 1
+#: The longest ``--scene``: Linux's PATH_MAX (a longer path cannot name a file).
+MAX_SCENE_ARGUMENT = 4096
+
+
+def bounded_int(low: int, high: int | None = None) -> Callable[[str], int]:
+    """An argparse ``type=`` that accepts whole numbers in ``[low, high]`` (no upper bound when
+    ``high`` is ``None``); the error names the value and the range."""
+    accepted = f"a whole number >= {low}" if high is None else f"a whole number in [{low}, {high}]"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {accepted}") from None
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"{value} is not {accepted}")
+        return value
+
+    parse.__name__ = "whole number"  # argparse names the type in its own messages
+    return parse
+
+
+def bounded_float(low: float, high: float) -> Callable[[str], float]:
+    """An argparse ``type=`` that accepts finite numbers in ``[low, high]``; the error names the
+    value and the range."""
+    accepted = f"a finite number in [{low:g}, {high:g}]"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {accepted}") from None
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"{text} is not {accepted}")
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+#: ``type=`` for counts that must be at least 1 (iterations, validation groups, intervals).
+positive_int = bounded_int(1)
+#: ``type=`` for counts where 0 means "none" (threads, evaluation seeds).
+nonnegative_int = bounded_int(0)
+#: ``type=`` for ``--seed``.
+seed_int = bounded_int(0, MAX_SEED)
+#: ``type=`` for ``--resolution``.
+resolution_int = bounded_int(1, MAX_RESOLUTION)
+
+
+def scene_argument(text: str) -> str:
+    """``type=`` of ``--scene``: a name or path no longer than :data:`MAX_SCENE_ARGUMENT`."""
+    if len(text) > MAX_SCENE_ARGUMENT:
+        raise argparse.ArgumentTypeError(
+            f"{text[:40]!r}... ({len(text)} characters) is longer than a scene name or path can "
+            f"be; expected at most {MAX_SCENE_ARGUMENT} characters"
+        )
+    return text
 
 
 def add_scene_argument(p: argparse.ArgumentParser, *, required: bool, help: str = "") -> None:
@@ -39,6 +103,7 @@ def add_scene_argument(p: argparse.ArgumentParser, *, required: bool, help: str 
     :func:`physbench.scenes.resolve_scene`."""
     p.add_argument(
         "--scene",
+        type=scene_argument,
         required=required,
         default=None,
         metavar="NAME|FILE",
@@ -122,7 +187,7 @@ def add_renderer_arguments(
     add_renderer_choice(p)
     p.add_argument(
         "--resolution",
-        type=int,
+        type=resolution_int,
         default=None if from_frames else resolution,
         metavar="PX",
         help="frame width in pixels (default: "

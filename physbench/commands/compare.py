@@ -60,12 +60,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     from physbench.bench.compare import compare
-    from physbench.bench.runner import read_table
-    from physbench.bench.tables import SETTINGS, markdown
+    from physbench.bench.tables import SETTINGS, markdown, read_results
     from physbench.errors import counted
 
     res = compare(
-        read_table(args.new), read_table(args.baseline), alpha=args.alpha, min_ratio=args.min_ratio
+        read_results(args.new),
+        read_results(args.baseline),
+        alpha=args.alpha,
+        min_ratio=args.min_ratio,
     )
     t = res.table
     shown = t if args.all else t[t["verdict"].isin(["worse", "better"])]

@@ -10,6 +10,8 @@ from physbench.commands.arguments import (
     add_renderer_arguments,
     add_scene_argument,
     add_video_input_arguments,
+    positive_int,
+    seed_int,
 )
 
 #: what :func:`physbench.discover.discover` reports to its ``stage`` callback, in order
@@ -56,7 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--iterations",
-        type=int,
+        type=positive_int,
         default=60,
         help="estimator iterations for the base fit (default 60)",
     )
@@ -101,7 +103,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_renderer_arguments(p, from_frames=True)
     p.add_argument(
         "--seed",
-        type=int,
+        type=seed_int,
         default=0,
         help="instance of a registered --scene and seed of a black-box base-fit estimator "
         "(default 0)",

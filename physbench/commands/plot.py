@@ -55,13 +55,12 @@ def main(args: argparse.Namespace) -> int:
         )
 
     from physbench.bench import plots, report
-    from physbench.bench.runner import read_table
     from physbench.bench.store import atomic_write
-    from physbench.bench.tables import final_rows, win_rate_table
+    from physbench.bench.tables import final_rows, read_results, win_rate_table
     from physbench.commands.console import stages, wrote
 
     source = Path(args.dir)
-    df = read_table(source)
+    df = read_results(source)
     if df.empty:
         raise PhysbenchError(
             f"{str(source)!r}: the results table is empty; run `physbench bench SPEC --out "

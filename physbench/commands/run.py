@@ -14,12 +14,15 @@ import sys
 from typing import Any
 
 from physbench.commands.arguments import (
+    MAX_RESOLUTION,
     add_json_argument,
     add_params_argument,
     add_quiet_argument,
     add_renderer_arguments,
     add_scene_argument,
     add_video_input_arguments,
+    bounded_float,
+    seed_int,
 )
 
 
@@ -62,7 +65,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--seed",
-        type=int,
+        type=seed_int,
         default=0,
         help="scene instance, truth, initial guess and estimator seed (default: 0); with an "
         "--observation file that carries its scene, only the initial guess and estimator seed",
@@ -84,10 +87,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_renderer_arguments(p)
     p.add_argument(
         "--blur",
-        type=float,
+        type=bounded_float(0.0, MAX_RESOLUTION),
         default=0.0,
         metavar="SIGMA",
-        help="Gaussian blur (pixels) of the observation only; the model stays sharp",
+        help="Gaussian blur (pixels) of the observation only; the model stays sharp (at most "
+        "--resolution)",
     )
     p.add_argument(
         "--noise",
@@ -210,8 +214,11 @@ def main(args: argparse.Namespace) -> int:
 
     if args.iterations < 1:
         raise PhysbenchError(f"--iterations {args.iterations}: expected a whole number >= 1")
-    if args.seed < 0:
-        raise PhysbenchError(f"--seed {args.seed}: expected a whole number >= 0")
+    if args.blur > args.resolution:
+        raise PhysbenchError(
+            f"--blur {args.blur:g}: expected at most the frame width --resolution "
+            f"{args.resolution} pixels (a wider blur leaves flat frames)"
+        )
 
     from physbench.commands.arguments import parse_key_values, renderer_choice
     from physbench.commands.console import progress_bar, wrote

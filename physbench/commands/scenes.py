@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+from physbench.commands.arguments import seed_int
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--seed", type=int, default=0, help="instance to describe (default 0)")
+    p.add_argument("--seed", type=seed_int, default=0, help="instance to describe (default 0)")
     p.add_argument("--toml", metavar="NAME", help="print one scene's instance as TOML and exit")
 
 

@@ -11,6 +11,7 @@ from physbench.commands.arguments import (
     add_renderer_arguments,
     add_scene_argument,
     make_renderer_from,
+    seed_int,
 )
 
 #: ``--out`` suffixes written as a video file (camera renderer only).
@@ -24,7 +25,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--engine", default="pymunk", help="simulator (see `physbench plugins`; default pymunk)"
     )
-    p.add_argument("--seed", type=int, default=0, help="scene instance seed (default 0)")
+    p.add_argument("--seed", type=seed_int, default=0, help="scene instance seed (default 0)")
     p.add_argument(
         "--set",
         action="append",

@@ -9,6 +9,9 @@ from physbench.commands.arguments import (
     add_quiet_argument,
     add_renderer_choice,
     add_scene_argument,
+    nonnegative_int,
+    positive_int,
+    resolution_int,
 )
 
 
@@ -32,7 +35,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="channel widths of the 4 stages (paper: 64,128,256,512)",
     )
     p.add_argument(
-        "--resolution", type=int, default=32, help="network input resolution (default 32)"
+        "--resolution",
+        type=resolution_int,
+        default=32,
+        help="network input resolution (default 32)",
     )
     p.add_argument(
         "--frames", type=int, default=15, help="frames per sequence after subsampling (default 15)"
@@ -62,16 +68,24 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
     add_renderer_choice(p)
     p.add_argument("--workers", type=int, default=1, help="data-generating processes (default 1)")
-    p.add_argument("--threads", type=int, default=0, help="torch threads (default: torch's choice)")
     p.add_argument(
-        "--val-groups", type=int, default=24, help="validation scene instances (fixed seeds)"
+        "--threads", type=nonnegative_int, default=0, help="torch threads (default: torch's choice)"
     )
     p.add_argument(
-        "--eval-every", type=int, default=2_000, help="samples between validation/checkpoints"
+        "--val-groups",
+        type=positive_int,
+        default=24,
+        help="validation scene instances (fixed seeds)",
+    )
+    p.add_argument(
+        "--eval-every",
+        type=positive_int,
+        default=2_000,
+        help="samples between validation/checkpoints",
     )
     p.add_argument(
         "--eval-seeds",
-        type=int,
+        type=nonnegative_int,
         default=5,
         help="held-out runs of the final evaluation (0 to skip)",
     )

@@ -32,7 +32,10 @@ def scene_generator(
 
 def is_scene_file(name_or_path: str) -> bool:
     """Whether a ``--scene`` value names a scene TOML file rather than a registered generator."""
-    return name_or_path.endswith(".toml") or Path(name_or_path).is_file()
+    try:
+        return name_or_path.endswith(".toml") or Path(name_or_path).is_file()
+    except OSError:  # e.g. a name too long for a path: it cannot name a file
+        return False
 
 
 def resolve_scene(name_or_path: str, seed: int = 0) -> Scene:

@@ -83,7 +83,13 @@ def test_seed_forms(seeds: object, expected: tuple[int, ...]) -> None:
         ),
         ({"seeds": -1}, "seeds = -1: expected a count"),
         ({"iterations": 0}, "iterations = 0: expected a whole number >= 1"),
-        ({"blur": -1.0}, "blur = -1.0: expected a finite number >= 0"),
+        ({"blur": -1.0}, "blur = -1.0: expected a finite number in [0, 4096]"),
+        # Found by fuzzing (issue 14): a MemoryError building the seeds, a huge frame, a blur
+        # that overflows the kernel.
+        ({"seeds": 2**62}, f"seeds = {2**62}: expected a count"),
+        ({"seeds": {"start": 2**40, "count": 2}}, "whole numbers in [0, 4294967295]"),
+        ({"resolution": 100_000}, "resolution = 100000: expected a whole number in [1, 4096]"),
+        ({"blur": 1e30}, "blur = 1e+30: expected a finite number in [0, 4096]"),
         ({"estimators": ["random", "random"]}, "two estimators are labelled 'random'"),
     ],
 )
@@ -91,6 +97,19 @@ def test_bad_specs(change: dict[str, object], message: str) -> None:
     with pytest.raises(SpecError) as err:
         parse_spec({**GOOD, **change})
     assert message in str(err.value), str(err.value)
+
+
+def test_spec_file_not_utf8_or_nested_too_deeply_is_a_spec_error(tmp_path: Path) -> None:
+    latin1 = tmp_path / "latin1.toml"
+    latin1.write_bytes(b'name = "t"\ndescription = "caf\xe9"\n')
+    with pytest.raises(
+        SpecError, match=r"latin1.toml: byte 29 \(b'\\xe9'\) on line 2 is not UTF-8"
+    ):
+        load_spec(latin1)
+    deep = tmp_path / "deep.toml"
+    deep.write_text("seeds = " + "[" * 2000 + "]" * 2000 + "\n")
+    with pytest.raises(SpecError, match=r"deep\.toml: arrays or tables nested too deeply"):
+        load_spec(deep)
 
 
 def test_missing_axis_and_duplicate_cells() -> None:

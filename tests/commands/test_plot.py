@@ -80,3 +80,26 @@ def test_an_empty_table_says_to_run_the_sweep_first(
 def test_argument_parsing_imports_nothing_heavy(heavy_imports: Callable[..., list[str]]) -> None:
     then = "physbench.cli.build_parser('plot')"
     assert heavy_imports("physbench.cli", then=then, heavy=PARSING_HEAVY) == []
+
+
+@pytest.mark.parametrize("command", ["plot", "compare"])
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("not parquet", "results.parquet': not a Parquet table"),
+        ("no columns", "results.parquet': not a sweep's results table: no column cell, "),
+    ],
+)
+def test_a_table_that_is_not_a_sweeps_exits_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str, content: str, message: str
+) -> None:
+    # Issue 14: these were ArrowInvalid and KeyError tracebacks.
+    table = tmp_path / "results.parquet"
+    if content == "not parquet":
+        table.write_text("t,body,x,y\n")
+    else:
+        pd.DataFrame({"x": [1.0]}).to_parquet(table)
+    argv = [command, str(tmp_path)] + ([str(tmp_path)] if command == "compare" else [])
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"physbench {command}: error: " in err and message in err, err
