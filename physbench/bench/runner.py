@@ -145,21 +145,11 @@ def write_table(df: pd.DataFrame, out: Path) -> Path:
 
 
 def read_table(path: str | Path) -> pd.DataFrame:
-    """A sweep's long table from its folder or its ``results.parquet``; a table written before
-    some columns existed gets them with the values it implies (:func:`~.tables.upgrade`)."""
-    import pandas as pd
+    """A sweep's long table from its folder or its ``results.parquet``, checked and upgraded:
+    :func:`~.tables.read_results` (kept under this name for its callers)."""
+    from physbench.bench.tables import read_results
 
-    from physbench.bench.tables import upgrade
-    from physbench.errors import PhysbenchError
-
-    p = Path(path)
-    f = p / RESULTS if p.is_dir() else p
-    if not f.is_file():
-        raise PhysbenchError(
-            f"{str(p)!r}: no {RESULTS} there; expected the --out folder of a finished "
-            "`physbench bench` run"
-        )
-    return upgrade(pd.read_parquet(f))
+    return read_results(path)
 
 
 def run_sweep(
