@@ -18,7 +18,9 @@ class Parameter:
     ``owner`` is what it belongs to (a body for a scene's unknown, an effect's key for an effect's
     parameter); an effect class declares its parameters without one and each instance qualifies
     them with its key (:meth:`owned_by`). ``default`` is the value used when none is given
-    (``None``: the owner decides, e.g. a body's own mass).
+    (``None``: the owner decides, e.g. a body's own mass). ``extensible``: the range is a typical
+    span, not a physical limit (a drag coefficient, a friction torque), so a fit that reaches its
+    high end, or a nonzero low end, may widen it (:meth:`widened`).
     """
 
     name: str
@@ -28,6 +30,7 @@ class Parameter:
     unit: str = ""
     default: float | None = None
     doc: str = ""
+    extensible: bool = False
 
     @property
     def key(self) -> str:
@@ -41,6 +44,12 @@ class Parameter:
     def owned_by(self, owner: str) -> Parameter:
         """This parameter qualified by ``owner`` (an effect instance's key, a body)."""
         return replace(self, owner=owner)
+
+    def widened(self, factor: float = 10.0) -> Parameter:
+        """This parameter with its nonzero ends moved ``factor`` times further from zero."""
+        low = self.low * factor if self.low < 0 else self.low
+        high = self.high * factor if self.high > 0 else self.high
+        return replace(self, low=low, high=high)
 
     def contains(self, value: float, *, tol: float = 0.0) -> bool:
         """Whether ``value`` is a finite number inside the range (``tol`` of slack at both ends)."""

@@ -28,6 +28,11 @@ from physbench.errors import SimulationError
 
 #: Residual given to every entry of a simulation that explodes, in units of the start's RMS.
 FAILED_RESIDUAL = 100.0
+#: How many times a fit that ends at the end of an extensible effect range widens it (x10) and
+#: refits from there: the declared ranges are typical sizes, not limits of the scene at hand.
+WIDENINGS = 3
+#: How close to an end of its range (in units of the range's width) a value counts as at it.
+BOUND_TOL = 1e-3
 
 
 def _vector(model: Model, keys: Sequence[str]) -> tuple[np.ndarray, list[FitParameter]]:
@@ -53,24 +58,58 @@ def least_squares(
     of each parameter's scale (:attr:`FitParameter.scale`). ``budget`` caps the simulations of each
     horizon (the best point so far is kept). ``horizons``: fit the first shares of time in turn,
     each from the last optimum (continuation: a late bounce cannot pull an early fit into a wrong
-    valley); unless ``final`` is False, the last horizon is 1 whatever ``horizons`` ends with."""
+    valley); unless ``final`` is False, the last horizon is 1 whatever ``horizons`` ends with.
+
+    An effect parameter that ends at the end of an extensible range has its range widened and the
+    last horizon refitted from there, up to :data:`WIDENINGS` times; the ones still at a nonzero
+    end are listed in the result's ``at_bound``."""
     sims0 = model.problem.simulations
     steps = [h for h in horizons if 0 < h < 1] + ([1.0] if final else [])
     for h in steps[:-1]:
         _lsq(model, free, role, runs, max_nfev, budget, diff_step, tol, h, covariance_needed=False)
-    fr = _lsq(
-        model,
-        free,
-        role,
-        runs,
-        max_nfev,
-        budget,
-        diff_step,
-        tol,
-        steps[-1],
-        covariance_needed=final,
+
+    def last() -> FitResult:
+        return _lsq(
+            model,
+            free,
+            role,
+            runs,
+            max_nfev,
+            budget,
+            diff_step,
+            tol,
+            steps[-1],
+            covariance_needed=final,
+        )
+
+    fr = last()
+    for _ in range(WIDENINGS):
+        ends = [k for k in at_bound(model, free) if model.param(k).extensible]
+        if not ends:
+            break
+        for k in ends:
+            model.widen(k)
+        fr = last()
+    return replace(
+        fr,
+        simulations=model.problem.simulations - sims0,
+        at_bound=tuple(at_bound(model, free)),
     )
-    return replace(fr, simulations=model.problem.simulations - sims0)
+
+
+def at_bound(model: Model, keys: Sequence[str]) -> list[str]:
+    """The effect parameters among ``keys`` whose value is at a nonzero end of its range (within
+    :data:`BOUND_TOL` of its width): the data may want a value beyond it. A zero end is where
+    an effect switches off, not a limit."""
+    out = []
+    for k in keys:
+        p = model.param(k)
+        if p.kind != "effect":
+            continue
+        v, tol = model.values[k], BOUND_TOL * (p.high - p.low)
+        if (p.high != 0 and v >= p.high - tol) or (p.low != 0 and v <= p.low + tol):
+            out.append(k)
+    return out
 
 
 class _OutOfBudget(Exception):

@@ -90,6 +90,7 @@ class FitParameter(Parameter):
             unit=p.unit,
             default=default,
             doc=p.doc,
+            extensible=p.extensible,
             kind=kind,
             scale=scale,
             run=run,
@@ -449,6 +450,19 @@ class Model:
         )
         m.values.update(self.values)
         return m
+
+    def widen(self, key: str, factor: float = 10.0) -> FitParameter:
+        """Widen the range of the effect parameter ``key`` ``factor`` times (its nonzero ends, in
+        the model and in the effect, so that the effect accepts the new values); returns the
+        widened parameter. Called when a fit ends at the end of an extensible range."""
+        old = self.param(key)
+        wide = old.widened(factor)
+        new = replace(old, low=wide.low, high=wide.high)
+        for e in self.effects:
+            if e.key == old.owner:
+                e.widen(old.name, new.low, new.high)
+        self.params = [new if p.key == key else p for p in self.params]
+        return new
 
     def _time_scale(self, values: Mapping[str, float]) -> float:
         """How much longer than the data the simulation must run (clock effects)."""

@@ -34,6 +34,9 @@ class FitResult:
     simulations: int
     status: str
     correlations: dict[str, dict[str, float]] = field(default_factory=dict)
+    #: Effect parameters left at a nonzero end of their range, even after widening it
+    #: (:func:`~physbench.discover.fit.least_squares`): their true values may lie beyond.
+    at_bound: tuple[str, ...] = ()
 
     @property
     def k(self) -> int:
@@ -150,6 +153,9 @@ class CandidateResult:
     scored: Scored | None = None
     quick: bool = False
     previous: Scored | None = None  # the model this candidate extends
+    #: Its parameters (bare names) left at an end of their range: the magnitude is a lower bound
+    #: at best, and the verdict says so wherever it names the candidate.
+    at_bound: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -168,6 +174,7 @@ class CandidateResult:
             "chosen": self.chosen,
             "note": self.note,
             "quick_fit_only": self.quick,
+            "at_bound": list(self.at_bound),
         }
 
 

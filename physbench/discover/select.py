@@ -154,6 +154,7 @@ def _refitted(
         heldout_error=scored.heldout,
         criterion=scored.bic,
         scored=scored,
+        at_bound=tuple(k for k in c.params if f"{key}.{k}" in scored.fit.at_bound),
     )
     if out.previous is not None:
         out = judge(out, out.previous, base, settings)

@@ -11,6 +11,7 @@ offset needs something fixed in the world (a pivot, a floor) to differ from the 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -424,21 +425,41 @@ def _record(
     return Recording(tracks, run=scene_kind, fields=fields, source="synthetic")
 
 
-def make_case(effect: str | None, scene_kind: str, seed: int, engine: Any) -> SyntheticRun:
+def make_case(
+    effect: str | None,
+    scene_kind: str,
+    seed: int,
+    engine: Any,
+    truth: Mapping[str, float] | None = None,
+    body_params: Mapping[str, float] | None = None,
+) -> SyntheticRun:
     """One synthetic run of ``scene_kind`` (see :data:`SCENES`) with ``effect`` hidden at a random
-    magnitude (None: a control), simulated by ``engine`` (a simulator instance)."""
+    magnitude (None: a control), simulated by ``engine`` (a simulator instance). ``truth``: the
+    hidden values instead (missing ones random), beyond the effect's declared ranges if need be
+    (an extensible range is widened to hold them; the random draws are made all the same, so the
+    scene and the noise do not change). ``body_params``: body parameters (``{"ball.mass": 80}``)
+    applied to the drawn scene, for magnitudes that need a heavier or larger body to stay
+    visible without swamping the motion."""
     from physbench.effects import apply_measurements
     from physbench.plugins import get_registry
 
     rng = _rng(seed, 1 + sorted(SCENES).index(scene_kind))
-    scene = SCENES[scene_kind](rng).validate()
-    truth: dict[str, float] = {}
+    scene = SCENES[scene_kind](rng).with_params(body_params or {}).validate()
+    values: dict[str, float] = {}
     effects = []
     if effect is not None:
-        truth = hidden_values(effect, scene, rng)
-        effects = [get_registry().get("effect", effect)(**truth)]
+        values = {**hidden_values(effect, scene, rng), **(truth or {})}
+        eff = get_registry().get("effect", effect)()
+        for p in eff.parameters():
+            wide = p
+            while not wide.contains(values.get(p.name, 0.0)) and wide.extensible:
+                wide = wide.widened()
+            if wide is not p:
+                eff.widen(p.name, wide.low, wide.high)
+        eff.setup(scene, values)
+        effects = [eff]
     t_end = (scene.frames - 1) / scene.fps
-    scale = truth.get("scale", 1.0)
+    scale = values.get("scale", 1.0)
     sim_scene = (
         scene if scale <= 1 else replace(scene, frames=math.ceil(t_end * scale * scene.fps) + 2)
     )
@@ -450,7 +471,7 @@ def make_case(effect: str | None, scene_kind: str, seed: int, engine: Any) -> Sy
         scene_kind,
         Run(name, _blur(scene, rng), recording=rec, source="synthetic"),
         effect,
-        truth,
+        values,
         trajectory=traj,
     )
 

@@ -134,6 +134,7 @@ def try_effect(
         significant=False,
         scored=scored,
         quick=quick,
+        at_bound=tuple(k.rpartition(".")[2] for k in fr.at_bound if k in seen),
     )
     return judge(c, current, base, settings)
 

@@ -51,6 +51,24 @@ def params_text(c: CandidateResult, *, units: bool = True) -> str:
     return ", ".join(parts)
 
 
+def bound_caveat(c: CandidateResult) -> str:
+    """Why the magnitude of ``c`` is not a measurement when a fit left parameters at an end of
+    their range ("" when none)."""
+    if not c.at_bound:
+        return ""
+    parts = []
+    for k in c.at_bound:
+        v = c.params[k]
+        u = _unit(c.name, k)
+        more = "larger" if v > 0 else "smaller"
+        parts.append(f"{k} = {v:.4g}{(' ' + u) if u else ''} (the true value may be {more})")
+    return (
+        "at its bound: "
+        + ", ".join(parts)
+        + "; the fit could not go further, so this magnitude is not a measurement"
+    )
+
+
 def text(disc: Discovery) -> str:
     """The readable verdict: what is wrong, the cause, its magnitude, the gain, and a table of every
     candidate."""
@@ -99,6 +117,8 @@ def text(disc: Discovery) -> str:
                 "model before it, "
                 f"ΔBIC {c.delta_criterion:+.1f})"
             )
+            if c.at_bound:
+                lines.append(f"     {bound_caveat(c)}")
             alts = disc.alternatives.get(c.effect, [])
             if alts:
                 lines.append(
@@ -120,6 +140,7 @@ def text(disc: Discovery) -> str:
         why = (
             f"; best was {best.effect} with held-out gain {best.gain:+.1%}, "
             f"ΔBIC {best.delta_criterion:+.1f}"
+            + (f" ({bound_caveat(best)})" if best.at_bound else "")
             if best is not None
             else ""
         )
@@ -146,11 +167,15 @@ def table(disc: Discovery) -> str:
     rows.append(f"{0:>5}  {'base':<32} {disc.base.heldout:>18.5g} {'':>8} {'':>9}")
     for c in disc.candidates:
         verdict = "CHOSEN" if c.chosen else ("signif." if c.significant else "-")
+        if c.at_bound:
+            verdict += "*"
         rows.append(
             f"{c.round:>5}  {c.effect:<32} {c.heldout_error:>18.5g} {c.gain:>+8.1%} "
             f"{c.delta_criterion:>+9.1f}  "
             f"{verdict:<8}  {params_text(c, units=False)}"
         )
+    if any(c.at_bound for c in disc.candidates):
+        rows.append("* a parameter at the end of its range: the true value may lie beyond it")
     return "\n".join(rows)
 
 

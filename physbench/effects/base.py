@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
+from dataclasses import replace
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
@@ -114,6 +115,8 @@ class Effect(Requirements):
             raise EffectError(
                 f"effect {self.name!r} declares parameters {missing} without a default"
             )
+        #: This instance's parameters: the class's, with any ranges widened (:meth:`widen`).
+        self.declared: dict[str, Parameter] = {p.name: p for p in self.params}
         self.values: dict[str, float] = {p.name: float(p.default or 0.0) for p in self.params}
         self.values.update(self._checked(values))
         self.scene: Scene | None = None
@@ -145,7 +148,22 @@ class Effect(Requirements):
 
     def parameters(self) -> tuple[Parameter, ...]:
         """This instance's parameters, qualified by its :attr:`key` (``linear_drag.c``)."""
-        return tuple(p.owned_by(self.key) for p in self.params)
+        return tuple(p.owned_by(self.key) for p in self.declared.values())
+
+    def widen(self, name: str, low: float, high: float) -> None:
+        """Called by discovery when a fit reaches the end of an extensible parameter's range:
+        accept values in ``[low, high]`` (a range containing the current one) from now on."""
+        p = self.declared.get(name) or self.param(name)
+        if not p.extensible:
+            raise EffectError(
+                f"{self.key}.{name}: its range {p.describe()} is a physical limit, not widened"
+            )
+        if not (math.isfinite(low) and math.isfinite(high) and low <= p.low and high >= p.high):
+            raise EffectError(
+                f"{self.key}.{name}: new range [{low!r}, {high!r}] must be finite and contain "
+                f"{p.describe()}"
+            )
+        self.declared[name] = replace(p, low=float(low), high=float(high))
 
     @classmethod
     def param(cls, name: str) -> Parameter:
@@ -160,7 +178,7 @@ class Effect(Requirements):
         out: dict[str, float] = {}
         for key, value in values.items():
             name = key.removeprefix(f"{self.key}.").removeprefix(f"{self.name}.")
-            p = self.param(name)
+            p = self.declared.get(name) or self.param(name)
             if isinstance(value, bool) or not isinstance(
                 value, int | float | np.floating | np.integer
             ):

@@ -15,7 +15,15 @@ class LinearDrag(Effect):
 
     name: ClassVar[str] = "linear_drag"
     params: ClassVar[tuple[Parameter, ...]] = (
-        Parameter("c", 0.0, 10.0, unit="N·s/m", default=0.0, doc="drag force per unit speed"),
+        Parameter(
+            "c",
+            0.0,
+            10.0,
+            unit="N·s/m",
+            default=0.0,
+            doc="drag force per unit speed",
+            extensible=True,
+        ),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -33,7 +41,15 @@ class QuadraticDrag(Effect):
 
     name: ClassVar[str] = "quadratic_drag"
     params: ClassVar[tuple[Parameter, ...]] = (
-        Parameter("c", 0.0, 1.0, unit="kg/m", default=0.0, doc="drag force per unit squared speed"),
+        Parameter(
+            "c",
+            0.0,
+            1.0,
+            unit="kg/m",
+            default=0.0,
+            doc="drag force per unit squared speed",
+            extensible=True,
+        ),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -16,8 +16,8 @@ class ConstantForce(Effect):
 
     name: ClassVar[str] = "constant_force"
     params: ClassVar[tuple[Parameter, ...]] = (
-        Parameter("fx", -10.0, 10.0, unit="N", default=0.0, doc="force along x"),
-        Parameter("fy", -10.0, 10.0, unit="N", default=0.0, doc="force along y"),
+        Parameter("fx", -10.0, 10.0, unit="N", default=0.0, doc="force along x", extensible=True),
+        Parameter("fy", -10.0, 10.0, unit="N", default=0.0, doc="force along y", extensible=True),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -33,8 +33,12 @@ class TableTilt(Effect):
 
     name: ClassVar[str] = "table_tilt"
     params: ClassVar[tuple[Parameter, ...]] = (
-        Parameter("ax", -1.0, 1.0, unit="m/s²", default=0.0, doc="acceleration along x"),
-        Parameter("ay", -1.0, 1.0, unit="m/s²", default=0.0, doc="acceleration along y"),
+        Parameter(
+            "ax", -1.0, 1.0, unit="m/s²", default=0.0, doc="acceleration along x", extensible=True
+        ),
+        Parameter(
+            "ay", -1.0, 1.0, unit="m/s²", default=0.0, doc="acceleration along y", extensible=True
+        ),
     )
 
     def forces(self, t: float, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -81,7 +81,13 @@ class JointViscousDamping(JointEffect):
     name: ClassVar[str] = "joint_viscous_damping"
     params: ClassVar[tuple[Parameter, ...]] = (
         Parameter(
-            "c", 0.0, 0.1, unit="N·m·s/rad", default=0.0, doc="torque per unit relative rate"
+            "c",
+            0.0,
+            0.1,
+            unit="N·m·s/rad",
+            default=0.0,
+            doc="torque per unit relative rate",
+            extensible=True,
         ),
     )
 
@@ -101,7 +107,13 @@ class JointCoulombFriction(JointEffect):
     name: ClassVar[str] = "joint_coulomb_friction"
     params: ClassVar[tuple[Parameter, ...]] = (
         Parameter(
-            "tau", 0.0, 0.1, unit="N·m", default=0.0, doc="friction torque while the joint turns"
+            "tau",
+            0.0,
+            0.1,
+            unit="N·m",
+            default=0.0,
+            doc="friction torque while the joint turns",
+            extensible=True,
         ),
     )
 
@@ -131,6 +143,7 @@ class JointQuadraticDamping(JointEffect):
             unit="N·m·s²/rad²",
             default=0.0,
             doc="torque per unit squared relative rate",
+            extensible=True,
         ),
     )
 

@@ -30,6 +30,7 @@ class RollingResistance(Effect):
             unit="",
             default=0.0,
             doc="rolling resistance coefficient (deceleration / g)",
+            extensible=True,
         ),
     )
 
