@@ -120,5 +120,7 @@ def test_items_that_kill_their_worker_are_retried_once_then_given_to_died(
         11: "the worker process died: signal 11 (SIGSEGV)" + again,
     }
     calls = Counter(int(line) for line in log.read_text().split())
-    assert calls[3] == calls[11] == 2  # once in the pool, once alone
-    assert set(calls) == set(items) and max(calls.values()) == 2
+    # Once alone after the pool broke (the messages above say so), and at most once before: an
+    # item in flight when another one broke the pool may not have started there yet.
+    assert 1 <= calls[3] <= 2 and 1 <= calls[11] <= 2
+    assert set(calls) == set(items) and max(calls.values()) <= 2
