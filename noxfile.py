@@ -21,11 +21,16 @@ def tests(session: nox.Session) -> None:
 
 @nox.session
 def fuzz(session: nox.Session) -> None:
-    """The property tests of tests/test_fuzz_inputs.py (scene files, recordings, observation
-    files) with 10x the examples the normal test run tries."""
-    session.install("-e", ".[test]")
+    """The property tests (scene files, recordings, observation files, resnet3d weights) with 10x
+    the examples the normal test run tries."""
+    session.install(TORCH)
+    session.install("-e", ".[all]")
     session.run(
-        "pytest", "tests/test_fuzz_inputs.py", *session.posargs, env={"PHYSBENCH_FUZZ_SCALE": "10"}
+        "pytest",
+        "tests/test_fuzz_inputs.py",
+        "tests/estimators/resnet3d/test_weights_hardening.py",
+        *session.posargs,
+        env={"PHYSBENCH_FUZZ_SCALE": "10"},
     )
 
 

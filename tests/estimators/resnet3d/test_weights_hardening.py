@@ -7,6 +7,7 @@ import contextlib
 import copy
 import hashlib
 import json
+import os
 import pickle
 import warnings
 from pathlib import Path
@@ -291,7 +292,7 @@ def _edit_bytes(data: bytes, edits: list[tuple[str, int, int]]) -> bytes:
 
 
 @settings(
-    max_examples=150,
+    max_examples=150 * int(os.environ.get("PHYSBENCH_FUZZ_SCALE", "1")),  # nox -s fuzz: 10x
     deadline=None,
     derandomize=True,
     suppress_health_check=[HealthCheck.function_scoped_fixture],
