@@ -109,6 +109,9 @@ class History:
     #: Unknowns that moved no pixel when probed before the run
     #: (:mod:`physbench.identifiability`): their estimates are guesses. Empty when not probed.
     unseen: tuple[str, ...] = ()
+    #: Unknowns whose best estimate lies at an end of their range
+    #: (:meth:`~physbench.params.ParamSpace.at_bound`): the range, not the data, may hold them.
+    at_bound: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return len(self.iterations)
@@ -158,6 +161,7 @@ class History:
             "best_nmse": self.best_nmse,
             "min_loss": self.min_loss,
             "unseen": list(self.unseen),
+            "at_bound": list(self.at_bound),
             "meta": {k: v for k, v in self.meta.items() if timings or not k.startswith("t_")},
             "iterations": recs,
         }
@@ -182,6 +186,7 @@ class History:
             options=dict(d.get("options", {})),
             meta=dict(d.get("meta", {})),
             unseen=tuple(d.get("unseen", ())),
+            at_bound=tuple(d.get("at_bound", ())),
         )
 
     def to_frame(self) -> pd.DataFrame:
@@ -370,6 +375,7 @@ def refine(
         iterations=records,
         keys=space.keys,
         estimator=name,
+        at_bound=space.at_bound(records[best].params),
         seed=int(seed),
         initial=first,
         truth=truth,

@@ -21,6 +21,9 @@ if TYPE_CHECKING:
 
 Params = dict[str, float]
 
+#: Share of an unknown's range from either end within which an estimate counts as at its bound.
+AT_BOUND = 1e-3
+
 
 def split_params(value: str | Sequence[str]) -> tuple[str, ...]:
     """The unknown names of one set as the user spelled it: ``"mass+elasticity"``,
@@ -123,6 +126,12 @@ class ParamSpace:
     def contains(self, params: Mapping[str, float]) -> bool:
         v = self.to_vector(params)
         return bool(np.all(v >= self.low - 1e-12) and np.all(v <= self.high + 1e-12))
+
+    def at_bound(self, params: Mapping[str, float], tolerance: float = AT_BOUND) -> tuple[str, ...]:
+        """The keys of ``params`` within ``tolerance`` of their range's width from either end: an
+        estimate there may be held by the range rather than by the data."""
+        u = self.to_unit(params)
+        return tuple(k for k, x in zip(self.keys, u, strict=True) if min(x, 1 - x) <= tolerance)
 
     def sample(self, rng: np.random.Generator) -> Params:
         """Uniform draw inside the ranges."""

@@ -288,3 +288,35 @@ def test_bouncing_balls_end_to_end_with_six_masses_and_marked_objects() -> None:
     assert len(step.marked) == 6
     assert all(f[:, 1].max() > 0.5 for f in step.marked.values())  # the marked ball is in channel 1
     assert h.iterations[0].nmse is not None and h.iterations[1].params == est.points[0]
+
+
+def test_an_estimate_at_an_end_of_its_range_is_flagged() -> None:
+    from physbench.plugins import create
+    from physbench.render.raster import RasterRenderer
+    from physbench.scenes.generator import resolve_scene
+
+    scene = resolve_scene("three_circles", 0)
+    space = ParamSpace.from_scene(scene, ("mass",))
+    obs = simulate_observation(
+        scene,
+        space.sample(np.random.default_rng(0)),
+        create("simulator", "pymunk"),
+        RasterRenderer(resolution=32),
+    )
+    (a, b), ranges = space.keys, space.unknowns
+    at_edge = {a: ranges[0].high, b: 0.5 * (ranges[1].low + ranges[1].high)}
+    history = refine(
+        obs,
+        scene,
+        space,
+        create("simulator", "pymunk"),
+        RasterRenderer(resolution=32),
+        create("estimator", "random"),
+        iterations=1,
+        initial=at_edge,
+    )
+    assert history.at_bound == (a,)
+    assert History.from_dict(history.to_dict()).at_bound == (a,)
+    assert space.at_bound({a: ranges[0].low, b: ranges[1].high}) == (a, b)
+    inside = {a: ranges[0].low + 0.01 * (ranges[0].high - ranges[0].low), b: at_edge[b]}
+    assert space.at_bound(inside) == ()

@@ -305,6 +305,13 @@ def main(args: argparse.Namespace) -> int:
         Path(args.out).write_text(history.to_json(indent=1) + "\n", encoding="utf-8")
         wrote(args.out)
 
+    if history.at_bound:
+        print(
+            f"physbench run: warning: {', '.join(history.at_bound)} ended at an end of "
+            "its range: the range, not the data, may hold the estimate; widen the unknown's range "
+            "in the scene (a scene TOML's [[unknowns]]) and run again",
+            file=sys.stderr,
+        )
     if args.json:
         print(history.to_json(indent=1))
         return 0
@@ -325,7 +332,13 @@ def main(args: argparse.Namespace) -> int:
         print(
             f"best (iteration {best.iteration}, by image MSE): "
             + "  ".join(
-                f"{k}={v:.4g}" + (" (unseen: a guess)" if k in history.unseen else "")
+                f"{k}={v:.4g}"
+                + (" (unseen: a guess)" if k in history.unseen else "")
+                + (
+                    " (at its range's end: the true value may lie beyond)"
+                    if k in history.at_bound
+                    else ""
+                )
                 for k, v in best.params.items()
             )
         )
