@@ -19,6 +19,7 @@ from typing import Any
 import pytest
 
 from physbench.plugins import reset_registry
+from physbench.scene import Body, Circle, Scene
 
 #: A renderer unlike ``raster``: every body a hard square of ``size`` pixels (no anti-aliasing),
 #: and a count of its calls, so a test can tell that its frames were the ones used.
@@ -284,3 +285,18 @@ def heavy_imports() -> Callable[..., list[str]]:
         return list(json.loads(out.stdout))
 
     return check
+
+
+@pytest.fixture
+def slide() -> Scene:
+    """A ball coasting without gravity: drag is the only thing that slows it (discover's and the
+    API's tests)."""
+    return Scene(
+        "slide",
+        (Body("ball", Circle(0.05), (1.0, 1.0), velocity=(2.0, 0.5), mass=1.0),),
+        bounds=(-3, -3, 9, 6),
+        gravity=(0.0, 0.0),
+        fps=20.0,
+        frames=41,
+        substeps=4,
+    ).validate()

@@ -19,7 +19,7 @@ from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig, run_config
 from physbench.loop import History
 from physbench.recording import Recording, Track, write_recordings
-from physbench.scene import Body, Circle, Scene
+from physbench.scene import Scene
 from physbench.scene_toml import save_scene
 from physbench.simulators.pymunk_sim import PymunkSimulator
 
@@ -31,19 +31,6 @@ TINY_SPEC = {
     "iterations": 2,
     "resolution": 16,
 }
-
-
-def slide() -> Scene:
-    """A ball coasting without gravity: drag is the only thing that slows it."""
-    return Scene(
-        "slide",
-        (Body("ball", Circle(0.05), (1.0, 1.0), velocity=(2.0, 0.5), mass=1.0),),
-        bounds=(-3, -3, 9, 6),
-        gravity=(0.0, 0.0),
-        fps=20.0,
-        frames=41,
-        substeps=4,
-    ).validate()
 
 
 def noisy(rec: Recording, sigma: float = 0.002) -> Recording:
@@ -94,8 +81,8 @@ def test_make_scene_takes_a_registered_name_with_a_seed_or_a_toml_file(tmp_path:
         physbench.make_scene("nope")
 
 
-def test_simulate_applies_params_and_effects_as_the_engine_does() -> None:
-    sc = slide()
+def test_simulate_applies_params_and_effects_as_the_engine_does(slide: Scene) -> None:
+    sc = slide
     plain = physbench.simulate(sc)
     np.testing.assert_array_equal(plain.states, PymunkSimulator().simulate(sc).states)
     dragged = physbench.simulate(sc, effects={"linear_drag": {"c": 0.3}})
@@ -157,11 +144,11 @@ def test_run_returns_the_history_of_the_same_run_config() -> None:
     assert other.truth != h.truth
 
 
-def test_run_refuses_an_unknown_setting_naming_the_known() -> None:
+def test_run_refuses_an_unknown_setting_naming_the_known(slide: Scene) -> None:
     with pytest.raises(PhysbenchError, match=r"unknown settings \['iteration'\].*iterations"):
         physbench.run(iteration=2)
     with pytest.raises(PhysbenchError, match=r"run\(scene=Scene\): expected a registered"):
-        physbench.run(scene=slide())
+        physbench.run(scene=slide)
 
 
 def test_run_takes_a_scene_file_as_a_path(tmp_path: Path) -> None:
@@ -246,16 +233,16 @@ def test_load_table_names_a_folder_without_a_table(tmp_path: Path) -> None:
 # ---------------------------------------------------------------- recordings and discovery
 
 
-def test_read_recording_reads_what_was_written(tmp_path: Path) -> None:
-    rec = Recording.from_trajectory(physbench.simulate(slide()))
+def test_read_recording_reads_what_was_written(tmp_path: Path, slide: Scene) -> None:
+    rec = Recording.from_trajectory(physbench.simulate(slide))
     write_recordings(tmp_path / "r.csv", rec)
     back = physbench.read_recording(tmp_path / "r.csv")
     assert back.bodies == ("ball",)
     np.testing.assert_array_equal(back.track("ball").x, rec.track("ball").x)
 
 
-def test_discover_effects_names_the_hidden_drag(tmp_path: Path) -> None:
-    sc = slide()
+def test_discover_effects_names_the_hidden_drag(tmp_path: Path, slide: Scene) -> None:
+    sc = slide
     hidden = physbench.simulate(sc, effects={"linear_drag": {"c": 0.3}})
     rec = noisy(Recording.from_trajectory(hidden))
     effects = ["linear_drag", "constant_force"]

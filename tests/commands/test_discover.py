@@ -208,18 +208,6 @@ def test_the_renderer_of_frames_is_checked_against_them(tmp_path, capsys, args, 
     assert re.search(message, err, re.S), err
 
 
-def slide() -> Scene:
-    return Scene(
-        "slide",
-        (Body("ball", Circle(0.05), (1.0, 1.0), velocity=(2.0, 0.5), mass=1.0),),
-        bounds=(-3, -3, 9, 6),
-        gravity=(0.0, 0.0),
-        fps=20.0,
-        frames=41,
-        substeps=4,
-    ).validate()
-
-
 def noisy(traj, sigma=0.002, seed=0) -> Recording:
     rng = np.random.default_rng(seed)
     rec = Recording.from_trajectory(traj)
@@ -257,8 +245,8 @@ def test_frames_input_uses_the_image_loss(tmp_path):
     assert c["params"]["c"] == pytest.approx(0.5, rel=0.15)
 
 
-def test_cli_prints_the_verdict_and_the_table(tmp_path, capsys):
-    scene = slide()
+def test_cli_prints_the_verdict_and_the_table(tmp_path, capsys, slide):
+    scene = slide
     rec = noisy(PymunkSimulator().simulate(scene))
     write_recordings(tmp_path / "r.csv", rec)
     save_scene(scene, tmp_path / "s.toml")
@@ -273,9 +261,9 @@ def test_cli_prints_the_verdict_and_the_table(tmp_path, capsys):
     assert (tmp_path / "rep" / "index.html").is_file()
 
 
-def test_a_disagreement_below_the_floor_names_no_cause(tmp_path):
+def test_a_disagreement_below_the_floor_names_no_cause(tmp_path, slide):
     # Drag found in tracks accurate to 2 mm names nothing in data said to be good to a metre.
-    scene = slide()
+    scene = slide
     rec = noisy(PymunkSimulator().simulate(scene, effects=[LinearDrag(c=0.3)]))
     write_recordings(tmp_path / "r.csv", rec)
     save_scene(scene, tmp_path / "s.toml")
@@ -292,12 +280,12 @@ def test_a_disagreement_below_the_floor_names_no_cause(tmp_path):
     assert any("above the data's accuracy 1 " in n for n in notes), notes
 
 
-def test_a_recording_tracked_in_y_only_is_fitted_in_y_only(tmp_path):
+def test_a_recording_tracked_in_y_only_is_fitted_in_y_only(tmp_path, slide):
     """The written CSV keeps the measured fields: the unseen x (filled with zeros by the tracker)
     is neither fitted nor blamed on a sensor offset."""
     from physbench.discover.data import load_runs
 
-    scene = slide()
+    scene = slide
     seen = Recording.from_trajectory(PymunkSimulator().simulate(scene), angle=False)
     tracks = {b: Track(t.t, np.zeros(len(t)), t.y) for b, t in seen.tracks.items()}
     write_recordings(tmp_path / "r.csv", Recording(tracks, fields=("y",)))
