@@ -199,15 +199,20 @@ class SMCEstimator(CorrectionEstimator):
         if self.evaluations < n:
             return None  # not even the first population: nothing to report
         complete = self.beta >= 1 and self.moved_at_one
-        note = (
-            ""
-            if complete
-            else (
+        if complete:
+            note = ""
+        elif self.beta >= 1:
+            note = (
+                f"the budget ran out after {self.evaluations} simulations, during the moves that "
+                "follow the last resampling: the samples repeat one another; give more iterations"
+            )
+        else:
+            note = (
                 f"the budget ran out at tempering beta = {self.beta:.3g} of 1 after "
                 f"{self.evaluations} simulations: the intervals are too wide; give more "
                 "iterations"
             )
-        )
+
         return Posterior.from_unit(
             self.space,
             self.units,
