@@ -453,7 +453,7 @@ def coverage(df: pd.DataFrame, out: Path) -> list[Path]:
         ax.grid(True, alpha=0.25)
         _legend_below(fig, [ax])
         fig.suptitle(
-            f"{_title(cfg, varying)}\nshare of truths inside the posterior's central intervals; "
+            f"{_title(cfg, varying)}\nshare of truths inside the posteriors' central intervals\n"
             f"bars: {100 * CONFIDENCE:.0f} % Clopper-Pearson, n = seeds × unknowns",
             fontsize="small",
         )
