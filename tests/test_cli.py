@@ -125,18 +125,25 @@ def test_ctrl_c_while_the_command_is_imported_is_one_line_and_status_130() -> No
 def test_an_unexpected_error_is_one_line_saying_where_to_report_it(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    import physbench.cli as cli
     import physbench.commands.plugins as command
-    from physbench.cli import issue_tracker
 
     def broken(args: object) -> int:
         raise ValueError("an internal slip")
 
     monkeypatch.setattr(command, "main", broken)
+    monkeypatch.setattr(cli, "issue_tracker", lambda: None)
     assert main(["plugins"]) == 70
     assert capsys.readouterr().err == (
-        "physbench plugins: internal error: ValueError: an internal slip (please report it at "
-        f"{issue_tracker()} with the command; rerun with --debug for the traceback)\n"
+        "physbench plugins: internal error: ValueError: an internal slip (please report it as "
+        'the README\'s "Reporting a problem" says, with the command and the output of '
+        "`physbench --version`; rerun with --debug for the traceback)\n"
     )
+    readme = (ROOT / "README.md").read_text()
+    assert "\n## Reporting a problem\n" in readme and "physbench --version" in readme
+    monkeypatch.setattr(cli, "issue_tracker", lambda: "https://example.org/pb/issues")
+    assert main(["plugins"]) == 70
+    assert "please report it at https://example.org/pb/issues, with" in capsys.readouterr().err
     with pytest.raises(ValueError, match="an internal slip"):
         main(["--debug", "plugins"])
 
@@ -168,4 +175,4 @@ def test_the_issue_tracker_comes_from_the_package_metadata(
     monkeypatch.setattr(md, "metadata", lambda name: Meta(urls))
     assert issue_tracker() == "https://example.org/pb/issues"
     monkeypatch.setattr(md, "metadata", lambda name: Meta(urls[:1]))
-    assert issue_tracker() == "the physbench issue tracker"
+    assert issue_tracker() is None
