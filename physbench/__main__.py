@@ -1,11 +1,38 @@
-"""``python -m physbench``: the same as the ``physbench`` command."""
+"""``python -m physbench`` and the ``physbench`` script (its entry point is :func:`main`): the
+first physbench code the process runs, so that Ctrl-C is one line and status 130 from here on,
+even while the command's modules are still being imported."""
 
+import os
+import signal
 import sys
 
-try:
-    from physbench.cli import main
-except KeyboardInterrupt:  # Ctrl-C while the command is still being imported
-    print("physbench: interrupted", file=sys.stderr)
-    raise SystemExit(130) from None
 
-raise SystemExit(main())
+def _interrupted_while_starting(signum: int, frame: object) -> None:
+    """The SIGINT handler until :func:`main` hands over to the command: nothing has been done
+    yet that needs unwinding, so stop at once, as the command would."""
+    os.write(2, b"physbench: interrupted\n")
+    os._exit(130)
+
+
+signal.signal(signal.SIGINT, _interrupted_while_starting)
+
+
+def main() -> int:
+    """Called once per process, by the ``physbench`` script or ``python -m physbench``; runs the
+    command in :data:`sys.argv`."""
+    from physbench.cli import main as run_command
+
+    try:
+        # From here Ctrl-C raises KeyboardInterrupt, so the command cleans up (saves finished
+        # cells, ...) and run_command turns it into the line and 130.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        return run_command()
+    except KeyboardInterrupt:  # before run_command's own guard, or re-raised by --debug
+        if "--debug" in sys.argv[1:]:
+            raise
+        print("physbench: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -72,8 +72,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         where = f"physbench {command}" if command in COMMANDS else "physbench"
         print(
-            f"{where}: internal error: {type(exc).__name__}: {exc} (please report it at "
-            f"{issue_tracker()} with the command; rerun with --debug for the traceback)",
+            f"{where}: internal error: {type(exc).__name__}: {exc} (please report it "
+            f"{how_to_report()}, with the command and the output of `physbench --version`; "
+            "rerun with --debug for the traceback)",
             file=sys.stderr,
         )
         return 70  # EX_SOFTWARE
@@ -126,9 +127,9 @@ def _blame_plugin(exc: BaseException) -> None:
         raise ComponentError(*culprit, exc) from exc
 
 
-def issue_tracker() -> str:
+def issue_tracker() -> str | None:
     """Where to report a bug: the ``Issues``/``Bug``/``Tracker`` URL of physbench's metadata
-    (``[project.urls]``), else a plain description."""
+    (``[project.urls]``), or ``None`` when it names none."""
     from importlib.metadata import PackageNotFoundError, metadata
 
     try:
@@ -139,7 +140,14 @@ def issue_tracker() -> str:
         label, _, url = entry.partition(",")
         if any(w in label.lower() for w in ("issue", "bug", "tracker")) and url.strip():
             return url.strip()
-    return "the physbench issue tracker"
+    return None
+
+
+def how_to_report() -> str:
+    """``at <issue tracker URL>``, or, where physbench has none, the README section that says
+    what to send and to whom; called for the line of an internal error."""
+    url = issue_tracker()
+    return f"at {url}" if url else 'as the README\'s "Reporting a problem" says'
 
 
 if __name__ == "__main__":

@@ -7,9 +7,10 @@ process (nothing is written by workers), so Dask workers need no shared file sys
 same physbench installation.
 
 A cell that kills its interpreter (``os._exit``, a segfault in an extension) is contained by the
-``processes`` executor: it is retried once alone, then handed to the caller's ``died`` with what
-happened, and the sweep goes on. ``serial`` runs cells in this very process, so it cannot contain
-that. Local worker processes die with the process that started them.
+``processes`` and ``dask`` executors: it is retried once alone, then handed to the caller's
+``died`` with what happened, and the sweep goes on. ``serial`` runs cells in this very process, so
+it cannot contain that. Local worker processes (a LocalCluster's too) die with the process that
+started them.
 """
 
 from __future__ import annotations
@@ -260,6 +261,11 @@ class DaskExecutor:
     """A Dask ``distributed`` cluster: the scheduler at ``address`` (``tcp://host:8786``), or a
     LocalCluster of ``workers`` single-threaded worker processes when no address is given.
 
+    A cell whose worker dies is run again once, alone on the cluster after the other cells, then
+    given to ``died``. A LocalCluster's scheduler gives up on a cell at its first dead worker
+    (``allowed_failures=0``) so that physbench does the retrying; a remote scheduler first retries
+    as its own ``allowed-failures`` says.
+
     The address is a trust boundary: results arrive pickled, and unpickling runs code of the
     sender's choosing, so whoever controls that cluster can run code in this process."""
 
@@ -296,7 +302,10 @@ class DaskExecutor:
                     threads_per_worker=1,
                     processes=True,
                     dashboard_address=None,
-                    silence_logs=logging.ERROR,
+                    # The scheduler logs every cell it gives up on as an error; physbench
+                    # reports that cell itself.
+                    silence_logs=logging.CRITICAL,
+                    scheduler_kwargs={"allowed_failures": 0},
                 )
                 self._client = Client(self._cluster)
         except OSError as exc:
@@ -316,23 +325,54 @@ class DaskExecutor:
     def map_unordered(
         self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
     ) -> Iterator[tuple[T, R]]:
-        from distributed import as_completed
+        from distributed import KilledWorker, as_completed
 
-        futures = [self._client.submit(fn, item, pure=False) for item in items]
-        index = {f.key: item for f, item in zip(futures, items, strict=True)}
+        running: dict[str, tuple[Any, T]] = {}
+        for item in items:
+            fut = self._client.submit(fn, item, pure=False)
+            running[fut.key] = (fut, item)
+        suspects: list[T] = []
         try:
-            for fut in as_completed(futures):
+            for fut in as_completed([f for f, _ in running.values()]):
+                _, item = running.pop(fut.key)
                 try:
-                    result = fut.result()
-                # the cell itself never raises: this is the cluster (a killed worker, ...)
-                except Exception as exc:
-                    raise PhysbenchError(
-                        f"the Dask cluster lost a cell ({type(exc).__name__}: {exc}); finished "
-                        "cells are saved: re-run the same command to resume"
-                    ) from None
-                yield index[fut.key], result
+                    result = self._result(fut)
+                except KilledWorker:  # maybe only queued on the worker another cell killed
+                    suspects.append(item)
+                    continue
+                yield item, result
+            for item in suspects:
+                # Alone, so that if it kills its worker again it takes no other cell along.
+                fut = self._client.submit(fn, item, pure=False)
+                running[fut.key] = (fut, item)
+                try:
+                    result = self._result(fut)
+                except KilledWorker:
+                    result = died(
+                        item,
+                        "the Dask worker process died running it (KilledWorker), also when run "
+                        "again alone on the cluster",
+                    )
+                del running[fut.key]
+                yield item, result
         finally:
-            self._client.cancel(futures)
+            self._client.cancel([f for f, _ in running.values()])
+
+    @staticmethod
+    def _result(fut: Any) -> Any:
+        """``fut``'s result; a cell never raises (the runner records its errors), so an exception
+        here is the cluster's: ``KilledWorker`` passes, the rest end the sweep."""
+        from distributed import KilledWorker
+
+        try:
+            return fut.result()
+        except KilledWorker:
+            raise
+        except Exception as exc:
+            raise PhysbenchError(
+                f"the Dask cluster lost a cell ({type(exc).__name__}: {exc}); finished cells are "
+                "saved: re-run the same command to resume"
+            ) from None
 
     def describe(self) -> str:
         return f"dask ({self.address or 'LocalCluster'}, {counted(self.workers, 'worker')})"

@@ -34,12 +34,20 @@ class _Measurement(Effect):
 
 class SensorOffset(_Measurement):
     """A constant bias added to the tracked ``x``, ``y`` and ``angle`` of each selected body
-    (default: all), e.g. an encoder zero that is not the rest angle."""
+    (default: all), e.g. an encoder zero that is not the rest angle.
+
+    A position bias has no physical limit (a camera's origin can be anywhere), so ``dx`` and
+    ``dy`` widen at either end; ``dangle`` does not, as widening ten-fold would pass ±π, where
+    an angle bias repeats."""
 
     name: ClassVar[str] = "sensor_offset"
     params: ClassVar[tuple[Parameter, ...]] = (
-        Parameter("dx", -0.5, 0.5, unit="m", default=0.0, doc="bias of the tracked x"),
-        Parameter("dy", -0.5, 0.5, unit="m", default=0.0, doc="bias of the tracked y"),
+        Parameter(
+            "dx", -0.5, 0.5, unit="m", default=0.0, doc="bias of the tracked x", extensible=True
+        ),
+        Parameter(
+            "dy", -0.5, 0.5, unit="m", default=0.0, doc="bias of the tracked y", extensible=True
+        ),
         Parameter("dangle", -0.5, 0.5, unit="rad", default=0.0, doc="bias of the tracked angle"),
     )
 

@@ -6,6 +6,9 @@ executor gives the same table: ``test_executors_give_identical_tables`` in test_
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
+import time
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
@@ -88,6 +91,9 @@ def test_processes_yield_every_item_once_with_its_result() -> None:
 #: A worker function that kills its process for some items, and logs every call to ``LOG``.
 DYING = """
 import os
+import subprocess
+import sys
+import time
 import signal
 
 LOG = os.environ["PB_DYING_LOG"]
@@ -124,3 +130,36 @@ def test_items_that_kill_their_worker_are_retried_once_then_given_to_died(
     # item in flight when another one broke the pool may not have started there yet.
     assert 1 <= calls[3] <= 2 and 1 <= calls[11] <= 2
     assert set(calls) == set(items) and max(calls.values()) <= 2
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, dead but not yet reaped by its new parent, does not)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except FileNotFoundError:
+        return False
+    return "\nState:\tZ" not in status
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads /proc")
+def test_a_killed_sweep_leaves_no_local_dask_worker_behind() -> None:
+    pytest.importorskip("distributed")
+    code = (
+        "import os, time\n"
+        "from physbench.bench.executors import DaskExecutor\n"
+        "with DaskExecutor(workers=2) as ex:\n"
+        "    print(*ex._client.run(os.getpid).values(), flush=True)\n"
+        "    time.sleep(120)\n"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        workers = [int(pid) for pid in proc.stdout.readline().split()]
+        assert len(workers) == 2 and all(_alive(pid) for pid in workers)
+    finally:
+        proc.kill()  # SIGKILL: no cleanup runs in the main process
+        proc.wait()
+    deadline = time.monotonic() + 10
+    while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [pid for pid in workers if _alive(pid)]

@@ -157,9 +157,25 @@ def register_estimators():
 """
 
 
+@pytest.mark.parametrize(
+    ("executor", "how"),
+    [
+        (
+            "processes",
+            "the worker process died: exit code 3, also when run again alone in a fresh process",
+        ),
+        (
+            "dask",
+            "the Dask worker process died running it (KilledWorker), also when run again "
+            "alone on the cluster",
+        ),
+    ],
+)
 def test_a_cell_that_kills_its_worker_is_recorded_failed_and_the_sweep_goes_on(
-    tmp_path: Path, plugin: Any
+    tmp_path: Path, plugin: Any, executor: str, how: str
 ) -> None:
+    if executor == "dask":
+        pytest.importorskip("distributed")
     plugin("pb_exiting", EXITING)
     spec = parse_spec(
         {
@@ -171,15 +187,12 @@ def test_a_cell_that_kills_its_worker_is_recorded_failed_and_the_sweep_goes_on(
             "scenes": [{"name": "second_order", "unknowns": ["elasticity"]}],
         }
     )
-    res = run_sweep(spec, tmp_path, executor="processes", workers=2, progress=False)
+    res = run_sweep(spec, tmp_path, executor=executor, workers=2, progress=False)
     assert (res.ran, res.failed) == (6, 1)
     df = pd.read_parquet(tmp_path / "results.parquet")
     cells = df.drop_duplicates("cell").set_index(["estimator", "seed"])
     assert cells.loc[("exiting", 1), "status"] == "failed"
-    assert cells.loc[("exiting", 1), "error"] == (
-        "WorkerDied: the worker process died: exit code 3, also when run again alone in a fresh "
-        "process"
-    )
+    assert cells.loc[("exiting", 1), "error"] == f"WorkerDied: {how}"
     assert (cells.drop(index=("exiting", 1))["status"] == "ok").all() and len(cells) == 6
     assert "WorkerDied" in (tmp_path / "summary.md").read_text()
 

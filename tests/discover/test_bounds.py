@@ -63,6 +63,19 @@ def test_a_cause_left_at_its_bound_is_flagged_in_the_verdict(monkeypatch):
     assert "CHOSEN*" in table(disc)
 
 
+@pytest.mark.parametrize("sign", [1, -1])
+def test_a_sensor_offset_beyond_its_declared_range_widens_at_either_end(sign):
+    sim = PymunkSimulator()
+    truth = {"dx": sign * 1.5, "dy": -sign * 1.5, "dangle": 0.0}
+    case = make_case("sensor_offset", "pendulum_xy", 0, sim, truth=truth)
+    disc = discover([case.run], sim, diagnose=False)
+    assert disc.causes[:1] == ["sensor_offset"], disc.causes
+    found = disc.cause_results[0]
+    assert found.params["dx"] == pytest.approx(sign * 1.5, abs=0.02)
+    assert found.params["dy"] == pytest.approx(-sign * 1.5, abs=0.02)
+    assert found.at_bound == ()
+
+
 def _drag_run(c: float, mass: float) -> Run:
     scene = (
         make_case(None, "puck", 0, PymunkSimulator())
