@@ -28,6 +28,7 @@ from physbench.metrics import image_mse
 from physbench.observation import Observation, expected_shape, validate
 from physbench.params import Params, ParamSpace
 from physbench.plugins import guard
+from physbench.posterior import Posterior
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -112,6 +113,9 @@ class History:
     #: Unknowns whose best estimate lies at an end of their range
     #: (:meth:`~physbench.params.ParamSpace.at_bound`): the range, not the data, may hold them.
     at_bound: tuple[str, ...] = ()
+    #: How sure the estimator is (:meth:`CorrectionEstimator.posterior`); ``None`` for an
+    #: estimator that gives a point only.
+    posterior: Posterior | None = None
 
     def __len__(self) -> int:
         return len(self.iterations)
@@ -162,6 +166,7 @@ class History:
             "min_loss": self.min_loss,
             "unseen": list(self.unseen),
             "at_bound": list(self.at_bound),
+            "posterior": None if self.posterior is None else self.posterior.to_dict(),
             "meta": {k: v for k, v in self.meta.items() if timings or not k.startswith("t_")},
             "iterations": recs,
         }
@@ -187,6 +192,7 @@ class History:
             meta=dict(d.get("meta", {})),
             unseen=tuple(d.get("unseen", ())),
             at_bound=tuple(d.get("at_bound", ())),
+            posterior=None if d.get("posterior") is None else Posterior.from_dict(d["posterior"]),
         )
 
     def to_frame(self) -> pd.DataFrame:
@@ -235,6 +241,23 @@ def _check_proposal(name: str, space: ParamSpace, proposal: object, iteration: i
             )
         out[u.key] = min(max(x, u.low), u.high)
     return out
+
+
+def _check_posterior(name: str, space: ParamSpace, posterior: object) -> None:
+    from physbench.posterior import Posterior
+
+    if posterior is None:
+        return
+    if not isinstance(posterior, Posterior):
+        raise EstimatorError(
+            f"estimator {name!r}: posterior() returned {type(posterior).__name__}, expected a "
+            "physbench.posterior.Posterior or None"
+        )
+    if posterior.keys != space.keys:
+        raise EstimatorError(
+            f"estimator {name!r}: posterior over {list(posterior.keys)}, expected the run's "
+            f"unknowns {list(space.keys)}"
+        )
 
 
 def _space(scene: Scene, unknowns: ParamSpace | Sequence[str] | None) -> ParamSpace:
@@ -311,6 +334,7 @@ def refine(
         renderer=renderer,
         iterations=int(iterations),
         marked_observation=obs.marked,
+        noise=obs.noise,
     )
     t = time.perf_counter()
     with guard("estimator", estimator, "start()"):
@@ -371,8 +395,13 @@ def refine(
             callback(rec)
         params = nxt
 
+    with guard("estimator", estimator, "posterior()"):
+        posterior = estimator.posterior()
+    _check_posterior(name, space, posterior)
+
     return History(
         iterations=records,
+        posterior=posterior,
         keys=space.keys,
         estimator=name,
         at_bound=space.at_bound(records[best].params),

@@ -64,6 +64,9 @@ class Observation:
     scene: Scene | None = None
     engine: str = ""
     effects: tuple[str, ...] = ()
+    #: The standard deviation of the observation model's Gaussian pixel noise, when it is known
+    #: (a simulated observation); ``None`` for frames from a file or a camera.
+    noise: float | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -167,6 +170,7 @@ def simulate_observation(
         scene=scene.with_params(truth),
         engine=name,
         effects=tuple(repr(e) for e in effects),
+        noise=None if camera is None else float(camera.noise),
     )
 
 

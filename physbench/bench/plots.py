@@ -9,6 +9,8 @@ function).
 - :func:`landscape`: image MSE against the deviation of one parameter from its nominal value,
   per body (Fig. 4), with the sweep's engine and renderer; this one simulates.
 - :func:`win_rate`: how often each estimator ends closer to the truth than each other one.
+- :func:`coverage`: for estimators that return a posterior, how often the truth lies inside
+  its central intervals against how often it should (:mod:`physbench.calibration`).
 
 Axes carry units (:mod:`physbench.plotting.units`), legends sit outside the axes, titles name the
 engine and blur, and iterations are numbered as in the long table (0: the initial guess).
@@ -26,7 +28,9 @@ import numpy as np
 
 from physbench.bench import tables
 from physbench.bench.tables import (
+    calibration_scores,
     final_rows,
+    has_posteriors,
     paper_value,
     param_frame,
     scene_label,
@@ -402,8 +406,63 @@ def win_rate(df: pd.DataFrame, out: Path) -> list[Path]:
     return [_save(fig, out / "win_rate.png")]
 
 
+def coverage(df: pd.DataFrame, out: Path) -> list[Path]:
+    """One figure per scene (and setting) whose sweep has posteriors: observed against nominal
+    coverage of the central intervals, a line per estimator and unknown set (pooled over seeds
+    and unknowns) with Clopper-Pearson bars, and the diagonal a calibrated posterior follows.
+    Nothing for a table without posteriors."""
+    from physbench.calibration import CONFIDENCE, LEVELS
+    from physbench.calibration import coverage as observed_coverage
+
+    fin = final_rows(df)
+    if not has_posteriors(fin):
+        return []
+    plt = _plt()
+    varying = _varying(df)
+    paths = []
+    for cfg, rows in _groups(fin, SETTINGS):
+        lines = [
+            (f"{est['estimator']}, {unknowns_label(str(est['unknowns']))}", scores)
+            for est, er in _groups(rows, ["estimator", "unknowns"])
+            if (scores := calibration_scores(er))
+        ]
+        if not lines:
+            continue
+        fig, ax = plt.subplots(figsize=(5.2, 5.0), layout="constrained")
+        ax.plot([0, 1], [0, 1], color="0.5", ls="--", lw=1, label="calibrated")
+        for i, (label, scores) in enumerate(lines):
+            cov = observed_coverage(scores)
+            y = np.array([c.observed for c in cov])
+            ci = np.array([c.ci() for c in cov])
+            # a small horizontal offset per line keeps overlapping bars apart
+            x = np.array(LEVELS) + 0.006 * (i - (len(lines) - 1) / 2)
+            ax.errorbar(
+                x,
+                y,
+                yerr=[y - ci[:, 0], ci[:, 1] - y],
+                marker="o",
+                ms=3.5,
+                lw=1.2,
+                capsize=2.5,
+                label=f"{label} (n={len(scores)})",
+            )
+        ax.set_xlim(0.4, 1.0)
+        ax.set_ylim(0.0, 1.02)
+        ax.set_xlabel(f"nominal coverage of the central interval ({DIMENSIONLESS})")
+        ax.set_ylabel(f"observed coverage ({DIMENSIONLESS})")
+        ax.grid(True, alpha=0.25)
+        _legend_below(fig, [ax])
+        fig.suptitle(
+            f"{_title(cfg, varying)}\nshare of truths inside the posteriors' central intervals\n"
+            f"bars: {100 * CONFIDENCE:.0f} % Clopper-Pearson, n = seeds × unknowns",
+            fontsize="small",
+        )
+        paths.append(_save(fig, out / _name("coverage", cfg, varying)))
+    return paths
+
+
 #: the groups of figures :func:`plot_all` draws, in order (the keys of what it returns)
-FIGURE_GROUPS = ("convergence", "trajectories", "win rate", "landscape")
+FIGURE_GROUPS = ("convergence", "trajectories", "win rate", "coverage", "landscape")
 
 
 def plot_all(
@@ -427,6 +486,8 @@ def plot_all(
     figs["trajectories"] = trajectories(df, out, seeds=seeds)
     stage("win rate")
     figs["win rate"] = win_rate(df, out)
+    stage("coverage")
+    figs["coverage"] = coverage(df, out)
     stage("landscape")
     figs["landscape"] = landscape(df, out, seeds=landscape_seeds) if landscape_seeds else []
     return figs

@@ -1,5 +1,6 @@
 """One self-contained HTML page for a sweep: its settings, the Table 1 layout, per-configuration
-statistics, failures, the win-rate matrix and every figure (PNG embedded as base64), so the file
+statistics, the posteriors' calibration (when some estimator returned one), failures, the
+win-rate matrix and every figure (PNG embedded as base64), so the file
 can be mailed or committed and opened anywhere."""
 
 from __future__ import annotations
@@ -46,6 +47,8 @@ def build(
     path."""
     from physbench.bench.store import atomic_write
     from physbench.bench.tables import (
+        CALIBRATION_NOTE,
+        calibration,
         detail,
         final_rows,
         paper_layout,
@@ -97,6 +100,12 @@ def build(
         "of the mean over seeds.</p>",
         _table(detail(st)),
     ]
+    cal = calibration(st)
+    if len(cal):
+        parts += [
+            f"<h2>Calibration</h2><p class='note'>{html.escape(CALIBRATION_NOTE)}</p>",
+            _table(cal),
+        ]
     bad = st[st["failed"] > 0]
     if len(bad):
         parts += [

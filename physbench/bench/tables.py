@@ -8,6 +8,11 @@ its ``error``). Parameters and truths are JSON objects in the ``params`` / ``tru
 fill most of it with nulls; a JSON column keeps one fixed schema for every sweep, round-trips floats
 exactly, and :func:`param_frame` spreads it into columns when needed. Columns starting with ``t_``
 are wall-clock timings; everything else is identical between runs of the same spec.
+
+A sweep where some estimator returned a posterior also has a ``calibration`` column
+(:data:`OPTIONAL`): per unknown, the :mod:`physbench.calibration` scores of the cell's posterior
+against its truth (a JSON object like ``params``), null for cells without one. A sweep without
+posteriors lacks the column, so its tables are those written before calibration existed.
 """
 
 from __future__ import annotations
@@ -25,6 +30,8 @@ from physbench.render.base import DEFAULT_RENDERER
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from physbench.calibration import Score
 
 #: Column -> pandas dtype of the long table.
 SCHEMA: dict[str, str] = {
@@ -68,6 +75,8 @@ SCHEMA: dict[str, str] = {
     "t_cell": "float64",
     "versions": "string",
 }
+#: Columns a table has only when some cell fills them (see the module docstring).
+OPTIONAL: dict[str, str] = {"calibration": "string"}
 #: Columns that vary between identical runs.
 TIMINGS = tuple(c for c in SCHEMA if c.startswith("t_"))
 #: What identifies a configuration (a cell without its seed), in display order.
@@ -135,6 +144,14 @@ PAPER_SCENES = {
     "bouncing_balls": "bouncing balls",
 }
 BOOTSTRAP = 4000
+#: What the calibration table shows (summary.md and report.html).
+CALIBRATION_NOTE = (
+    "Posteriors against the truths, pooled over seeds and unknowns (scored: how many): share of "
+    "truths inside the central 50/80/90/95 % intervals (calibrated: the nominal share), "
+    "Kolmogorov-Smirnov p-value of uniform SBC ranks (small: miscalibrated), mean 90 % interval "
+    "width over the range, mean negative log density of the truth in unit-range units (0: the "
+    "uniform prior; lower is better)."
+)
 
 
 def dumps(obj: Any) -> str:
@@ -186,6 +203,8 @@ def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str
         truth=None if hist["truth"] is None else json.dumps(hist["truth"]),
         t_start=hist["meta"].get("t_start"),
     )
+    if hist.get("posterior") is not None and hist["truth"] is not None:
+        base["calibration"] = _calibration(hist["posterior"], hist["truth"])
     return [
         {
             **base,
@@ -205,12 +224,24 @@ def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str
     ]
 
 
+def _calibration(posterior: Mapping[str, Any], truth: Mapping[str, float]) -> str:
+    """The ``calibration`` cell: the scores of a stored posterior against the truth."""
+    from physbench.calibration import score
+    from physbench.posterior import Posterior
+
+    scores = score(Posterior.from_dict(posterior), truth)
+    return dumps({k: s.to_dict() for k, s in scores.items()})
+
+
 def to_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
-    """The long table with the fixed :data:`SCHEMA` (columns and dtypes), whatever the rows hold."""
+    """The long table with the fixed :data:`SCHEMA` (columns and dtypes), whatever the rows hold,
+    and the columns of :data:`OPTIONAL` that some row fills."""
     import pandas as pd
 
-    df = pd.DataFrame(list(rows), columns=list(SCHEMA))
-    for col, dtype in SCHEMA.items():
+    rows = list(rows)
+    schema = {**SCHEMA, **{c: t for c, t in OPTIONAL.items() if any(r.get(c) for r in rows)}}
+    df = pd.DataFrame(rows, columns=list(schema))
+    for col, dtype in schema.items():
         if dtype == "string":
             df[col] = df[col].astype("object").where(df[col].notna(), None).astype("string")
         else:
@@ -345,15 +376,38 @@ def _ordered_groups(df: pd.DataFrame, cols: Sequence[str]) -> list[tuple[Any, ..
     return [tuple(r) for r in first[list(cols)].itertuples(index=False)]
 
 
+def calibration_scores(rows: pd.DataFrame) -> list[Score]:
+    """The posterior scores in the ``calibration`` column of finished ``rows``, one per cell and
+    unknown (none for a table without the column)."""
+    from physbench.calibration import Score
+
+    if "calibration" not in rows.columns:
+        return []
+    ok = rows[(rows["status"] == "ok") & rows["calibration"].notna()]
+    return [Score.from_dict(d) for v in ok["calibration"] for d in json.loads(v).values()]
+
+
+def has_posteriors(df: pd.DataFrame) -> bool:
+    """Whether any cell of the long table ``df`` has a posterior (and so a calibration)."""
+    return "calibration" in df.columns and bool(df["calibration"].notna().any())
+
+
 def stats(df: pd.DataFrame) -> pd.DataFrame:
     """Per configuration (:data:`CONFIG`): cells, failures, and mean, sample std, median and 95 %
     bootstrap interval (of the mean) of the normalized min MSE after the configuration's
-    iterations, plus the initial guess's mean error and the paper's values where it has the cell."""
+    iterations, plus the initial guess's mean error and the paper's values where it has the cell.
+    When some cell has a posterior, also the calibration of the configuration's posteriors
+    (:func:`physbench.calibration.summarize`: ``coverage50`` ... ``coverage95``, ``sbc_p``,
+    ``width90``, ``nld``, ``scored``; NaN and 0 scored for a configuration without
+    posteriors)."""
     import pandas as pd
+
+    from physbench.calibration import summarize
 
     df = upgrade(df)
     fin = final_rows(df)
     init = df[df["iteration"] == 0]
+    calibrated = has_posteriors(fin)
     rows = []
     for key in _ordered_groups(fin, CONFIG):
         cfg = dict(zip(CONFIG, key, strict=True))
@@ -382,6 +436,8 @@ def stats(df: pd.DataFrame) -> pd.DataFrame:
                 "error": errors[0] if errors else "",
             }
         )
+        if calibrated:
+            rows[-1].update(summarize(calibration_scores(g)))
     return pd.DataFrame(rows)
 
 
@@ -502,6 +558,38 @@ def detail(st: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def calibration(st: pd.DataFrame) -> pd.DataFrame:
+    """Per configuration with posteriors, formatted: observed coverage of each central interval,
+    the SBC p-value, mean 90 % width over the range and the truth's mean negative log density.
+    Empty when no configuration has posteriors."""
+    import pandas as pd
+
+    from physbench.calibration import LEVELS
+
+    if "scored" not in st.columns:
+        return pd.DataFrame()
+    extra = _varying(st, SETTINGS)
+    rows = []
+    for r in st[st["scored"] > 0].to_dict("records"):
+        rows.append(
+            {
+                "scene": r["scene"],
+                "unknowns": r["unknowns"],
+                **{c: r[c] for c in extra},
+                "estimator": r["estimator"],
+                "scored": int(r["scored"]),
+                **{
+                    f"{round(100 * lv)} %": f"{100 * r[f'coverage{round(100 * lv)}']:.0f}%"
+                    for lv in LEVELS
+                },
+                "SBC p": f"{r['sbc_p']:.2g}",
+                "90 % width": f"{r['width90']:.3f}",
+                "NLD": f"{r['nld']:.2f}",
+            }
+        )
+    return pd.DataFrame(rows)
+
+
 def win_rate_table(fin: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(rate, n): for each ordered estimator pair, the share of matched finished cells (same
     configuration and seed) where the row estimator's normalized min MSE is lower than the
@@ -608,6 +696,13 @@ def write_summary(df: pd.DataFrame, out: Path, *, title: str) -> pd.DataFrame:
         "(n) and failed.\n",
         markdown(detail(st)),
     ]
+    cal = calibration(st)
+    if len(cal):
+        md += [
+            "\n## Calibration\n",
+            CALIBRATION_NOTE + "\n",
+            markdown(cal),
+        ]
     failed = st[st["failed"] > 0]
     if len(failed):
         md += [

@@ -2,7 +2,8 @@
 
 Writes into ``--out`` (default: DIR itself) ``plots/*.png`` (convergence per scene like the
 paper's Fig. 3, parameter-space trajectories for two unknowns like Fig. 5, the image-MSE landscape
-along each parameter like Fig. 4, and the estimators' win-rate matrix), ``win_rate.csv`` and
+along each parameter like Fig. 4, the estimators' win-rate matrix, and the coverage of the
+posteriors' intervals when some estimator returned one), ``win_rate.csv`` and
 ``report.html`` (self-contained: tables and figures embedded).
 """
 

@@ -147,7 +147,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--plot",
         default=None,
         metavar="FILE",
-        help="convergence plot (best-so-far errors per iteration), e.g. out.png",
+        help="convergence plot (best-so-far errors per iteration), e.g. out.png; with an "
+        "estimator that returns a posterior (smc) also its marginals, e.g. out.posterior.png",
     )
     add_quiet_argument(p, "only the final line (or the JSON)")
 
@@ -300,6 +301,10 @@ def main(args: argparse.Namespace) -> int:
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         plot_convergence({f"{history.estimator}": [history]}, args.plot, title=run_title(history))
         wrote(args.plot)
+        if history.posterior is not None:
+            from physbench.plotting.posterior import plot_posterior, posterior_path
+
+            wrote(str(plot_posterior(history.posterior, posterior_path(args.plot), history.truth)))
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(history.to_json(indent=1) + "\n", encoding="utf-8")
@@ -310,6 +315,15 @@ def main(args: argparse.Namespace) -> int:
             f"physbench run: warning: {', '.join(history.at_bound)} ended at an end of "
             "its range: the range, not the data, may hold the estimate; widen the unknown's range "
             "in the scene (a scene TOML's [[unknowns]]) and run again",
+            file=sys.stderr,
+        )
+    post = history.posterior
+    if post is not None and not post.complete:
+        print(f"physbench run: warning: incomplete posterior: {post.note}", file=sys.stderr)
+    if post is not None and post.undetermined():
+        print(
+            f"physbench run: warning: the data do not determine {', '.join(post.undetermined())}: "
+            "the posterior is about as wide as the range",
             file=sys.stderr,
         )
     if args.json:
@@ -342,6 +356,10 @@ def main(args: argparse.Namespace) -> int:
                 for k, v in best.params.items()
             )
         )
+    if history.posterior is not None:
+        print(f"posterior ({history.posterior.method}, {len(history.posterior)} samples):")
+        for line in history.posterior.describe(history.truth):
+            print("  " + line)
     if history.best_nmse is not None:
         print(
             f"normalized min MSE after {counted(n, 'iteration')}: {history.best_nmse:.3e} "

@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from physbench.params import Params, ParamSpace
+    from physbench.posterior import Posterior
     from physbench.render.base import Renderer
     from physbench.scene import Scene
     from physbench.trajectory import Trajectory
@@ -45,6 +46,9 @@ class Task:
     renderer: Renderer | None
     iterations: int
     marked_observation: Mapping[str, np.ndarray] = field(default_factory=dict)
+    #: The standard deviation of the observation's Gaussian pixel noise when the observation model
+    #: states it (a simulated observation), ``None`` when unknown (a file, a camera).
+    noise: float | None = None
 
 
 @dataclass
@@ -90,3 +94,9 @@ class CorrectionEstimator(Requirements):
         ``task.space`` inside its range. Raise :class:`~physbench.errors.PhysbenchError` saying
         that ``start()`` must come first when called before it."""
         raise NotImplementedError(f"{type(self).__name__} must implement propose()")
+
+    def posterior(self) -> Posterior | None:
+        """Called once after the last :meth:`propose`: how sure the estimator is, as a
+        :class:`~physbench.posterior.Posterior` over ``task.space``. Default ``None``: the
+        estimator gives a point estimate only."""
+        return None

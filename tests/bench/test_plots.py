@@ -14,9 +14,9 @@ import pandas as pd
 import pytest
 
 from physbench.bench.plots import landscape, landscape_data, plot_all
-from physbench.bench.runner import run_sweep
+from physbench.bench.runner import read_table, run_sweep
 from physbench.bench.spec import parse_spec
-from physbench.bench.tables import final_rows, win_rate_table
+from physbench.bench.tables import final_rows, stats, win_rate_table
 from physbench.render.base import DEFAULT_RENDERER
 
 
@@ -111,6 +111,7 @@ def test_a_table_without_renderer_columns_plots(tmp_path: Path) -> None:
     old = df.drop(columns=["renderer", "renderer_name", "renderer_options"])
     figures = plot_all(old, tmp_path / "plots", seeds=1, landscape_seeds=1)
     assert [p.name for p in figures["landscape"]] == ["landscape_three_circles.png"]
+    assert figures.pop("coverage") == []  # no estimator here returns a posterior
     assert all(figures.values()), figures
 
 
@@ -201,3 +202,49 @@ def test_the_win_rate_colour_bar_is_labelled(figures: dict[str, Any]) -> None:
     heat = fig.axes[0]
     assert heat.images[0].colorbar.ax.get_ylabel() == "share won by the row (ties: half)"
     assert heat.get_ylabel() == "estimator (row)" and heat.get_xlabel() == "opponent (column)"
+
+
+def test_the_coverage_figure_draws_posteriors_against_the_diagonal(
+    calibrated_sweep, tmp_path: Path
+) -> None:
+    from physbench.bench import plots
+    from physbench.calibration import LEVELS
+
+    from .conftest import SMC
+
+    drawn: dict[str, Any] = {}
+    save = plots._save
+
+    def keep(fig: Any, path: Path) -> Path:
+        drawn[path.name] = fig
+        return save(fig, path)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(plots, "_save", keep)
+        paths = plots.coverage(calibrated_sweep.table, tmp_path)
+    assert [p.name for p in paths] == ["coverage_three_circles.png"] and paths[0].is_file()
+    fig = drawn["coverage_three_circles.png"]
+    (ax,) = fig.axes
+    assert ax.get_xlabel() == "nominal coverage of the central interval (dimensionless)"
+    assert ax.get_ylabel() == "observed coverage (dimensionless)"
+    diagonal, line = ax.lines[0], ax.lines[1]
+    assert diagonal.get_xdata().tolist() == [0, 1] == diagonal.get_ydata().tolist()
+    # one line, for smc only (random has no posterior): its points are the table's coverages
+    assert len(ax.containers) == 1
+    row = stats(calibrated_sweep.table).set_index("estimator").loc[SMC]
+    assert line.get_xdata() == pytest.approx(LEVELS)
+    assert line.get_ydata().tolist() == [row[f"coverage{n}"] for n in (50, 80, 90, 95)]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert labels == ["calibrated", f"{SMC}, Elasticity (n=6)"]
+    assert "engine pymunk" in fig.get_suptitle() and "Clopper-Pearson" in fig.get_suptitle()
+    assert _legend_outside_the_axes(fig)
+
+
+def test_no_coverage_figure_without_posteriors(calibrated_sweep, tmp_path: Path) -> None:
+    from physbench.bench import plots
+
+    df = calibrated_sweep.table
+    assert plots.coverage(df[df["estimator"] == "random"], tmp_path) == []
+    old = read_table(Path(__file__).resolve().parents[2] / "results" / "baseline")
+    assert plots.coverage(old, tmp_path) == []
+    assert not list(tmp_path.iterdir())

@@ -100,3 +100,19 @@ def test_a_table_from_before_renderer_columns_is_rendered_by_the_default(
     old = table.drop(columns=["renderer", "renderer_name", "renderer_options"])
     page = build(old, tmp_path, {}, title="cmp").read_text()
     assert f"iterations, rendered by {DEFAULT_RENDERER}. " in page
+
+
+def test_posteriors_get_a_calibration_section(calibrated_sweep: Any, tmp_path: Path) -> None:
+    from .conftest import SMC
+
+    page = build(calibrated_sweep.table, tmp_path, {}, title="cal").read_text()
+    assert _headings(page) == [
+        "Table 1 layout",
+        "Next to the paper",
+        "Per configuration",
+        "Calibration",
+        "Win rate",
+    ]
+    section = page.split("<h2>Calibration</h2>", 1)[1].split("<h2>", 1)[0]
+    assert f"<td>{SMC}</td>" in section and "<td>random</td>" not in section
+    assert "<th>SBC p</th>" in section

@@ -1,9 +1,12 @@
 """The long table's schema: tables written before the renderer and observer columns existed (the
 committed ones among them) read with the default renderer, the sharp observer and no options. And
-the summaries' bootstrap intervals: BCa, seeded, and a point where BCa is undefined."""
+the summaries' bootstrap intervals: BCa, seeded, and a point where BCa is undefined. And the
+calibration of posteriors: a column and summary columns only where some estimator returned one."""
 
 from __future__ import annotations
 
+import json
+import math
 import warnings
 from pathlib import Path
 
@@ -20,6 +23,7 @@ from physbench.bench.tables import (
     MATCH,
     SCHEMA,
     bootstrap_ci,
+    final_rows,
     ratio_ci,
     stats,
     upgrade,
@@ -120,3 +124,93 @@ def test_ratio_ci_where_bca_is_undefined() -> None:
         warnings.simplefilter("error")
         assert ratio_ci(2 * den, den) == (2.0, 2.0, 2.0)  # pairing cancels all the spread
         assert ratio_ci([3.0], [2.0]) == (1.5, 1.5, 1.5)
+
+
+CALIBRATION_STATS = [
+    "coverage50",
+    "coverage80",
+    "coverage90",
+    "coverage95",
+    "sbc_p",
+    "width90",
+    "nld",
+    "scored",
+]
+
+
+def test_cells_with_a_posterior_record_its_scores_against_the_truth(calibrated_sweep) -> None:
+    from physbench.bench.store import CellStore
+    from physbench.calibration import score
+    from physbench.posterior import Posterior
+
+    from .conftest import SMC
+
+    df = calibrated_sweep.table
+    assert list(df.columns) == [*SCHEMA, "calibration"]
+    fin = final_rows(df)
+    assert (fin["status"] == "ok").all()
+    smc, rnd = fin[fin["estimator"] == SMC], fin[fin["estimator"] == "random"]
+    assert len(smc) == 3 and rnd["calibration"].isna().all()
+    store = CellStore(calibrated_sweep.out)
+    for row in smc.to_dict("records"):
+        hist = store.load(row["cell"])["history"]
+        want = score(Posterior.from_dict(hist["posterior"]), hist["truth"])
+        got = json.loads(row["calibration"])
+        assert list(got) == ["a.elasticity", "b.elasticity"]
+        assert got == {k: s.to_dict() for k, s in want.items()}
+        assert set(got["a.elasticity"]) == {
+            "in50", "in80", "in90", "in95", "rank", "width90", "nld"
+        }  # fmt: skip
+    # every row of a cell carries it, like the truth
+    assert df.loc[df["estimator"] == SMC, "calibration"].notna().all()
+
+
+def test_stats_gain_calibration_columns_for_configurations_with_posteriors(
+    calibrated_sweep,
+) -> None:
+    from .conftest import SMC
+
+    df = calibrated_sweep.table
+    full = stats(df)
+    before = stats(df.drop(columns="calibration"))
+    assert list(full.columns) == [*before.columns, *CALIBRATION_STATS]
+    pd.testing.assert_frame_equal(full[before.columns], before)
+    st = full.set_index("estimator")
+    smc, rnd = st.loc[SMC], st.loc["random"]
+    assert smc["scored"] == 6  # 3 seeds x 2 unknowns
+    covs = [smc[f"coverage{n}"] for n in (50, 80, 90, 95)]
+    assert all(0 <= c <= 1 for c in covs) and covs == sorted(covs)  # nested intervals
+    assert 0 < smc["sbc_p"] <= 1 and 0 < smc["width90"] < 1 and math.isfinite(smc["nld"])
+    assert rnd["scored"] == 0 and all(math.isnan(rnd[c]) for c in CALIBRATION_STATS[:-1])
+
+
+def test_the_summary_has_a_calibration_section_for_posteriors_only(
+    calibrated_sweep, tmp_path: Path
+) -> None:
+    from physbench.bench.tables import write_summary
+
+    from .conftest import SMC
+
+    write_summary(calibrated_sweep.table, tmp_path, title="t")
+    md = (tmp_path / "summary.md").read_text()
+    section = md.split("## Calibration\n", 1)[1].split("\n## ", 1)[0]
+    assert "| 50 % | 80 % | 90 % | 95 % | SBC p | 90 % width | NLD |" in section
+    assert f"| {SMC} | 6 |" in section and "random" not in section
+    assert "coverage90" in (tmp_path / "stats.csv").read_text().splitlines()[0]
+
+
+def test_a_sweep_without_posteriors_keeps_the_tables_it_had(
+    calibrated_sweep, tmp_path: Path
+) -> None:
+    """Only the random cells: no calibration column, no calibration in stats or the summary,
+    so such a sweep writes the files it wrote before posteriors existed."""
+    from physbench.bench.runner import assemble
+    from physbench.bench.store import CellStore
+    from physbench.bench.tables import write_summary
+
+    cells = [c for c in calibrated_sweep.spec.cells() if c.label == "random"]
+    df = assemble(cells, CellStore(calibrated_sweep.out))
+    assert list(df.columns) == list(SCHEMA)
+    st = write_summary(df, tmp_path, title="t")
+    assert not set(CALIBRATION_STATS) & set(st.columns)
+    assert "Calibration" not in (tmp_path / "summary.md").read_text()

@@ -342,3 +342,23 @@ def test_resnet3d_without_torch_names_the_extra_instead_of_a_traceback(
         "physbench run: error: estimator 'resnet3d' needs torch, which is not installed: "
         "pip install 'physbench[learn]'"
     )
+
+
+def test_a_posterior_is_printed_warned_about_saved_and_plotted(
+    capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    common = ["--estimator", "smc", "--noise", "0.2", "--resolution", "16", "--seed", "1"]
+    code, out, err = run(
+        capsys, "run", *common, "--iterations", "200", "--plot", str(tmp_path / "r.png")
+    )
+    assert code == 0
+    assert "posterior (smc, 64 samples):" in out
+    assert "a.mass: median" in out and "90 % [" in out and "truth" in out
+    # 200 simulations do not finish tempering: said on stdout and as a warning.
+    assert "incomplete posterior" in out and "warning: incomplete posterior" in err
+    assert (tmp_path / "r.png").exists() and (tmp_path / "r.posterior.png").exists()
+    code, out, _ = run(capsys, "run", *common, "--iterations", "200", "--json")
+    post = json.loads(out)["posterior"]
+    assert post["method"] == "smc" and post["keys"] == ["a.mass", "b.mass"]
+    assert len(post["samples"]) == 64 and len(post["quantiles"]["a.mass"]) == 5
+    assert post["complete"] is False
