@@ -357,7 +357,7 @@ def test_a_posterior_is_printed_warned_about_saved_and_plotted(
     # 200 simulations do not finish tempering: said on stdout and as a warning.
     assert "incomplete posterior" in out and "warning: incomplete posterior" in err
     assert (tmp_path / "r.png").exists() and (tmp_path / "r.posterior.png").exists()
-    code, out, _ = run(capsys, "run", *common, "--iterations", "200", "--json")
+    code, out, _ = run(capsys, *common, "--iterations", "200", "--json")
     post = json.loads(out)["posterior"]
     assert post["method"] == "smc" and post["keys"] == ["a.mass", "b.mass"]
     assert len(post["samples"]) == 64 and len(post["quantiles"]["a.mass"]) == 5
