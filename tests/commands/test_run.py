@@ -348,9 +348,7 @@ def test_a_posterior_is_printed_warned_about_saved_and_plotted(
     capsys: pytest.CaptureFixture[str], tmp_path
 ) -> None:  # type: ignore[no-untyped-def]
     common = ["--estimator", "smc", "--noise", "0.2", "--resolution", "16", "--seed", "1"]
-    code, out, err = run(
-        capsys, "run", *common, "--iterations", "200", "--plot", str(tmp_path / "r.png")
-    )
+    code, out, err = run(capsys, *common, "--iterations", "200", "--plot", str(tmp_path / "r.png"))
     assert code == 0
     assert "posterior (smc, 64 samples):" in out
     assert "a.mass: median" in out and "90 % [" in out and "truth" in out
