@@ -2,9 +2,9 @@
 vector (trust-region reflective, finite-difference Jacobian), optionally started from the best point
 of any registered black-box estimator (ask/tell, as in the correction loop).
 
-Uncertainty comes from the Jacobian at the optimum: ``cov ≈ s² (JᵀJ)⁻¹`` with
-``s² = SSR / (n - p)``. It assumes independent residuals; tracking errors that are correlated in
-time, or model error, make it optimistic.
+Uncertainty: the result's ``stderr`` is the i.i.d. Jacobian standard error ``s² (JᵀJ)⁻¹`` with
+``s² = SSR / (n - p)``, a lower bound when residuals are correlated in time; its ``intervals``
+are 90 % intervals that allow for that correlation (:mod:`physbench.discover.intervals`).
 
 :func:`fit_model` is the fit every stage uses, with the budgets, horizons and estimator of the
 :class:`~physbench.discover.settings.Settings`; :func:`score` scores a fitted model on the held-out
@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 
 from physbench.discover.data import DiscoverError, Run
+from physbench.discover.intervals import METHOD, ar1_covariance
 from physbench.discover.model import FitParameter, Model
 from physbench.discover.residuals import rms
 from physbench.discover.results import FitResult, Scored
@@ -52,6 +53,7 @@ def least_squares(
     tol: float = 1e-8,
     horizons: Sequence[float] = (1.0,),
     final: bool = True,
+    uncertainty: bool = True,
 ) -> FitResult:
     """Fit ``free`` (keys) of ``model`` to the parts of ``role``, starting from ``model.values``;
     the model's values are set to the optimum. ``diff_step`` is the finite-difference step in units
@@ -59,6 +61,8 @@ def least_squares(
     horizon (the best point so far is kept). ``horizons``: fit the first shares of time in turn,
     each from the last optimum (continuation: a late bounce cannot pull an early fit into a wrong
     valley); unless ``final`` is False, the last horizon is 1 whatever ``horizons`` ends with.
+    ``uncertainty``: estimate standard errors and intervals at the optimum (a full fit; a
+    profile's inner refit does not need them).
 
     An effect parameter that ends at the end of an extensible range has its range widened and the
     last horizon refitted from there, up to :data:`WIDENINGS` times; the ones still at a nonzero
@@ -79,7 +83,7 @@ def least_squares(
             diff_step,
             tol,
             steps[-1],
-            covariance_needed=final,
+            covariance_needed=final and uncertainty,
         )
 
     fr = last()
@@ -215,13 +219,32 @@ def _lsq(
     model.values = values
     stderr: dict[str, float] = {}
     corr: dict[str, dict[str, float]] = {}
+    intervals: dict[str, tuple[float, float]] = {}
+    half_widths: dict[str, float] = {}
     if covariance_needed:
+        limit = math.inf
         if j is None:
-            limit = math.inf
             j = jac(z)
         stderr, corr = covariance(j, ssr, n, scale, free)
+        hw = ar1_covariance(j, fun(z), model.problem.series(role, runs)).half_width() * scale
+        half_widths = {k: float(hw[i]) for i, k in enumerate(free)}
+        intervals = {
+            k: (max(float(x[i] - hw[i]), ps[i].low), min(float(x[i] + hw[i]), ps[i].high))
+            for i, k in enumerate(free)
+        }
     return FitResult(
-        values, list(free), stderr, ssr, n, nfev, model.problem.simulations - sims0, status, corr
+        values,
+        list(free),
+        stderr,
+        ssr,
+        n,
+        nfev,
+        model.problem.simulations - sims0,
+        status,
+        corr,
+        intervals=intervals,
+        interval_method=METHOD if intervals else "",
+        half_widths=half_widths,
     )
 
 

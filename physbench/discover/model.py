@@ -28,7 +28,7 @@ from physbench.effects import apply_measurements
 from physbench.effects.measurement import ClockScale
 from physbench.errors import SimulationError
 from physbench.parameter import Parameter
-from physbench.recording import Recording, Track
+from physbench.recording import POSE_FIELDS, Recording, Track
 from physbench.scene import Scene
 from physbench.trajectory import Trajectory
 
@@ -408,6 +408,25 @@ class Problem:
 
     def parts(self, role: str) -> tuple[Part, ...]:
         return {"fit": self.split.fit, "lead": self.split.lead, "held": self.split.held}[role]
+
+    def series(self, role: str, runs: Sequence[int] | None = None) -> np.ndarray:
+        """A label per entry of the full-horizon residuals of ``role`` (as
+        :meth:`Model.residuals` concatenates them) naming its series: one run's body and field
+        in time order, or one frame of an image part. The fit's intervals estimate the
+        correlation in time within each series."""
+        out, base = [], 0
+        for p in self.parts(role):
+            if runs is not None and p.run not in runs:
+                continue
+            lay = self.layouts[(role, p.run)]
+            if lay.field[0] < 0:
+                key = np.rint(lay.t * self.runs[p.run].scene.fps).astype(np.int64)
+            else:
+                key = lay.body.astype(np.int64) * len(POSE_FIELDS) + lay.field
+            _, inverse = np.unique(key, return_inverse=True)
+            out.append(base + inverse)
+            base += int(inverse.max()) + 1 if inverse.size else 0
+        return np.concatenate(out) if out else np.zeros(0, dtype=np.int64)
 
     @property
     def unit(self) -> str:

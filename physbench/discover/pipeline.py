@@ -24,6 +24,7 @@ from physbench.discover.candidates import CandidateSpec, candidates_for
 from physbench.discover.data import DiscoverError, Run, make_split
 from physbench.discover.fit import fit_model, is_rough, score
 from physbench.discover.model import Model, Problem, body_params, nuisance_params
+from physbench.discover.profile import profiled
 from physbench.discover.results import Discovery, Scored, Selection
 from physbench.discover.select import prune_causes, select_causes
 from physbench.discover.sensitivity import prune_nuisance
@@ -179,7 +180,7 @@ def conclude(
         unit=problem.unit,
         base=selection.base,
         final=selection.final,
-        candidates=selection.candidates,
+        candidates=[profiled(c, settings) if c.chosen else c for c in selection.candidates],
         causes=selection.causes,
         gain=selection.gain,
         skipped=selection.skipped,

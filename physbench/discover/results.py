@@ -14,6 +14,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from physbench.discover.intervals import LEVEL
+
 if TYPE_CHECKING:
     from physbench.discover.data import Run, Split
     from physbench.discover.model import Model
@@ -37,6 +39,13 @@ class FitResult:
     #: Effect parameters left at a nonzero end of their range, even after widening it
     #: (:func:`~physbench.discover.fit.least_squares`): their true values may lie beyond.
     at_bound: tuple[str, ...] = ()
+    #: 90 % interval (low, high) of each fitted parameter, clipped to its range, made by
+    #: ``interval_method`` (:mod:`physbench.discover.intervals`); ``stderr`` is the i.i.d.
+    #: Jacobian standard error, a lower bound when residuals are correlated.
+    intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
+    interval_method: str = ""
+    #: Half width of each interval before clipping to the range (what a profile aims at).
+    half_widths: dict[str, float] = field(default_factory=dict)
 
     @property
     def k(self) -> int:
@@ -76,6 +85,9 @@ class Scored:
             "effects": list(self.causes),
             "params": {k: self.model.values[k] for k in shown},
             "stderr": {k: self.fit.stderr.get(k) for k in shown},
+            "intervals": {k: list(self.fit.intervals[k]) for k in shown if k in self.fit.intervals},
+            "interval_level": LEVEL,
+            "interval_method": self.fit.interval_method,
             "nuisance": {p.key: self.model.values[p.key] for p in params if p.kind == "nuisance"},
             "fit_error": self.fit.rms,
             "heldout_error": self.heldout,
@@ -156,6 +168,10 @@ class CandidateResult:
     #: Its parameters (bare names) left at an end of their range: the magnitude is a lower bound
     #: at best, and the verdict says so wherever it names the candidate.
     at_bound: tuple[str, ...] = ()
+    #: 90 % interval (low, high) of each parameter and the method that made it
+    #: (:attr:`FitResult.intervals`); ``stderr`` is the i.i.d. Jacobian lower bound.
+    intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
+    interval_method: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -164,6 +180,9 @@ class CandidateResult:
             "round": self.round,
             "params": self.params,
             "stderr": self.stderr,
+            "intervals": {k: list(v) for k, v in self.intervals.items()},
+            "interval_level": LEVEL,
+            "interval_method": self.interval_method,
             "fixed": self.fixed,
             "heldout_error": _num(self.heldout_error),
             "gain": _num(self.gain),

@@ -151,6 +151,12 @@ def _refitted(
         c,
         params={k: m.values[f"{key}.{k}"] for k in c.params},
         stderr={k: scored.fit.stderr.get(f"{key}.{k}", math.nan) for k in c.params},
+        intervals={
+            k: scored.fit.intervals[f"{key}.{k}"]
+            for k in c.params
+            if f"{key}.{k}" in scored.fit.intervals
+        },
+        interval_method=scored.fit.interval_method,
         heldout_error=scored.heldout,
         criterion=scored.bic,
         scored=scored,

@@ -117,6 +117,8 @@ def try_effect(
             fr.nfev,
             fr.simulations,
             "no better than the current model",
+            intervals={k: v for k, v in current.fit.intervals.items() if k in free},
+            interval_method=current.fit.interval_method,
         )
     scored = score(f"{current.label} + {key}", (*current.causes, key), model, fr)
     c = CandidateResult(
@@ -125,6 +127,8 @@ def try_effect(
         name=eff.name,
         params={k.rpartition(".")[2]: model.values[k] for k in seen},
         stderr={k.rpartition(".")[2]: fr.stderr.get(k, math.nan) for k in seen},
+        intervals={k.rpartition(".")[2]: fr.intervals[k] for k in seen if k in fr.intervals},
+        interval_method=fr.interval_method,
         fixed=fixed,
         heldout_error=scored.heldout,
         gain=0.0,

@@ -13,6 +13,7 @@ import math
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
+from physbench.discover.intervals import LEVEL
 from physbench.discover.phrasing import describe
 from physbench.errors import counted
 
@@ -34,20 +35,33 @@ def _unit(name: str, param: str) -> str:
         return ""
 
 
-def format_value(value: float, err: float | None) -> str:
-    if err is None or not math.isfinite(err) or err <= 0:
-        return f"{value:.4g}"
-    digits = max(0, 1 - math.floor(math.log10(err))) if err < 1 else 0
-    if abs(value) > 0 and abs(value) < 1e-3:
-        return f"{value:.3g} ± {err:.2g}"
-    return f"{value:.{digits}f} ± {err:.{digits}f}" if digits < 8 else f"{value:.3g} ± {err:.2g}"
+def format_interval(
+    value: float, interval: tuple[float, float] | None, unit: str = "", *, words: bool = True
+) -> str:
+    """``value`` with its 90 % interval, rounded to the interval's precision:
+    ``0.30 N·m (90 % interval [0.27, 0.33])``, or ``0.30 [0.27, 0.33]`` without ``words``; the
+    bare value when there is no interval."""
+    u = f" {unit}" if unit else ""
+    lo, hi = interval if interval is not None else (math.nan, math.nan)
+    half = (hi - lo) / 2
+    if not (math.isfinite(lo) and math.isfinite(hi)) or half <= 0:
+        return f"{value:.4g}{u}"
+    digits = max(0, 1 - math.floor(math.log10(half))) if half < 1 else 0
+    if digits >= 8 or 0 < abs(value) < 1e-3:
+        nums = [f"{x:.3g}" for x in (value, lo, hi)]
+    else:
+        nums = [f"{x:.{digits}f}" for x in (value, lo, hi)]
+    band = f"[{nums[1]}, {nums[2]}]"
+    return f"{nums[0]}{u} ({LEVEL * 100:g} % interval {band})" if words else f"{nums[0]} {band}"
 
 
 def params_text(c: CandidateResult, *, units: bool = True) -> str:
+    """``c``'s parameters with their 90 % intervals (with units and words, or compact for the
+    table)."""
     parts = []
     for k, v in c.params.items():
         u = _unit(c.name, k) if units else ""
-        parts.append(f"{k} = {format_value(v, c.stderr.get(k))}{(' ' + u) if u else ''}")
+        parts.append(f"{k} = {format_interval(v, c.intervals.get(k), u, words=units)}")
     return ", ".join(parts)
 
 
@@ -88,7 +102,9 @@ def text(disc: Discovery) -> str:
     if shown:
         lines.append(
             "  fitted: "
-            + ", ".join(f"{k} = {format_value(v, b.fit.stderr.get(k))}" for k, v in shown.items())
+            + ", ".join(
+                f"{k} = {format_interval(v, b.fit.intervals.get(k))}" for k, v in shown.items()
+            )
         )
     lines.append("")
     lines.append("what is wrong with the base model:")
