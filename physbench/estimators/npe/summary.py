@@ -3,8 +3,8 @@
 The paper embeds the video with a 3D-ResNet. Trained end to end on this project's CPU that costs
 about 20-200 ms per sample, while simulating and rendering a sample costs 3-11 ms (three_circles:
 11 ms, second_order: 3 ms, measured), so the network would take hours where the simulations take
-minutes. These summaries cost 2.5 ms per 30-frame 64-pixel view and keep what the dynamics show: the marked
-body's path and size (channel 1) and the other bodies' joint path (channel 0).
+minutes. These summaries cost 2.5 ms per 30-frame 64-pixel view and keep what the dynamics show:
+the marked body's path and size (channel 1) and the other bodies' joint path (channel 0).
 """
 
 from __future__ import annotations

@@ -35,11 +35,11 @@ def test_log_density_is_the_full_covariance_gaussian() -> None:
     from scipy.stats import multivariate_normal
 
     cfg = MDNConfig(n_features=3, n_params=2, hidden=4, components=1, members=1)
-    # L = [[2, 0], [0.5, 0.5]] -> covariance [[4, 1], [1, 0.5]]
-    net = _fixed(cfg, [0.0], [[0.3, -1.0]], [[math.log(2.0), 0.5, math.log(0.5)]])
+    # L = [[2, 0], [0.5, 1.5]] -> covariance [[4, 1], [1, 2.5]]
+    net = _fixed(cfg, [0.0], [[0.3, -1.0]], [[math.log(2.0), 0.5, math.log(1.5)]])
     z = np.array([[0.0, 0.0], [1.5, -2.0], [-3.0, 0.7]])
     got = net.log_prob(torch.zeros(3, 3), torch.tensor(z, dtype=torch.float32))
-    want = multivariate_normal([0.3, -1.0], [[4.0, 1.0], [1.0, 0.5]]).logpdf(z)
+    want = multivariate_normal([0.3, -1.0], [[4.0, 1.0], [1.0, 2.5]]).logpdf(z)
     np.testing.assert_allclose(got.detach().numpy(), want, rtol=1e-5)
 
 
