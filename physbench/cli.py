@@ -19,7 +19,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "simulate a scene, save trajectory + frames (.npz), preview as GIF/PNG",
     ),
     "run": ("run", "identify parameters: the correction loop on a simulated or given observation"),
-    "train": ("train", "train the resnet3d correction network for a scene and parameter set"),
+    "train": (
+        "train",
+        "train the resnet3d correction network (or --posterior: npe) for a scene and parameter set",
+    ),
     "bench": ("bench", "run a benchmark sweep spec (TOML) into tables of normalized min MSE"),
     "plot": ("plot", "plots and an HTML report for a benchmark output folder"),
     "compare": (

@@ -1,4 +1,5 @@
-"""``physbench train``: train the resnet3d correction network for a scene and parameter set."""
+"""``physbench train``: train the resnet3d correction network for a scene and parameter set, or
+with ``--posterior`` the npe amortized posterior."""
 
 from __future__ import annotations
 
@@ -25,9 +26,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_params_argument(p)
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/train/SCENE__PARAMS)")
     p.add_argument(
-        "--samples", type=int, default=40_000, help="training budget in samples (default 40000)"
+        "--samples",
+        type=int,
+        default=None,
+        help="training budget in samples (default 40000; --posterior: simulations, default 20000)",
     )
-    p.add_argument("--batch", type=int, default=16)
+    p.add_argument("--batch", type=int, default=None, help="default 16 (--posterior: 256)")
     p.add_argument("--lr", type=float, default=1e-3)
     p.add_argument(
         "--widths",
@@ -41,7 +45,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="network input resolution (default 32)",
     )
     p.add_argument(
-        "--frames", type=int, default=15, help="frames per sequence after subsampling (default 15)"
+        "--frames",
+        type=int,
+        default=None,
+        help="frames per sequence after subsampling (default 15; --posterior: 30)",
     )
     p.add_argument(
         "--minutes",
@@ -92,6 +99,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--no-resume", action="store_true", help="start over even if a checkpoint exists"
     )
+    p.add_argument(
+        "--posterior",
+        action="store_true",
+        help="train the npe amortized posterior (a mixture density network on pixel summaries) "
+        "instead; uses --scene, --params, --out, --samples, --batch, --lr, --frames, --engine, "
+        "--renderer, --threads",
+    )
     add_quiet_argument(p, "only the result lines")
 
 
@@ -112,6 +126,11 @@ def main(args: argparse.Namespace) -> int:
     from physbench.requirements import require
     from physbench.scenes.generator import resolve_scene
 
+    if args.posterior:
+        return _posterior(args)
+    args.samples = 40_000 if args.samples is None else args.samples
+    args.batch = 16 if args.batch is None else args.batch
+    args.frames = 15 if args.frames is None else args.frames
     require("estimator", "resnet3d", get_registry().get("estimator", "resnet3d"))
     params = split_params(args.params)
     scene_name = args.scene or DEFAULT_SCENE  # a registered generator or a scene TOML file
@@ -203,4 +222,58 @@ def main(args: argparse.Namespace) -> int:
                 "iterations: "
                 f"{sum(vals) / len(vals):.3g}"
             )
+    return 0
+
+
+def _posterior(args: argparse.Namespace) -> int:
+    """``train --posterior``: simulate, fit the npe ensemble, write its weights."""
+    from pathlib import Path
+
+    from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
+    from physbench.commands.console import wrote
+    from physbench.errors import PhysbenchError
+    from physbench.estimators.npe.data import NPEDataSpec
+    from physbench.estimators.npe.estimator import NPEEstimator
+    from physbench.estimators.npe.train import NPETrainConfig, train, weights_name
+    from physbench.experiment import make_renderer
+    from physbench.params import ParamSpace, split_params
+    from physbench.requirements import require
+    from physbench.scenes.generator import is_scene_file, resolve_scene
+
+    require("estimator", "npe", NPEEstimator)
+    params = split_params(args.params)
+    scene_name = args.scene or DEFAULT_SCENE
+    if is_scene_file(scene_name):
+        raise PhysbenchError(
+            f"--posterior --scene {scene_name!r}: a scene file is one instance; npe learns over "
+            "a generator's instances, e.g. --scene three_circles"
+        )
+    ParamSpace.from_scene(resolve_scene(scene_name, 0), params)  # unknown names fail here
+    renderer, renderer_options = renderer_choice(args)
+    make_renderer(renderer, renderer_options, resolution=64, mode="mark")
+    samples = 20_000 if args.samples is None else args.samples
+    batch = 256 if args.batch is None else args.batch
+    frames = 30 if args.frames is None else args.frames
+    for name, value, low in (("samples", samples, 20), ("batch", batch, 1), ("frames", frames, 2)):
+        if value < low:
+            raise PhysbenchError(f"--{name} {value}: must be >= {low}")
+    spec = NPEDataSpec(
+        scene_name,
+        params,
+        engine=args.engine,
+        renderer=renderer,
+        renderer_options=renderer_options,
+        frames=frames,
+    )
+    cfg = NPETrainConfig(samples=samples, batch=batch, lr=args.lr, threads=args.threads)
+    out = Path(args.out or f"runs/train/npe/{weights_name(spec)}")
+    path, meta = train(spec, None, cfg, out, progress=not args.quiet)
+    wrote(path)
+    wrote(path.with_suffix(".json"))
+    t = meta["training"]
+    print(
+        f"npe weights: {path} (+ {path.with_suffix('.json').name}); validation NLL in logit-unit "
+        f"space {meta['val_nll']:.3f} ({t['train_rows']} training rows from {samples} "
+        f"simulations; {t['simulate_s']:.0f} s simulating, {t['wall_s']:.0f} s in all)"
+    )
     return 0

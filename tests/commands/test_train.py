@@ -67,3 +67,36 @@ def test_a_scene_file_trains_weights_that_run_on_it(
 
     history = json.loads(capsys.readouterr().out)
     assert history["meta"]["scene"] == scene.name and len(history["iterations"]) == 2
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--params", "volume"], "unknown parameter 'volume'"),
+        (["--params", "mass", "--samples", "5"], "--samples 5: must be >= 20"),
+        (["--params", "mass", "--frames", "1"], "--frames 1: must be >= 2"),
+    ],
+)
+def test_posterior_bad_arguments_are_named(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    code = main(["train", "--posterior", "--scene", "three_circles", "--out", str(tmp_path), *argv])
+    assert code == 2 and message in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_posterior_writes_npe_weights_the_estimator_loads(
+    capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    pytest.importorskip("torch")
+    from physbench.estimators.npe import weights
+
+    argv = ["train", "--posterior", "--scene", "second_order", "--params", "mass"]
+    code = main(
+        [*argv, "--samples", "20", "--frames", "4", "--threads", "1", "--out", str(tmp_path)]
+    )
+    assert code == 0
+    assert "npe weights:" in capsys.readouterr().out
+    members, meta = weights.load(tmp_path / "second_order__mass.safetensors")
+    assert meta["data"]["frames"] == 4 and meta["training"]["train_rows"] == 40
+    assert len(members) == meta["net"]["members"] == 3
