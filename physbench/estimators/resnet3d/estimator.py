@@ -4,13 +4,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from physbench.errors import PhysbenchError
 from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.params import Params
+
+if TYPE_CHECKING:
+    from physbench.posterior import Posterior
 
 
 class ResNet3DEstimator(CorrectionEstimator):
@@ -25,7 +28,10 @@ class ResNet3DEstimator(CorrectionEstimator):
     converges to 1e-7-1e-5 instead of 2e-5-2e-4; off by default because it hurts on blurred
     observations, which the network only ever saw in the observed slot), ``any_renderer`` (accept
     frames of a renderer other than the one the weights were trained on; off by default, since the
-    weights were never validated on such frames).
+    weights were never validated on such frames), ``posterior_samples`` (0: a point only; N: after
+    the run, N forward passes with the network's dropout left on, applied to the last iterate,
+    give a posterior -- Monte Carlo dropout, the corrector's own uncertainty; it is not calibrated
+    by construction, see docs/posterior.md for what was measured).
     """
 
     name: ClassVar[str] = "resnet3d"
@@ -40,7 +46,13 @@ class ResNet3DEstimator(CorrectionEstimator):
         threads: int = 1,
         symmetric: bool = False,
         any_renderer: bool = False,
+        posterior_samples: int = 0,
     ) -> None:
+        from physbench.estimators.options import int_option
+
+        self.posterior_samples = int_option(
+            self.name, "posterior_samples", posterior_samples, low=0
+        )
         self.weights_path, self.threads, self.symmetric = weights, threads, symmetric
         self.any_renderer = any_renderer
         self.options = {
@@ -48,7 +60,9 @@ class ResNet3DEstimator(CorrectionEstimator):
             "threads": threads,
             "symmetric": symmetric,
             "any_renderer": any_renderer,
+            "posterior_samples": self.posterior_samples,
         }
+        self.last: tuple[np.ndarray, dict[str, float]] | None = None
         self.targets: list[tuple[str, list[str], np.ndarray]] | None = None
 
     def start(self, task: Task, *, seed: int) -> None:
@@ -136,6 +150,7 @@ class ResNet3DEstimator(CorrectionEstimator):
                     ),
                 ]
             )
+        self.last = (x, dict(step.params))
         with torch.no_grad():
             delta = self.net(torch.from_numpy(x)).numpy().astype(float)
         if self.symmetric:
@@ -146,6 +161,43 @@ class ResNet3DEstimator(CorrectionEstimator):
             for k, s, dk in zip(keys, scale, d, strict=True):
                 new[k] = step.params[k] + dk * s
         return self.space.clip(new)
+
+    def posterior(self) -> Posterior | None:
+        """Called once after the run: with ``posterior_samples`` N > 0, N corrections of the last
+        iterate with dropout on (the same input each time, a fresh dropout mask per pass); else
+        ``None``."""
+        import torch
+
+        from physbench.posterior import Posterior
+
+        if not self.posterior_samples or self.last is None:
+            return None
+        x, params = self.last
+        n = len(self.targets)
+        if self.symmetric:
+            x = x[:n]  # the swapped half would double the cost for the same spread
+        self.net.train()  # dropout on; the network has no batch norm, so nothing else changes
+        deltas = []
+        try:
+            with torch.no_grad():
+                for _ in range(self.posterior_samples):
+                    deltas.append(self.net(torch.from_numpy(x)).numpy().astype(float))
+        finally:
+            self.net.eval()
+        keys = list(self.space.keys)
+        samples = np.tile([params[k] for k in keys], (self.posterior_samples, 1))
+        col = {k: j for j, k in enumerate(keys)}
+        for i, (_, tkeys, scale) in enumerate(self.targets):
+            for m, (k, s) in enumerate(zip(tkeys, scale, strict=True)):
+                samples[:, col[k]] += np.array([d[i, m] for d in deltas]) * s
+        low, high = self.space.low, self.space.high
+        return Posterior(
+            keys=tuple(keys),
+            samples=np.clip(samples, low, high),
+            low=tuple(float(v) for v in low),
+            high=tuple(float(v) for v in high),
+            method="resnet3d MC dropout",
+        )
 
 
 def info() -> dict[str, Any]:

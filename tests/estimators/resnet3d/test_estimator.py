@@ -85,3 +85,33 @@ def test_weights_refuse_frames_of_another_renderer(squares_renderer) -> None:  #
         run_config(config)
     accepted = run_config(RunConfig(**{**config.__dict__, "options": {"any_renderer": True}}))
     assert accepted.meta["renderer"] == "squares" and len(accepted) == 2
+
+
+def test_posterior_samples_give_a_dropout_posterior_around_the_last_correction() -> None:
+    from physbench.estimators.options import EstimatorOptionError
+    from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
+    from physbench.loop import draw_problem, refine
+    from physbench.observation import simulate_observation
+    from physbench.params import ParamSpace
+    from physbench.plugins import create, get_registry
+
+    scene = get_registry().get("scene", "three_circles")(2)
+    space = ParamSpace.from_scene(scene, ("mass",))
+    truth, initial = draw_problem(space, 2)
+    sim, renderer = create("simulator", "pymunk"), create("renderer", "raster", resolution=64)
+    obs = simulate_observation(scene, truth, sim, renderer, marked=space.bodies)
+
+    def run(**options: object):  # type: ignore[no-untyped-def]
+        est = ResNet3DEstimator(**options)  # type: ignore[arg-type]
+        return refine(obs, scene, space, sim, renderer, est, iterations=4, seed=2, initial=initial)
+
+    assert run().posterior is None  # off by default: a point only
+    h = run(posterior_samples=32)
+    p = h.posterior
+    assert p is not None and len(p) == 32 and p.keys == space.keys
+    spread = p.samples.std(axis=0)
+    assert (spread > 0).all()  # dropout on: the passes differ
+    # Centred on the correction of the last iterate, far narrower than the range.
+    assert max(p.width_ratio().values()) < 0.2
+    with pytest.raises(EstimatorOptionError, match="posterior_samples"):
+        ResNet3DEstimator(posterior_samples=-1)
