@@ -36,6 +36,8 @@ DEFAULT_SCENE = "three_circles"
 MAX_RESOLUTION = 4096
 #: Seeds go to numpy, random, torch and optuna; this is the range all of them accept.
 MAX_SEED = 2**32 - 1
+#: The widest ``--noise``: physbench.render.observe.MAX_NOISE, kept here for the same reason.
+MAX_NOISE = 1.0
 #: The longest ``--scene``: Linux's PATH_MAX (a longer path cannot name a file).
 MAX_SCENE_ARGUMENT = 4096
 

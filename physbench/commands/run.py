@@ -14,6 +14,7 @@ import sys
 from typing import Any
 
 from physbench.commands.arguments import (
+    MAX_NOISE,
     MAX_RESOLUTION,
     add_json_argument,
     add_params_argument,
@@ -22,6 +23,7 @@ from physbench.commands.arguments import (
     add_scene_argument,
     add_video_input_arguments,
     bounded_float,
+    positive_int,
     seed_int,
 )
 
@@ -58,7 +60,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--iterations",
-        type=int,
+        type=positive_int,
         default=11,
         metavar="N",
         help="simulations = propose calls (default: 11, as in the paper)",
@@ -95,10 +97,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--noise",
-        type=float,
+        type=bounded_float(0.0, MAX_NOISE),
         default=0.0,
         metavar="SIGMA",
-        help="Gaussian pixel noise of the observation only",
+        help=f"Gaussian pixel noise (standard deviation, at most {MAX_NOISE:g}) of the "
+        "observation only",
     )
     p.add_argument(
         "--observation",

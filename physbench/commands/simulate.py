@@ -142,6 +142,15 @@ def main(args: argparse.Namespace) -> int:
                 f"{renderer.name!r} makes {renderer.mode!r} channels, not a colour image "
                 "(write its frames to an .npz file)"
             )
+    from physbench import cost
+
+    # Rendered frames are held twice: as rendered and while --out compresses them.
+    one = cost.of_scene(scene, resolution=args.resolution, mode=renderer.mode, held=2)
+    cost.check(
+        one,
+        f"this simulation ({cost.simulations(1, scene, args.resolution)})",
+        "--resolution or the scene's frames, substeps or bodies",
+    )
     effects = make_effects(args.effect)
     traj = create("simulator", args.engine).simulate(scene, effects=effects)
     if effects:

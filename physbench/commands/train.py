@@ -3,16 +3,25 @@
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from physbench.commands.arguments import (
     add_params_argument,
     add_quiet_argument,
     add_renderer_choice,
     add_scene_argument,
+    bounded_int,
     nonnegative_int,
     positive_int,
     resolution_int,
 )
+
+# physbench.estimators.resnet3d.train.MAX_SAMPLES, MAX_BATCH, MAX_WORKERS and sidecar.FRAMES,
+# repeated so that building the parser imports nothing heavy (a test checks they agree).
+MAX_SAMPLES = 10**9
+MAX_BATCH = 4096
+MAX_WORKERS = 64
+FRAMES = (2, 64)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -25,9 +34,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_params_argument(p)
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/train/SCENE__PARAMS)")
     p.add_argument(
-        "--samples", type=int, default=40_000, help="training budget in samples (default 40000)"
+        "--samples",
+        type=bounded_int(1, MAX_SAMPLES),
+        default=40_000,
+        help="training budget in samples (default 40000)",
     )
-    p.add_argument("--batch", type=int, default=16)
+    p.add_argument(
+        "--batch",
+        type=bounded_int(1, MAX_BATCH),
+        default=16,
+        help="sequences per training step (default 16)",
+    )
     p.add_argument("--lr", type=float, default=1e-3)
     p.add_argument(
         "--widths",
@@ -41,7 +58,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="network input resolution (default 32)",
     )
     p.add_argument(
-        "--frames", type=int, default=15, help="frames per sequence after subsampling (default 15)"
+        "--frames",
+        type=bounded_int(*FRAMES),
+        default=15,
+        help="frames per sequence after subsampling (default 15)",
     )
     p.add_argument(
         "--minutes",
@@ -67,7 +87,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
     add_renderer_choice(p)
-    p.add_argument("--workers", type=int, default=1, help="data-generating processes (default 1)")
+    p.add_argument(
+        "--workers",
+        type=bounded_int(0, MAX_WORKERS),
+        default=1,
+        help="data-generating processes (default 1; 0: in the training process)",
+    )
     p.add_argument(
         "--threads", type=nonnegative_int, default=0, help="torch threads (default: torch's choice)"
     )
@@ -93,6 +118,22 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--no-resume", action="store_true", help="start over even if a checkpoint exists"
     )
     add_quiet_argument(p, "only the result lines")
+
+
+def check_size(spec: Any, samples: int, scene: Any, minutes: float = 0.0) -> None:
+    """Refuse a training run this machine cannot finish (:mod:`physbench.cost`): every sample is
+    a simulation of the scene rendered at the data's render resolution (the network's own time
+    is left out, so this is a lower bound); ``minutes`` (> 0) ends it sooner."""
+    from physbench import cost
+
+    one = cost.of_scene(scene, resolution=spec.render_resolution, mode="mark").times(samples)
+    if minutes > 0:
+        one = cost.Cost(one.memory, min(one.seconds, 60.0 * minutes))
+    cost.check(
+        one,
+        f"this training ({cost.simulations(samples, scene, spec.render_resolution)})",
+        "--samples",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -156,6 +197,7 @@ def main(args: argparse.Namespace) -> int:
         frames=args.frames,
         blur_max=args.blur_max,
     )
+    check_size(spec, args.samples, scene, args.minutes)
     n_out = len(params)
     net = NetConfig(n_outputs=n_out, widths=widths, resolution=args.resolution, frames=args.frames)  # type: ignore[arg-type]
     cfg = TrainConfig(
