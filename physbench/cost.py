@@ -176,12 +176,3 @@ def check(
             f"{what} would need {' and '.join(over)}; make {fix} smaller, or set {OVERRIDE}=1 to "
             "run it anyway"
         )
-
-
-#: The sentence commands add to their help about the size check.
-HELP = (
-    "Before any work, the memory and time a job needs are estimated from its sizes (frames, "
-    "substeps, bodies, resolution, iterations, seeds, samples); a job that needs more memory than "
-    f"is available or more than {MAX_SECONDS / 3600:g} h of compute is refused, naming the "
-    f"estimate: set {OVERRIDE}=1 to run it anyway (docs/architecture.md)."
-)

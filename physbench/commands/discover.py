@@ -7,6 +7,7 @@ import argparse
 from typing import Any
 
 from physbench.commands.arguments import (
+    SIZE_CHECK_HELP,
     add_quiet_argument,
     add_renderer_arguments,
     add_scene_argument,
@@ -20,6 +21,7 @@ STAGES = ("base fit", "candidate effects", "verdict")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     p.add_argument(
         "recording",
         metavar="RECORDING",

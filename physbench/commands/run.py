@@ -16,6 +16,7 @@ from typing import Any
 from physbench.commands.arguments import (
     MAX_NOISE,
     MAX_RESOLUTION,
+    SIZE_CHECK_HELP,
     add_json_argument,
     add_params_argument,
     add_quiet_argument,
@@ -29,6 +30,7 @@ from physbench.commands.arguments import (
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     p.add_argument(
         "--estimator",
         default="tpe",

@@ -7,6 +7,7 @@ import argparse
 
 from physbench.commands.arguments import (
     DEFAULT_SCENE,
+    SIZE_CHECK_HELP,
     add_quiet_argument,
     add_renderer_arguments,
     add_scene_argument,
@@ -21,6 +22,7 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     add_scene_argument(p, required=False)
     p.add_argument(
         "--engine", default="pymunk", help="simulator (see `physbench plugins`; default pymunk)"

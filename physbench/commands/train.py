@@ -6,6 +6,7 @@ import argparse
 from typing import Any
 
 from physbench.commands.arguments import (
+    SIZE_CHECK_HELP,
     add_params_argument,
     add_quiet_argument,
     add_renderer_choice,
@@ -25,6 +26,7 @@ FRAMES = (2, 64)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     add_scene_argument(
         p,
         required=False,

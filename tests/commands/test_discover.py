@@ -85,7 +85,7 @@ CASES = [
         "bad scene value",
         {"r.csv": recording(), "s.toml": SCENE.replace("MASS", "-1.0")},
         ["r.csv"],
-        r"s\.toml:\d+: bodies\[0\]\.mass = -1\.0: mass must be > 0",
+        r"s\.toml:\d+: bodies\[0\]\.mass = -1\.0: mass must lie in \[1e-06, 1e\+06\] kg",
     ),
     (
         "missing scene",
