@@ -109,6 +109,23 @@ def _run(argv: list[str], debug: bool) -> int:
             traceback.print_exc()
         print(f"physbench {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except MemoryError:
+        if debug:
+            traceback.print_exc()
+        from physbench.cost import OVERRIDE, overridden
+
+        why = (
+            f"{OVERRIDE} turned off the size check that refuses such a job"
+            if overridden()
+            else "more than the size check estimated"
+        )
+        print(
+            f"physbench {args.command}: error: out of memory: the job needed more memory than "
+            f"this machine could give ({why}); make its sizes (frames, substeps, bodies, "
+            "resolution, batch, seeds) smaller",
+            file=sys.stderr,
+        )
+        return 2
     except BrokenPipeError:
         # The reader left (``| head``): stop quietly, as Unix tools do. Python would otherwise
         # report the failed flush of stdout again at exit.

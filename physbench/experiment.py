@@ -297,9 +297,26 @@ def config_space(config: RunConfig, scene: Scene | None = None) -> ParamSpace:
     )
 
 
+def check_size(config: RunConfig, scene: Scene) -> None:
+    """Called before a run starts: refuse one whose estimated memory or time this machine cannot
+    give (:mod:`physbench.cost`). It simulates the observation, one probe per unknown and
+    direction, and ``iterations`` models, holding three rendered sequences (the observation, the
+    model's and the best so far)."""
+    from physbench import cost
+
+    n = config.iterations + 1 + 2 * max(1, len(config.params))
+    one = cost.of_scene(scene, resolution=config.resolution, mode=config.render_mode, held=3)
+    cost.check(
+        one.times(n),
+        f"this run ({cost.simulations(n, scene, config.resolution)})",
+        "the iterations, the resolution or the scene's frames, substeps or bodies",
+    )
+
+
 def check_config(config: RunConfig) -> ParamSpace:
     """Fail fast, before anything runs: every name is registered, the options are accepted, the
-    unknowns exist on the scene. Returns the unknowns."""
+    unknowns exist on the scene, the run fits this machine (:func:`check_size`). Returns the
+    unknowns."""
     from physbench.plugins import get_registry
 
     _check_observation(config)
@@ -319,7 +336,9 @@ def check_config(config: RunConfig) -> ParamSpace:
         resolution=config.resolution,
         mode=config.render_mode,
     )
-    return config_space(config, observed_scene(config, observed))
+    scene = observed_scene(config, observed)
+    check_size(config, scene)
+    return config_space(config, scene)
 
 
 def run_config(
@@ -346,6 +365,7 @@ def run_config(
     observed = load_observed(config)
     scene = observed_scene(config, observed)
     space = config_space(config, scene)
+    check_size(config, scene)
     estimator = make_estimator(config.estimator, config.options)
     simulator = create("simulator", model_engine(config, observed))
 

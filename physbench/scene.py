@@ -20,7 +20,7 @@ Vec = tuple[float, float]
 
 #: Physical parameters a body has, with the closed range each must lie in.
 BODY_PARAMS: dict[str, tuple[float, float]] = {
-    "mass": (0.0, math.inf),  # exclusive lower bound
+    "mass": (0.0, math.inf),  # exclusive lower bound; a scene's masses lie in MASS
     "elasticity": (0.0, 1.0),
     "friction": (0.0, math.inf),
     "moment": (0.0, math.inf),  # exclusive lower bound; None means "from shape and mass"
@@ -34,6 +34,17 @@ MAX_COORDINATE = 1e6
 #: m: the smallest radius, width and height (and square root of a polygon's area); a smaller shape
 #: has an area and a moment that underflow.
 MIN_SIZE = 1e-6
+#: Hz: the frame rates accepted, from a frame every 10 s to a high-speed camera's 100,000 fps.
+FPS = (0.1, 100_000.0)
+#: m/s: the largest initial speed along an axis (ten times a rifle bullet's).
+MAX_SPEED = 1e4
+#: rad/s: the largest initial angular speed (about a million rpm).
+MAX_SPIN = 1e5
+#: m/s²: the largest gravity along an axis (a thousand g).
+MAX_GRAVITY = 1e4
+#: kg: the masses accepted, a milligram to a thousand tonnes: outside them the engines' contact
+#: solvers lose precision (pymunk turns a subnormal mass into NaN).
+MASS = (1e-6, 1e6)
 #: Recorded frames: about an hour of video at 30 fps.
 MAX_FRAMES = 100_000
 #: Physics steps per recorded frame; more only costs time (1e4 steps per frame at 30 fps is a
@@ -323,6 +334,21 @@ def _coordinate(key: str, value: object) -> float:
     return v
 
 
+def _within(key: str, value: object, low: float, high: float, unit: str) -> float:
+    v = _finite(key, value)
+    if not low <= v <= high:
+        raise SceneError(f"must lie in [{low:g}, {high:g}] {unit}", key=key, value=value)
+    return v
+
+
+def _bounded_vec(key: str, value: object, most: float, unit: str) -> Vec:
+    x, y = _vec(key, value)
+    return (
+        _within(f"{key}[0]", x, -most, most, unit),
+        _within(f"{key}[1]", y, -most, most, unit),
+    )
+
+
 def _point(key: str, value: object) -> Vec:
     x, y = _vec(key, value)
     return (_coordinate(f"{key}[0]", x), _coordinate(f"{key}[1]", y))
@@ -348,7 +374,12 @@ def _name(key: str, value: object, seen: set[str], *, world: bool = False) -> st
 def _check_param(key: str, param: str, value: float) -> None:
     lo, hi = BODY_PARAMS[param]
     value = _finite(key, value)
-    if param in ("mass", "moment"):
+    if param == "mass":
+        if not MASS[0] <= value <= MASS[1]:
+            raise SceneError(
+                f"mass must lie in [{MASS[0]:g}, {MASS[1]:g}] kg", key=key, value=value
+            )
+    elif param == "moment":
         if value <= 0:
             raise SceneError(f"{param} must be > 0", key=key, value=value)
     elif not lo <= value <= hi:
@@ -367,9 +398,8 @@ def validate_scene(scene: Scene) -> None:
             key="bounds",
             value=scene.bounds,
         )
-    _vec("gravity", scene.gravity)
-    if _finite("fps", scene.fps) <= 0:
-        raise SceneError("must be > 0", key="fps", value=scene.fps)
+    _bounded_vec("gravity", scene.gravity, MAX_GRAVITY, "m/s²")
+    _within("fps", scene.fps, *FPS, "Hz")
     for key, most in (("frames", MAX_FRAMES), ("substeps", MAX_SUBSTEPS)):
         v = getattr(scene, key)
         if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= most:
@@ -401,8 +431,8 @@ def validate_scene(scene: Scene) -> None:
                 value=b.position,
             )
         _finite(f"{k}.angle", b.angle)
-        _vec(f"{k}.velocity", b.velocity)
-        _finite(f"{k}.angular_velocity", b.angular_velocity)
+        _bounded_vec(f"{k}.velocity", b.velocity, MAX_SPEED, "m/s")
+        _within(f"{k}.angular_velocity", b.angular_velocity, -MAX_SPIN, MAX_SPIN, "rad/s")
         _point(f"{k}.com_offset", b.com_offset)
         for p in ("mass", "elasticity", "friction"):
             _check_param(f"{k}.{p}", p, getattr(b, p))

@@ -300,3 +300,19 @@ def slide() -> Scene:
         frames=41,
         substeps=4,
     ).validate()
+
+
+@pytest.fixture
+def huge_scene(tmp_path: Path) -> str:
+    """A scene file too big to run: 100,000 frames x 10,000 substeps x 50 bodies (issue 14)."""
+    bodies = "".join(
+        f'[[bodies]]\nname = "b{i}"\nposition = [{0.5 + i % 10:g}, {0.5 + i // 10:g}]\n'
+        'shape = { kind = "circle", radius = 0.2 }\n'
+        for i in range(50)
+    )
+    path = tmp_path / "huge.toml"
+    path.write_text(
+        'name = "huge"\nbounds = [0.0, 0.0, 10.0, 10.0]\nfps = 30.0\nframes = 100000\n'
+        f"substeps = 10000\n{bodies}"
+    )
+    return str(path)

@@ -148,6 +148,31 @@ def test_an_unexpected_error_is_one_line_saying_where_to_report_it(
         main(["--debug", "plugins"])
 
 
+@pytest.mark.parametrize(
+    ("override", "why"),
+    [
+        ("1", "PHYSBENCH_NO_SIZE_CHECK turned off the size check that refuses such a job"),
+        ("", "more than the size check estimated"),
+    ],
+)
+def test_running_out_of_memory_is_one_line_not_an_internal_error(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, override: str, why: str
+) -> None:
+    import physbench.commands.plugins as command
+
+    def huge(args: object) -> int:
+        raise MemoryError("Unable to allocate 26.8 TiB")
+
+    monkeypatch.setattr(command, "main", huge)
+    monkeypatch.setenv("PHYSBENCH_NO_SIZE_CHECK", override)
+    assert main(["plugins"]) == 2
+    assert capsys.readouterr().err == (
+        "physbench plugins: error: out of memory: the job needed more memory than this machine "
+        f"could give ({why}); make its sizes (frames, substeps, bodies, resolution, batch, seeds) "
+        "smaller\n"
+    )
+
+
 def test_debug_shows_the_traceback_behind_a_reported_error(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

@@ -58,7 +58,14 @@ def test_a_good_scene_validates_and_returns_itself() -> None:
             (0.0, 0.0, 0.0, 4.0),
             "bounds must be [xmin, ymin, xmax, ymax] with min < max",
         ),
-        (dataclasses.replace(GOOD, fps=0.0), "fps", 0.0, "must be > 0"),
+        (dataclasses.replace(GOOD, fps=0.0), "fps", 0.0, "must lie in [0.1, 100000] Hz"),
+        (dataclasses.replace(GOOD, fps=1e9), "fps", 1e9, "must lie in [0.1, 100000] Hz"),
+        (
+            dataclasses.replace(GOOD, gravity=(0.0, -1e9)),
+            "gravity[1]",
+            -1e9,
+            "must lie in [-10000, 10000] m/s²",
+        ),
         (
             dataclasses.replace(GOOD, frames=True),
             "frames",
@@ -96,7 +103,21 @@ def test_a_good_scene_validates_and_returns_itself() -> None:
             (3.6, 1.0),
             "body (half size 0.5 x 0.25 m) must lie inside the world bounds (0.0, 0.0, 4.0, 4.0)",
         ),
-        (_body(0, mass=0.0), "bodies[0].mass", 0.0, "mass must be > 0"),
+        (_body(0, mass=0.0), "bodies[0].mass", 0.0, "mass must lie in [1e-06, 1e+06] kg"),
+        (_body(0, mass=1e-320), "bodies[0].mass", 1e-320, "mass must lie in [1e-06, 1e+06] kg"),
+        (_body(0, mass=1e12), "bodies[0].mass", 1e12, "mass must lie in [1e-06, 1e+06] kg"),
+        (
+            _body(0, velocity=(1e9, 0.0)),
+            "bodies[0].velocity[0]",
+            1e9,
+            "must lie in [-10000, 10000] m/s",
+        ),
+        (
+            _body(1, angular_velocity=-1e9),
+            "bodies[1].angular_velocity",
+            -1e9,
+            "must lie in [-100000, 100000] rad/s",
+        ),
         (
             _body(1, elasticity=1.5),
             "bodies[1].elasticity",

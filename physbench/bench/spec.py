@@ -53,6 +53,7 @@ from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
 from physbench.params import split_params
 from physbench.render.base import DEFAULT_RENDERER
+from physbench.render.observe import MAX_NOISE
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
 #: The most seeds a spec may list: each is a cell per scene x estimator x axis value, so more is
@@ -252,13 +253,14 @@ def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
             if not isinstance(v, str) or not v:
                 raise bad(v, "a name (string)")
         elif name in ("blur", "noise"):
+            most = MAX_RESOLUTION if name == "blur" else MAX_NOISE
             if (
                 isinstance(v, bool)
                 or not isinstance(v, int | float)
                 or not math.isfinite(v)
-                or not 0 <= v <= MAX_RESOLUTION
+                or not 0 <= v <= most
             ):
-                raise bad(v, f"a finite number in [0, {MAX_RESOLUTION}]")
+                raise bad(v, f"a finite number in [0, {most:g}]")
             v = float(v)
         elif name in ("resolution", "iterations") and (
             isinstance(v, bool) or not isinstance(v, int) or v < 1
@@ -412,7 +414,11 @@ def parse_spec(
         name, description, scenes, estimators, seeds, axes, renderers, source, path, observers
     )
     _check_names(spec)
-    check_unique(spec.cells())
+    # The seeds are distinct (_seeds), so two cells are the same run only when their first seed's
+    # cells are: checking those keeps a spec of many seeds quick to load (listing 1e5 seeds'
+    # cells takes minutes). Seeds are innermost, so cell i of one seed is cell i * seeds.
+    first = replace(spec, seeds=spec.seeds[:1]).cells()
+    check_unique([replace(c, index=c.index * len(seeds)) for c in first])
     return spec
 
 

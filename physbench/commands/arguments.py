@@ -36,6 +36,16 @@ DEFAULT_SCENE = "three_circles"
 MAX_RESOLUTION = 4096
 #: Seeds go to numpy, random, torch and optuna; this is the range all of them accept.
 MAX_SEED = 2**32 - 1
+#: The widest ``--noise``: physbench.render.observe.MAX_NOISE, kept here for the same reason.
+MAX_NOISE = 1.0
+#: The epilog of the commands that refuse a job too big for this machine (physbench.cost; kept
+#: here so that building a parser imports nothing else).
+SIZE_CHECK_HELP = (
+    "Before any work, the memory and time the job needs are estimated from its sizes (frames, "
+    "substeps, bodies, resolution, iterations, seeds, samples); a job that needs more memory than "
+    "is available or more than 24 h of compute is refused, naming the estimate. Set the "
+    "environment variable PHYSBENCH_NO_SIZE_CHECK=1 to run it anyway (docs/architecture.md)."
+)
 #: The longest ``--scene``: Linux's PATH_MAX (a longer path cannot name a file).
 MAX_SCENE_ARGUMENT = 4096
 

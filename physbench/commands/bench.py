@@ -11,7 +11,11 @@ import argparse
 import shlex
 import sys
 
-from physbench.commands.arguments import add_quiet_argument, add_renderer_choice
+from physbench.commands.arguments import (
+    SIZE_CHECK_HELP,
+    add_quiet_argument,
+    add_renderer_choice,
+)
 
 EPILOG = """\
 A spec is TOML: scenes (each with its unknown sets), estimators, seeds, iterations, and the axes
@@ -29,11 +33,13 @@ One run at a time writes a DIR: a second run on the same DIR refuses (naming the
 or waits for it with --wait. With --executor processes (the default), a cell that kills its worker
 process (os._exit, a segfault in an extension) is run once more alone, then recorded as failed, and
 the sweep goes on; --executor serial runs cells in this process, so such a cell ends the command
-(finished cells are saved). Worker processes end when this process does."""
+(finished cells are saved). Worker processes end when this process does.
+
+"""
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.epilog = EPILOG
+    p.epilog = EPILOG + SIZE_CHECK_HELP
     p.formatter_class = argparse.RawDescriptionHelpFormatter
     p.add_argument("spec", metavar="SPEC", help="sweep spec (TOML), e.g. benchmarks/smoke.toml")
     p.add_argument(

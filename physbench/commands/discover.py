@@ -4,8 +4,10 @@ effect(s), and report the held-out gain."""
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from physbench.commands.arguments import (
+    SIZE_CHECK_HELP,
     add_quiet_argument,
     add_renderer_arguments,
     add_scene_argument,
@@ -19,6 +21,7 @@ STAGES = ("base fit", "candidate effects", "verdict")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     p.add_argument(
         "recording",
         metavar="RECORDING",
@@ -119,6 +122,30 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+def check_size(runs: list[Any], settings: Any, renderer: Any) -> None:
+    """Refuse a discovery this machine cannot finish (:mod:`physbench.cost`). Its simulations, an
+    order of magnitude: the base fit's estimator iterations, then per run the base fit's budget
+    twice and a candidate fit's budget for each of the shortlisted candidates and the chosen."""
+    from physbench import cost
+
+    n = settings.estimator_iterations + settings.budget * (2 + settings.shortlist + 1)
+    resolution = 0 if renderer is None else _width(renderer.resolution)
+    mode = None if renderer is None else renderer.mode
+    total = cost.Cost(0.0, 0.0)
+    for run in runs:
+        total = total + cost.of_scene(run.scene, resolution=resolution, mode=mode, held=3).times(n)
+    biggest = max(runs, key=lambda r: r.scene.frames * r.scene.substeps * len(r.scene.bodies))
+    cost.check(
+        total,
+        f"this discovery ({len(runs)} x {cost.simulations(n, biggest.scene, resolution)}, at most)",
+        "--iterations, the recording's length or the scene's substeps or bodies",
+    )
+
+
+def _width(resolution: int | tuple[int, int]) -> int:
+    return resolution if isinstance(resolution, int) else max(resolution)
+
+
 def main(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
@@ -178,6 +205,7 @@ def main(args: argparse.Namespace) -> int:
         renderer = renderer_for(
             runs, name, options, resolution=args.resolution, mode=args.render_mode
         )
+    check_size(runs, settings, renderer)
     with stages(args, STAGES, "discover") as stage:
         disc = discover(
             runs,

@@ -14,7 +14,9 @@ import sys
 from typing import Any
 
 from physbench.commands.arguments import (
+    MAX_NOISE,
     MAX_RESOLUTION,
+    SIZE_CHECK_HELP,
     add_json_argument,
     add_params_argument,
     add_quiet_argument,
@@ -22,11 +24,13 @@ from physbench.commands.arguments import (
     add_scene_argument,
     add_video_input_arguments,
     bounded_float,
+    positive_int,
     seed_int,
 )
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     p.add_argument(
         "--estimator",
         default="tpe",
@@ -58,7 +62,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--iterations",
-        type=int,
+        type=positive_int,
         default=11,
         metavar="N",
         help="simulations = propose calls (default: 11, as in the paper)",
@@ -95,10 +99,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--noise",
-        type=float,
+        type=bounded_float(0.0, MAX_NOISE),
         default=0.0,
         metavar="SIGMA",
-        help="Gaussian pixel noise of the observation only",
+        help=f"Gaussian pixel noise (standard deviation, at most {MAX_NOISE:g}) of the "
+        "observation only",
     )
     p.add_argument(
         "--observation",

@@ -7,6 +7,7 @@ import argparse
 
 from physbench.commands.arguments import (
     DEFAULT_SCENE,
+    SIZE_CHECK_HELP,
     add_quiet_argument,
     add_renderer_arguments,
     add_scene_argument,
@@ -21,6 +22,7 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     add_scene_argument(p, required=False)
     p.add_argument(
         "--engine", default="pymunk", help="simulator (see `physbench plugins`; default pymunk)"
@@ -142,6 +144,15 @@ def main(args: argparse.Namespace) -> int:
                 f"{renderer.name!r} makes {renderer.mode!r} channels, not a colour image "
                 "(write its frames to an .npz file)"
             )
+    from physbench import cost
+
+    # Rendered frames are held twice: as rendered and while --out compresses them.
+    one = cost.of_scene(scene, resolution=args.resolution, mode=renderer.mode, held=2)
+    cost.check(
+        one,
+        f"this simulation ({cost.simulations(1, scene, args.resolution)})",
+        "--resolution or the scene's frames, substeps or bodies",
+    )
     effects = make_effects(args.effect)
     traj = create("simulator", args.engine).simulate(scene, effects=effects)
     if effects:

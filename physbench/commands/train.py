@@ -4,19 +4,30 @@ with ``--posterior`` the npe amortized posterior."""
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from physbench.commands.arguments import (
+    SIZE_CHECK_HELP,
     add_params_argument,
     add_quiet_argument,
     add_renderer_choice,
     add_scene_argument,
+    bounded_int,
     nonnegative_int,
     positive_int,
     resolution_int,
 )
 
+# physbench.estimators.resnet3d.train.MAX_SAMPLES, MAX_BATCH, MAX_WORKERS and sidecar.FRAMES,
+# repeated so that building the parser imports nothing heavy (a test checks they agree).
+MAX_SAMPLES = 10**9
+MAX_BATCH = 4096
+MAX_WORKERS = 64
+FRAMES = (2, 64)
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.epilog = SIZE_CHECK_HELP
     add_scene_argument(
         p,
         required=False,
@@ -27,11 +38,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/train/SCENE__PARAMS)")
     p.add_argument(
         "--samples",
-        type=int,
+        type=bounded_int(1, MAX_SAMPLES),
         default=None,
         help="training budget in samples (default 40000; --posterior: simulations, default 20000)",
     )
-    p.add_argument("--batch", type=int, default=None, help="default 16 (--posterior: 256)")
+    p.add_argument(
+        "--batch",
+        type=bounded_int(1, MAX_BATCH),
+        default=None,
+        help="sequences per training step (default 16; --posterior: 256)",
+    )
     p.add_argument("--lr", type=float, default=1e-3)
     p.add_argument(
         "--widths",
@@ -46,7 +62,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--frames",
-        type=int,
+        type=bounded_int(*FRAMES),
         default=None,
         help="frames per sequence after subsampling (default 15; --posterior: 30)",
     )
@@ -74,7 +90,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
     add_renderer_choice(p)
-    p.add_argument("--workers", type=int, default=1, help="data-generating processes (default 1)")
+    p.add_argument(
+        "--workers",
+        type=bounded_int(0, MAX_WORKERS),
+        default=1,
+        help="data-generating processes (default 1; 0: in the training process)",
+    )
     p.add_argument(
         "--threads", type=nonnegative_int, default=0, help="torch threads (default: torch's choice)"
     )
@@ -107,6 +128,22 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--renderer, --threads",
     )
     add_quiet_argument(p, "only the result lines")
+
+
+def check_size(spec: Any, samples: int, scene: Any, minutes: float = 0.0) -> None:
+    """Refuse a training run this machine cannot finish (:mod:`physbench.cost`): every sample is
+    a simulation of the scene rendered at the data's render resolution (the network's own time
+    is left out, so this is a lower bound); ``minutes`` (> 0) ends it sooner."""
+    from physbench import cost
+
+    one = cost.of_scene(scene, resolution=spec.render_resolution, mode="mark").times(samples)
+    if minutes > 0:
+        one = cost.Cost(one.memory, min(one.seconds, 60.0 * minutes))
+    cost.check(
+        one,
+        f"this training ({cost.simulations(samples, scene, spec.render_resolution)})",
+        "--samples",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -175,6 +212,7 @@ def main(args: argparse.Namespace) -> int:
         frames=args.frames,
         blur_max=args.blur_max,
     )
+    check_size(spec, args.samples, scene, args.minutes)
     n_out = len(params)
     net = NetConfig(n_outputs=n_out, widths=widths, resolution=args.resolution, frames=args.frames)  # type: ignore[arg-type]
     cfg = TrainConfig(
@@ -265,6 +303,7 @@ def _posterior(args: argparse.Namespace) -> int:
         renderer_options=renderer_options,
         frames=frames,
     )
+    check_size(spec, samples, resolve_scene(scene_name, 0))
     cfg = NPETrainConfig(samples=samples, batch=batch, lr=args.lr, threads=args.threads)
     out = Path(args.out or f"runs/train/npe/{weights_name(spec)}")
     path, meta = train(spec, None, cfg, out, progress=not args.quiet)

@@ -42,6 +42,11 @@ def add_noise(frames: np.ndarray, sigma: float, rng: np.random.Generator) -> np.
     return out
 
 
+#: The widest pixel noise (standard deviation): pixel values lie in [0, 1], so noise of 1 already
+#: drowns every frame; more is a typo.
+MAX_NOISE = 1.0
+
+
 def _nonneg(name: str, value: object) -> float:
     if (
         isinstance(value, bool)
@@ -67,6 +72,11 @@ class ObservationModel:
     def __post_init__(self) -> None:
         object.__setattr__(self, "blur", _nonneg("blur", self.blur))
         object.__setattr__(self, "noise", _nonneg("noise", self.noise))
+        if self.noise > MAX_NOISE:
+            raise RenderError(
+                f"noise = {self.noise!r}: expected a finite number in [0, {MAX_NOISE:g}] (the "
+                "standard deviation of pixel values in [0, 1])"
+            )
         if isinstance(self.seed, bool) or not isinstance(self.seed, int | np.integer):
             raise RenderError(f"seed = {self.seed!r}: expected a whole number")
 

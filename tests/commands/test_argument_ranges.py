@@ -34,6 +34,21 @@ LONG_SCENE = "x" * 100_000
         (["train", "--val-groups", "0"], "argument --val-groups: 0 is not a whole number >= 1"),
         (["train", "--eval-every", "0"], "argument --eval-every: 0 is not a whole number >= 1"),
         (["train", "--resolution", "0"], "argument --resolution: 0 is not a whole number in [1,"),
+        (
+            ["train", "--samples", str(10**12)],
+            "argument --samples: 1000000000000 is not a whole number in [1, 1000000000]",
+        ),
+        (["train", "--samples", "0"], "argument --samples: 0 is not a whole number in [1,"),
+        (["train", "--batch", "0"], "argument --batch: 0 is not a whole number in [1, 4096]"),
+        (["train", "--batch", "1e9"], "argument --batch: '1e9' is not a whole number in [1,"),
+        (["train", "--frames", "0"], "argument --frames: 0 is not a whole number in [2, 64]"),
+        (["train", "--frames", "1000"], "argument --frames: 1000 is not a whole number in [2, 64]"),
+        (["train", "--workers", "-1"], "argument --workers: -1 is not a whole number in [0, 64]"),
+        (["train", "--workers", "10000"], "argument --workers: 10000 is not a whole number in [0,"),
+        (["run", "--noise", "-0.1"], "argument --noise: -0.1 is not a finite number in [0, 1]"),
+        (["run", "--noise", "inf"], "argument --noise: inf is not a finite number in [0, 1]"),
+        (["run", "--noise", "5"], "argument --noise: 5 is not a finite number in [0, 1]"),
+        (["run", "--iterations", "0"], "argument --iterations: 0 is not a whole number >= 1"),
         (["discover", "r.csv", "--iterations", "0"], "argument --iterations: 0 is not a whole"),
         (["discover", "r.csv", "--seed", "-1"], "argument --seed: -1 is not a whole number in [0,"),
     ],
@@ -47,3 +62,15 @@ def test_out_of_range_values_are_argparse_errors(
     err = capsys.readouterr().err
     assert info.value.code == 2
     assert f"physbench {argv[0]}: error: " in err and message in err, err[-500:]
+
+
+def test_train_limits_agree_with_the_training_code() -> None:
+    """The parser repeats them so as not to import the trainer; they must be the same numbers."""
+    from physbench.commands import train as command
+    from physbench.estimators.resnet3d import sidecar
+    from physbench.estimators.resnet3d import train as trainer
+
+    assert command.MAX_SAMPLES == trainer.MAX_SAMPLES
+    assert command.MAX_BATCH == trainer.MAX_BATCH
+    assert command.MAX_WORKERS == trainer.MAX_WORKERS
+    assert command.FRAMES == sidecar.FRAMES

@@ -304,3 +304,30 @@ def test_a_second_run_on_the_same_folder_refuses_or_waits(
     runs = json.loads((out / "run.json").read_text())["runs"]
     assert [r["ran"] for r in runs] == [4, 0]
     assert len(list((out / "cells").glob("*.json"))) == 4 and len(list(gate.iterdir())) == 5
+
+
+def test_a_sweep_this_machine_cannot_finish_is_refused_at_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """100,000 seeds x 4 estimators x 5 unknown sets: one sentence in well under 2 s, not a
+    listing of two million cells."""
+    import time
+
+    monkeypatch.delenv("PHYSBENCH_NO_SIZE_CHECK", raising=False)
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "big"\nestimators = ["tpe", "cmaes", "optuna", "random"]\n'
+        "seeds = {start = 0, count = 100000}\n"
+        '[[scenes]]\nname = "three_circles"\nunknowns = ["mass", "mass+elasticity"]\n'
+        '[[scenes]]\nname = "second_order"\nunknowns = ["elasticity"]\n'
+        '[[scenes]]\nname = "stacked_boxes"\nunknowns = ["friction"]\n'
+        '[[scenes]]\nname = "bouncing_balls"\nunknowns = ["mass"]\n'
+    )
+    start = time.perf_counter()
+    code = main(["bench", str(spec), "--out", str(tmp_path / "out"), "--workers", "2"])
+    assert time.perf_counter() - start < 2
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1
+    assert err.startswith("physbench bench: error: this sweep (2000000 cells, 2 at a time; ")
+    assert "of compute, more than the 24 h limit; make the seeds, estimators, axes or " in err
+    assert not (tmp_path / "out").exists()

@@ -85,7 +85,7 @@ CASES = [
         "bad scene value",
         {"r.csv": recording(), "s.toml": SCENE.replace("MASS", "-1.0")},
         ["r.csv"],
-        r"s\.toml:\d+: bodies\[0\]\.mass = -1\.0: mass must be > 0",
+        r"s\.toml:\d+: bodies\[0\]\.mass = -1\.0: mass must lie in \[1e-06, 1e\+06\] kg",
     ),
     (
         "missing scene",
@@ -298,3 +298,16 @@ def test_a_recording_tracked_in_y_only_is_fitted_in_y_only(tmp_path, slide):
     d = json.loads(out.read_text())
     assert d["residuals"]["base"]["per_field"] == {"ball": {"y": pytest.approx(0.0, abs=1e-9)}}
     assert d["causes"] == []
+
+
+def test_a_discovery_this_machine_cannot_finish_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("PHYSBENCH_NO_SIZE_CHECK", raising=False)
+    scene = write(tmp_path, "slide.toml", SCENE.replace("MASS", "1.0"))
+    rec = write(tmp_path, "r.csv", recording())
+    code = cli(["discover", rec, "--scene", scene, "--iterations", str(10**10)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1
+    assert err.startswith("physbench discover: error: this discovery (1 x 10000000840 simulations")
+    assert "more than the 24 h limit" in err and "PHYSBENCH_NO_SIZE_CHECK=1" in err

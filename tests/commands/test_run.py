@@ -234,7 +234,6 @@ def test_estimator_options(capsys: pytest.CaptureFixture[str]) -> None:
         ),
         (["--scene", "no_such_scene"], "unknown scene 'no_such_scene'"),
         (["--params", "friction"], "unknown parameter 'friction' of scene 'three_circles'"),
-        (["--iterations", "0"], "--iterations 0: expected a whole number >= 1"),
         (["--engine", "bullet"], "unknown simulator 'bullet'; known simulators: box2d, pymunk"),
         (["-o", "startup=-1"], "tpe: startup = -1: expected a whole number >= 0"),
         (["-o", "temperature=3"], "estimator 'tpe' does not take options {'temperature': 3}"),
@@ -360,3 +359,52 @@ def test_a_posterior_is_printed_warned_about_saved_and_plotted(
     assert post["method"] == "smc" and post["keys"] == ["a.mass", "b.mass"]
     assert len(post["samples"]) == 64 and len(post["quantiles"]["a.mass"]) == 5
     assert post["complete"] is False
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["--iterations", "1000000000"],
+            "this run (1000000003 simulations of 30 frames x 10 substeps x 3 bodies at 64 px) "
+            "would need about 38.9 days of compute, more than the 24 h limit; make the iterations, "
+            "the resolution or the scene's frames, substeps or bodies smaller, or set "
+            "PHYSBENCH_NO_SIZE_CHECK=1 to run it anyway",
+        ),
+        (
+            ["--scene", "HUGE"],
+            "this run (14 simulations of 100000 frames x 10000 substeps x 50 bodies at 64 px) "
+            "would need about 8.1 days of compute, more than the 24 h limit",
+        ),
+        (
+            ["--scene", "HUGE", "--render-mode", "instance", "--resolution", "4096"],
+            "TB of memory, more than the ",
+        ),
+    ],
+    ids=["iterations", "scene", "memory"],
+)
+def test_a_run_this_machine_cannot_finish_is_one_sentence_at_once(
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    huge_scene: str,
+    argv: list[str],
+    message: str,
+) -> None:
+    import time
+
+    monkeypatch.delenv("PHYSBENCH_NO_SIZE_CHECK", raising=False)
+    start = time.perf_counter()
+    code, out, err = run(capsys, *(huge_scene if a == "HUGE" else a for a in argv))
+    assert time.perf_counter() - start < 2
+    assert code == 2 and out == ""
+    assert err.startswith("physbench run: error: this run (") and err.count("\n") == 1
+    assert message in err
+
+
+def test_the_size_check_refuses_through_the_api_too(monkeypatch: pytest.MonkeyPatch) -> None:
+    from physbench.cost import SizeError
+    from physbench.experiment import RunConfig, run_config
+
+    monkeypatch.delenv("PHYSBENCH_NO_SIZE_CHECK", raising=False)
+    with pytest.raises(SizeError, match="1000000003 simulations"):
+        run_config(RunConfig(iterations=10**9))

@@ -31,7 +31,7 @@ def test_bad_override_is_explained(capsys) -> None:
     assert main(["simulate", "--scene", "three_circles", "--set", "a.mass=-1"]) == 2
     err = capsys.readouterr().err
     assert "a.mass" in err or "bodies[1].mass = -1.0" in err
-    assert "mass must be > 0" in err
+    assert "mass must lie in [1e-06, 1e+06] kg" in err
 
 
 def test_simulate_writes_npz_and_previews(tmp_path: Path, capsys) -> None:
@@ -137,3 +137,19 @@ def test_effects_change_the_simulated_motion(tmp_path: Path, capsys) -> None:  #
     ):
         assert main(["simulate", "--scene", "ball_drop", "--effect", bad]) == 2
         assert message in capsys.readouterr().err
+
+
+def test_a_simulation_bigger_than_memory_is_refused_before_simulating(
+    tmp_path: Path, capsys, huge_scene, monkeypatch
+) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.delenv("PHYSBENCH_NO_SIZE_CHECK", raising=False)
+    out = tmp_path / "o.npz"
+    argv = ["simulate", "--scene", huge_scene, "--render-mode", "instance", "--resolution", "1024"]
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(
+        "physbench simulate: error: this simulation (1 simulation of 100000 frames x 10000 "
+        "substeps x 50 bodies at 1024 px) would need 41.9 TB of memory, more than the "
+    )
+    assert "set PHYSBENCH_NO_SIZE_CHECK=1 to run it anyway" in err and err.count("\n") == 1
+    assert not out.exists()

@@ -16,6 +16,17 @@ from physbench.estimators.resnet3d import weights
 from physbench.estimators.resnet3d.data import DataSpec, stream, validation_set
 from physbench.estimators.resnet3d.model import NetConfig, build_net
 
+# The largest training run accepted: a typo (1e12 samples, a batch of a million) fails here,
+# not hours later. 1e9 samples is 25,000 times the default budget; a batch of 4096 sequences of
+# 64 frames x 512 px is already more activations than a GPU holds; 64 data processes is more than
+# the cores of any one machine this runs on.
+#: ``samples`` accepted: [1, this].
+MAX_SAMPLES = 10**9
+#: ``batch`` accepted: [1, this].
+MAX_BATCH = 4096
+#: ``workers`` accepted: [0, this] (0: data made in the training process).
+MAX_WORKERS = 64
+
 
 @dataclass(frozen=True)
 class TrainConfig:
@@ -32,6 +43,16 @@ class TrainConfig:
     # Wall-clock budget of this session (0 = none); training stops at whichever budget ends first.
     minutes: float = 0.0
     init: str = ""  # start from these weights (fine-tuning) instead of a fresh network
+
+    def __post_init__(self) -> None:
+        for name, low, high in (
+            ("samples", 1, MAX_SAMPLES),
+            ("batch", 1, MAX_BATCH),
+            ("workers", 0, MAX_WORKERS),
+        ):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
+                raise PhysbenchError(f"{name} = {v!r}: expected a whole number in [{low}, {high}]")
 
 
 def progress_fraction(cfg: TrainConfig, seen: int, wall_s: float) -> float:
