@@ -3,16 +3,17 @@ seeds per Table 1 row: does the 90 % interval cover the truth in 90 % of cases?
 
 Every case draws the truth uniformly from the row's ranges (the prior), simulates and renders the
 observation (pymunk, a 32-pixel raster) with Gaussian pixel noise ``--noise`` (clipped to [0, 1],
-the observation model the likelihood states), and runs the estimator for ``--iterations``. One
-JSON line per case and unknown goes to ``OUT/cases.jsonl`` (appended; a case already there is
-skipped, so runs resume and split across processes with ``--seeds``). ``--summarize`` writes
+the observation model the likelihood states), and runs ``smc`` for ``--iterations`` (6,000: on
+three_circles mass no case needed more than 5,138 to reach the posterior). One JSON line per
+case and unknown goes to ``OUT/cases.jsonl`` (appended; a case already there is skipped, so runs
+resume and split across processes with ``--seeds``). ``--summarize`` writes
 ``OUT/summary.json`` and ``OUT/summary.md``: per row and unknown, the coverage of the
 50/80/90/95 % intervals with 95 % binomial intervals, the SBC rank-uniformity p-value, the mean
 90 % width over the range, and how many posteriors were complete.
 
     python benchmarks/posterior_calibration.py --rows three_circles:mass --seeds 0-199 \
-        --out results/posterior
-    python benchmarks/posterior_calibration.py --summarize --out results/posterior
+        --out results/posterior/smc
+    python benchmarks/posterior_calibration.py --summarize --out results/posterior/smc
 """
 
 from __future__ import annotations
@@ -151,11 +152,11 @@ def main() -> None:
     )
     ap.add_argument("--rows", nargs="+", default=["three_circles:mass"], help="SCENE:PARAM[+PARAM]")
     ap.add_argument("--seeds", default="0-199", help="e.g. 0-199 or 0-99,150-199")
-    ap.add_argument("--iterations", type=int, default=8000)
+    ap.add_argument("--iterations", type=int, default=6000)
     ap.add_argument("--particles", type=int, default=64)
     ap.add_argument("--noise", type=float, default=0.1)
     ap.add_argument("--resolution", type=int, default=32)
-    ap.add_argument("--out", type=Path, default=Path("results/posterior"))
+    ap.add_argument("--out", type=Path, default=Path("results/posterior/smc"))
     ap.add_argument("--summarize", action="store_true")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)

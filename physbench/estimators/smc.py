@@ -40,7 +40,6 @@ ESS_SHARE = 0.5
 #: moved, capped at MAX_MOVES.
 STUCK = 0.05
 MAX_MOVES = 8
-DEBUG = False
 
 
 def _ess(logw: np.ndarray) -> float:
@@ -113,6 +112,11 @@ class SMCEstimator(CorrectionEstimator):
         self.moved_at_one = False
         self.evaluations = 0
         self.converged_at = 0
+        # Particle sets after each sweep at beta = 1, once the first moves there are done: every
+        # one is a sample of the posterior. Pooled, they give its quantiles from thousands of
+        # (correlated) draws instead of 64; a central 90 % interval between order statistics of
+        # 64 draws holds only about 87 % of the posterior.
+        self.pool: list[np.ndarray] = []
         self._gen = self._run()
         self._first = True
 
@@ -156,22 +160,6 @@ class SMCEstimator(CorrectionEstimator):
                         self.units[i], self.loglik[i] = prop, ll
                         accepted += 1
                 rate = accepted / max(tried, 1)
-                if DEBUG:
-                    print(
-                        "stage",
-                        self.stages,
-                        "beta",
-                        round(beta, 4),
-                        "sweep",
-                        sweep,
-                        "rate",
-                        round(rate, 3),
-                        "tried",
-                        tried,
-                        "scale",
-                        round(scale, 4),
-                        flush=True,
-                    )
                 # Keep the acceptance near 0.25: shrink or grow the proposal.
                 scale *= math.exp(rate - 0.25)
                 if sweep == 0:
@@ -184,13 +172,16 @@ class SMCEstimator(CorrectionEstimator):
                         )
                     )
                 sweep += 1
+                if self.moved_at_one:
+                    self.pool.append(self.units.copy())
             if self.beta >= 1 and not self.moved_at_one:
                 self.moved_at_one = True
                 self.converged_at = self.evaluations
+                self.pool.append(self.units.copy())
 
     def posterior(self) -> Posterior | None:
-        """Called once after the run: the current particles, marked incomplete when the budget
-        ran out before the likelihood was fully on."""
+        """Called once after the run: the particles of every sweep since the likelihood was fully
+        on (or the current ones, marked incomplete, when the budget ran out before)."""
         from physbench.posterior import Posterior
 
         if self.space is None:
@@ -215,7 +206,7 @@ class SMCEstimator(CorrectionEstimator):
 
         return Posterior.from_unit(
             self.space,
-            self.units,
+            np.concatenate(self.pool) if self.pool else self.units,
             self.name,
             complete=complete,
             note=note,
