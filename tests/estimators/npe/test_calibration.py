@@ -1,5 +1,7 @@
-"""The committed calibration measurement (benchmarks/npe_calibration.py) says what it says: the
-90 % intervals' coverage on 200 held-out seeds per row, checked against what was measured."""
+"""The committed calibration measurement (benchmarks/npe_calibration.py) meets the issue's bands
+on 200 held-out seeds per row: 90 % intervals cover 85-95 % of the truths, 50 % intervals 45-55 %
+(per row, its unknowns pooled), and no unknown's SBC ranks are rejected as non-uniform at p = 0.01;
+one posterior costs at most 2 s."""
 
 from __future__ import annotations
 
@@ -9,36 +11,26 @@ from pathlib import Path
 import pytest
 
 SUMMARY = Path(__file__).parents[3] / "results" / "posterior" / "npe" / "summary.json"
-#: The 90 % coverage measured per row and unknown (summary.md: 0.895-0.955), each ±0.03 so that a
-#: rerun with other torch/BLAS rounding passes while a changed model or benchmark shows.
-MEASURED_90: dict[str, tuple[float, float]] = {
-    f"{row}:{key}": (round(v - 0.03, 3), round(v + 0.03, 3))
-    for row, key, v in (
-        ("three_circles[mass]", "a.mass", 0.935),
-        ("three_circles[mass]", "b.mass", 0.93),
-        ("three_circles[elasticity]", "a.elasticity", 0.91),
-        ("three_circles[elasticity]", "b.elasticity", 0.91),
-        ("second_order[mass]", "a.mass", 0.955),
-        ("second_order[mass]", "b.mass", 0.895),
-    )
-}
+ROWS = ("three_circles[mass]", "three_circles[elasticity]", "second_order[mass]")
+
+
+def _summary() -> dict:
+    return json.loads(SUMMARY.read_text())
 
 
 def test_summary_covers_three_rows_on_200_held_out_seeds() -> None:
-    summary = json.loads(SUMMARY.read_text())
-    assert set(summary) >= {
-        "three_circles[mass]",
-        "three_circles[elasticity]",
-        "second_order[mass]",
-    }
+    summary = _summary()
+    assert set(summary) >= set(ROWS)
     for row in summary.values():
         assert row["seeds"] == 200
         assert row["cost_s"] <= 2.0  # the cost target: one observation's posterior in 2 s
 
 
-@pytest.mark.parametrize("row_key", sorted(MEASURED_90))
-def test_90_percent_coverage_is_what_was_measured(row_key: str) -> None:
-    row, key = row_key.split(":")
-    got = json.loads(SUMMARY.read_text())[row]["per_key"][key]["coverage90"]
-    lo, hi = MEASURED_90[row_key]
-    assert lo <= got <= hi, f"{row} {key}: 90 % coverage {got:.3f}, measured band [{lo}, {hi}]"
+@pytest.mark.parametrize("row", ROWS)
+def test_coverage_lies_in_the_bands_and_sbc_is_not_rejected(row: str) -> None:
+    keys = _summary()[row]["per_key"]
+    for level, (lo, hi) in (("coverage90", (0.85, 0.95)), ("coverage50", (0.45, 0.55))):
+        pooled = sum(k[level] for k in keys.values()) / len(keys)
+        assert lo <= pooled <= hi, f"{row}: {level} {pooled:.3f} outside [{lo}, {hi}]"
+    for key, k in keys.items():
+        assert k["sbc_ks_p"] > 0.01, f"{row} {key}: SBC ranks rejected (p = {k['sbc_ks_p']:.3g})"

@@ -11,6 +11,7 @@ import pytest
 torch = pytest.importorskip("torch")
 
 from physbench.estimators.npe.model import (  # noqa: E402
+    SPREAD,
     MDNConfig,
     build_mdn,
     ensemble_log_prob,
@@ -75,3 +76,13 @@ def test_logit_is_finite_at_the_bounds() -> None:
     z = to_logit(np.array([0.0, 0.5, 1.0]))
     assert np.isfinite(z).all() and z[1] == 0
     np.testing.assert_allclose(z[[0, 2]], [-13.8155, 13.8155], atol=1e-4)
+
+
+def test_spread_scales_each_components_width_around_its_mean() -> None:
+    cfg = MDNConfig(n_features=2, n_params=1, hidden=4, components=1, members=1)
+    net = _fixed(cfg, [0.0], [[0.5]], [[math.log(0.8)]])  # N(0.5, 0.8^2) in logit space
+    rng = np.random.default_rng(0)
+    for spread in (1.0, SPREAD, 0.5):
+        z = to_logit(sample_unit([net], np.zeros(2, np.float32), 20_000, rng, spread=spread))
+        assert z.mean() == pytest.approx(0.5, abs=0.02)
+        assert z.std() == pytest.approx(0.8 * spread, rel=0.02)
