@@ -9,6 +9,8 @@ function).
 - :func:`landscape`: image MSE against the deviation of one parameter from its nominal value,
   per body (Fig. 4), with the sweep's engine and renderer; this one simulates.
 - :func:`win_rate`: how often each estimator ends closer to the truth than each other one.
+- :func:`time_to_accuracy`: the share of seeds whose answer has reached the paper's value, against
+  simulations and against wall-clock seconds (:mod:`physbench.bench.time_to_accuracy`).
 - :func:`coverage`: for estimators that return a posterior, how often the truth lies inside
   its central intervals against how often it should (:mod:`physbench.calibration`).
 
@@ -461,8 +463,89 @@ def coverage(df: pd.DataFrame, out: Path) -> list[Path]:
     return paths
 
 
+def _share_reached(
+    ax: Any, costs: np.ndarray, n: int, *, start: float, end: float, **style: Any
+) -> None:
+    """A step line from ``start`` to ``end``: the share of ``n`` seeds whose cost (+inf: never)
+    is at most x."""
+    x = np.sort(costs[np.isfinite(costs)])
+    y = np.arange(1, x.size + 1) / n
+    ax.step(np.r_[start, x, end], np.r_[0.0, y, y[-1] if y.size else 0.0], where="post", **style)
+
+
+def time_to_accuracy(df: pd.DataFrame, out: Path) -> list[Path]:
+    """One figure per scene (and setting) with a threshold for some unknown set: a column per
+    unknown set, the share of seeds that reached the threshold against simulations (top) and
+    against wall-clock seconds (bottom, log), a line per estimator. Rows without a paper value
+    are left out (:func:`physbench.bench.time_to_accuracy.per_seed`); the seconds panel is empty
+    for a sweep that recorded no timings."""
+    from matplotlib.ticker import NullFormatter
+
+    from physbench.bench.time_to_accuracy import REFERENCE, per_seed
+
+    seeds = per_seed(df)
+    if seeds.empty:
+        return []
+    plt = _plt()
+    varying = _varying(df)
+    # one colour per estimator in every panel, also where one never reached the threshold
+    colours = {e: f"C{i}" for i, e in enumerate(dict.fromkeys(seeds["estimator"]))}
+    paths = []
+    for cfg, rows in _groups(seeds, SETTINGS):
+        sets = list(dict.fromkeys(rows.sort_values("cell_index")["unknowns"]))
+        fig, axes = plt.subplots(
+            2, len(sets), figsize=(4.2 * len(sets), 6.4), squeeze=False, layout="constrained"
+        )
+        for col, unknowns in enumerate(sets):
+            top, bottom = axes[0, col], axes[1, col]
+            sub = rows[rows["unknowns"] == unknowns]
+            budget = int(sub["iterations"].max())
+            timed = sub["seconds"].to_numpy(dtype=float)
+            timed = timed[np.isfinite(timed)]
+            for est, er in _groups(sub, ["estimator"]):
+                label = str(est["estimator"])
+                style = {"color": colours[label], "lw": 1.3, "label": label}
+                sims = er["simulations"].to_numpy(dtype=float)
+                _share_reached(top, sims, len(er), start=0, end=budget, **style)
+                secs = er["seconds"].to_numpy(dtype=float)
+                if timed.size and not np.isnan(secs).any():
+                    lo, hi = 0.8 * float(timed.min()), 1.25 * float(timed.max())
+                    _share_reached(bottom, secs, len(er), start=lo, end=hi, **style)
+            top.set_xlim(0, budget + 0.5)
+            top.xaxis.get_major_locator().set_params(integer=True)
+            top.set_title(
+                f"{unknowns_label(unknowns)}: threshold {float(sub['threshold'].iloc[0]):.2g}",
+                fontsize="medium",
+            )
+            top.set_xlabel("simulations (1: the initial guess)")
+            bottom.set_xlabel("wall-clock time (s)")
+            if bottom.lines:
+                bottom.set_xscale("log")
+                bottom.xaxis.set_minor_formatter(NullFormatter())
+            for ax in (top, bottom):
+                ax.set_ylim(0, 1.02)
+                ax.grid(True, which="both", alpha=0.25)
+        for ax in axes[:, 0]:
+            ax.set_ylabel(f"share reached ({DIMENSIONLESS})")
+        _legend_below(fig, axes.ravel())
+        fig.suptitle(
+            f"{_title(cfg, varying)}\nshare of seeds whose best-so-far normalized MSE is at or "
+            f"below the paper's {REFERENCE} value (11 it.)",
+            fontsize="medium",
+        )
+        paths.append(_save(fig, out / _name("time_to_accuracy", cfg, varying)))
+    return paths
+
+
 #: the groups of figures :func:`plot_all` draws, in order (the keys of what it returns)
-FIGURE_GROUPS = ("convergence", "trajectories", "win rate", "coverage", "landscape")
+FIGURE_GROUPS = (
+    "convergence",
+    "trajectories",
+    "win rate",
+    "time to accuracy",
+    "coverage",
+    "landscape",
+)
 
 
 def plot_all(
@@ -486,6 +569,8 @@ def plot_all(
     figs["trajectories"] = trajectories(df, out, seeds=seeds)
     stage("win rate")
     figs["win rate"] = win_rate(df, out)
+    stage("time to accuracy")
+    figs["time to accuracy"] = time_to_accuracy(df, out)
     stage("coverage")
     figs["coverage"] = coverage(df, out)
     stage("landscape")

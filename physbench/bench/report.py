@@ -1,7 +1,7 @@
 """One self-contained HTML page for a sweep: its settings, the Table 1 layout, per-configuration
-statistics, the posteriors' calibration (when some estimator returned one), failures, the
-win-rate matrix and every figure (PNG embedded as base64), so the file
-can be mailed or committed and opened anywhere."""
+statistics, the time to accuracy, the posteriors' calibration (when some estimator returned one),
+failures, the win-rate matrix and every figure (PNG embedded as base64), so the file can be mailed
+or committed and opened anywhere."""
 
 from __future__ import annotations
 
@@ -45,6 +45,7 @@ def build(
 ) -> Path:
     """Write ``out/report.html`` from the long table ``df`` and the figure files; returns its
     path."""
+    from physbench.bench import time_to_accuracy
     from physbench.bench.store import atomic_write
     from physbench.bench.tables import (
         CALIBRATION_NOTE,
@@ -100,6 +101,12 @@ def build(
         "of the mean over seeds.</p>",
         _table(detail(st)),
     ]
+    tta = time_to_accuracy.table(df)
+    if len(tta):
+        parts += [
+            f"<h2>Time to accuracy</h2><p class='note'>{html.escape(time_to_accuracy.NOTE)}</p>",
+            _table(time_to_accuracy.formatted(tta)),
+        ]
     cal = calibration(st)
     if len(cal):
         parts += [

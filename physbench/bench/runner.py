@@ -255,7 +255,7 @@ def _run_locked(
     from tqdm import tqdm
 
     from physbench.bench.stamp import StaleCellsError, Stamper, describe, find_stale
-    from physbench.bench.tables import write_summary
+    from physbench.bench.summary import write_summary
 
     out = store.out
     cells = spec.cells()

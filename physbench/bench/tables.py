@@ -670,55 +670,6 @@ def _n_value_cols(df: pd.DataFrame) -> int:
     return len(df.columns) - 1 - list(df.columns).index("estimator")
 
 
-def write_summary(df: pd.DataFrame, out: Path, *, title: str) -> pd.DataFrame:
-    """Write ``stats.csv`` (numbers), ``summary.csv`` / ``summary.md`` / ``summary.tex`` (the
-    paper's layout; the Markdown adds the per-configuration details); returns the stats."""
-    st = stats(df)
-    layout = paper_layout(st)
-    iters = ", ".join(str(i) for i in dict.fromkeys(st["iterations"]))
-    caption = (
-        f"{title}: normalized min MSE after {iters} iterations, mean ± std over seeds "
-        "(paper: Link et al. 2022, Table 1, 10 seeds)"
-    )
-    _atomic(out / "stats.csv", st.to_csv(index=False))
-    _atomic(out / "summary.csv", layout.to_csv(index=False))
-    _atomic(out / "summary.tex", latex(layout, caption=caption))
-    md = [
-        f"# {title}\n",
-        f"{caption}.\n",
-        markdown(layout),
-        "\n## Next to the paper\n",
-        "The same means ± std, a row per scene and unknown set.\n",
-        markdown(side_by_side(st)),
-        "\n## Per configuration\n",
-        "Normalized min MSE after N iterations over seeds: mean ± sample std, median, "
-        f"95 % BCa bootstrap interval of the mean ({BOOTSTRAP} resamples), cells that ran "
-        "(n) and failed.\n",
-        markdown(detail(st)),
-    ]
-    cal = calibration(st)
-    if len(cal):
-        md += [
-            "\n## Calibration\n",
-            CALIBRATION_NOTE + "\n",
-            markdown(cal),
-        ]
-    failed = st[st["failed"] > 0]
-    if len(failed):
-        md += [
-            "\n## Failed cells\n",
-            markdown(failed[["scene", "unknowns", "estimator", "failed", "error"]]),
-        ]
-    _atomic(out / "summary.md", "\n".join(md))
-    return st
-
-
-def _atomic(path: Path, text: str) -> None:
-    from physbench.bench.store import atomic_write
-
-    atomic_write(path, text.encode())
-
-
 def read_results(path: str | Path) -> pd.DataFrame:
     """A finished sweep's long table from its folder or its ``results.parquet``, with the columns
     :func:`upgrade` adds; called by the commands that read a sweep (``plot``, ``compare``). A file

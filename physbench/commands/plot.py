@@ -3,8 +3,12 @@
 Writes into ``--out`` (default: DIR itself) ``plots/*.png`` (convergence per scene like the
 paper's Fig. 3, parameter-space trajectories for two unknowns like Fig. 5, the image-MSE landscape
 along each parameter like Fig. 4, the estimators' win-rate matrix, and the coverage of the
-posteriors' intervals when some estimator returned one), ``win_rate.csv`` and
-``report.html`` (self-contained: tables and figures embedded).
+posteriors' intervals when some estimator returned one, the share of seeds that reached the
+paper's value against simulations and seconds), ``win_rate.csv``, ``report.html``
+(self-contained: tables and figures embedded) and the summaries ``physbench bench`` writes
+(``stats.csv``, ``time_to_accuracy.csv``, ``summary.csv``/``.md``/``.tex``), rebuilt from
+``results.parquet`` alone: after the tables gain a section, this refreshes a committed sweep
+without rerunning it.
 """
 
 from __future__ import annotations
@@ -12,6 +16,15 @@ from __future__ import annotations
 import argparse
 
 from physbench.commands.arguments import add_quiet_argument
+
+#: What ``plot`` rewrites besides figures and report (:mod:`physbench.bench.summary`).
+SUMMARIES = (
+    "stats.csv",
+    "time_to_accuracy.csv",
+    "summary.csv",
+    "summary.md",
+    "summary.tex",
+)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -22,7 +35,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--out",
         default=None,
         metavar="DIR",
-        help="write plots/, win_rate.csv and report.html here (default: the input DIR)",
+        help="write plots/, the summaries, win_rate.csv and report.html here "
+        "(default: the input DIR)",
     )
     p.add_argument(
         "--seeds",
@@ -57,6 +71,7 @@ def main(args: argparse.Namespace) -> int:
 
     from physbench.bench import plots, report
     from physbench.bench.store import atomic_write
+    from physbench.bench.summary import write_summary
     from physbench.bench.tables import final_rows, read_results, win_rate_table
     from physbench.commands.console import stages, wrote
 
@@ -80,11 +95,14 @@ def main(args: argparse.Namespace) -> int:
         stage("report")
         rate, _ = win_rate_table(final_rows(df))
         atomic_write(out / "win_rate.csv", rate.to_csv(index_label="estimator").encode())
+        write_summary(df, out, title=title)
         page = report.build(df, out, figures, title=title, run_log=log)
     count = sum(len(v) for v in figures.values())
     for path in (p for group in figures.values() for p in group):
         wrote(path)
     wrote(out / "win_rate.csv")
+    for name in SUMMARIES:
+        wrote(out / name)
     wrote(page)
     print(f"{counted(count, 'figure')} in {out / 'plots'}; report {page}")
     return 0

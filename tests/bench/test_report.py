@@ -56,6 +56,7 @@ def test_the_page_is_self_contained_and_embeds_each_figure(
         "Table 1 layout",
         "Next to the paper",
         "Per configuration",
+        "Time to accuracy",
         "Win rate",
         "Convergence",
     ]
@@ -110,6 +111,7 @@ def test_posteriors_get_a_calibration_section(calibrated_sweep: Any, tmp_path: P
         "Table 1 layout",
         "Next to the paper",
         "Per configuration",
+        "Time to accuracy",
         "Calibration",
         "Win rate",
     ]

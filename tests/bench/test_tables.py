@@ -187,7 +187,7 @@ def test_stats_gain_calibration_columns_for_configurations_with_posteriors(
 def test_the_summary_has_a_calibration_section_for_posteriors_only(
     calibrated_sweep, tmp_path: Path
 ) -> None:
-    from physbench.bench.tables import write_summary
+    from physbench.bench.summary import write_summary
 
     from .conftest import SMC
 
@@ -206,7 +206,7 @@ def test_a_sweep_without_posteriors_keeps_the_tables_it_had(
     so such a sweep writes the files it wrote before posteriors existed."""
     from physbench.bench.runner import assemble
     from physbench.bench.store import CellStore
-    from physbench.bench.tables import write_summary
+    from physbench.bench.summary import write_summary
 
     cells = [c for c in calibrated_sweep.spec.cells() if c.label == "random"]
     df = assemble(cells, CellStore(calibrated_sweep.out))

@@ -34,11 +34,12 @@ def test_plot_command_writes_figures_and_report(
     )
     run_sweep(spec, tmp_path, executor="serial", progress=False)
     assert main(["plot", str(tmp_path), "--landscape-seeds", "1"]) == 0
-    assert capsys.readouterr().out.startswith("4 figures in ")
+    assert capsys.readouterr().out.startswith("5 figures in ")
     names = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
     assert names == [
         "convergence_three_circles.png",
         "landscape_three_circles.png",
+        "time_to_accuracy_three_circles.png",
         "trajectories_three_circles_mass.png",
         "win_rate.png",
     ]
@@ -46,9 +47,16 @@ def test_plot_command_writes_figures_and_report(
         data = (tmp_path / "plots" / name).read_bytes()
         assert data.startswith(PNG) and len(data) < 200_000
     page = (tmp_path / "report.html").read_text()
-    assert page.count("data:image/png;base64,") == 4 and "<h2>Table 1 layout</h2>" in page
+    assert page.count("data:image/png;base64,") == 5 and "<h2>Table 1 layout</h2>" in page
+    assert "<h2>Time to accuracy</h2>" in page
     assert "(2.6 ± 0.9)e-03" in page and "Win rate" in page and 'src="http' not in page
     assert pd.read_csv(tmp_path / "win_rate.csv", index_col=0).shape == (2, 2)
+    # the summaries are rebuilt from results.parquet alone, with the time-to-accuracy section
+    (tmp_path / "summary.md").unlink()
+    (tmp_path / "time_to_accuracy.csv").unlink()
+    assert main(["plot", str(tmp_path), "--landscape-seeds", "0"]) == 0
+    assert "## Time to accuracy" in (tmp_path / "summary.md").read_text()
+    assert len(pd.read_csv(tmp_path / "time_to_accuracy.csv")) == 4  # 2 unknown sets x 2
     assert main(["plot", str(tmp_path / "missing")]) == 2
     assert "no results.parquet there" in capsys.readouterr().err
 
