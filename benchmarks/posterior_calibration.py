@@ -4,7 +4,7 @@ seeds per Table 1 row: does the 90 % interval cover the truth in 90 % of cases?
 Every case draws the truth uniformly from the row's ranges (the prior), simulates and renders the
 observation (pymunk, a 32-pixel raster) with Gaussian pixel noise ``--noise`` (clipped to [0, 1],
 the observation model the likelihood states), and runs ``smc`` for ``--iterations`` (6,000: on
-three_circles mass no case needed more than 5,138 to reach the posterior). One JSON line per
+the three rows no case needed more than 5,455 to reach the posterior). One JSON line per
 case and unknown goes to ``OUT/cases.jsonl`` (appended; a case already there is skipped, so runs
 resume and split across processes with ``--seeds``). ``--summarize`` writes
 ``OUT/summary.json`` and ``OUT/summary.md``: per row and unknown, the coverage of the
