@@ -33,7 +33,9 @@ class Posterior:
     """``samples``: ``(n, d)`` draws in parameter units, column ``j`` for ``keys[j]``;
     ``low``/``high``: each unknown's prior range; ``method``: what made it (e.g. ``"smc"``);
     ``complete``: ``False`` when the method stopped short of its target (e.g. a sampler whose
-    budget ran out), with the reason in ``note``."""
+    budget ran out), with the reason in ``note``; ``extra``: the method's own diagnostics, for
+    people reading a run's JSON (smc: its noise level, final beta, stages, simulations to reach
+    the posterior); physbench computes nothing from them."""
 
     keys: tuple[str, ...]
     samples: np.ndarray
