@@ -237,7 +237,8 @@ def markdown(result: dict[str, Any]) -> str:
     ]
     for name, rows in (
         ("smoke sweep, end to end", sw),
-        ("raw engine episodes", raw),
+        ("its cell loop (pool start to last result)", result["cell_loop"]),
+        ("raw engine episodes (simulate only)", raw),
     ):
         t1, t2 = rows["1"]["median_s"], rows["2"]["median_s"]
         lines.append(f"| {name} | {t1:.2f} | {t2:.2f} | {rows['ratio']:.2f} |")
@@ -255,7 +256,9 @@ def markdown(result: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def summarise(runs: dict[int, list[dict[str, float]]]) -> dict[str, Any]:
+def summarise(runs: dict[int, list[Any]]) -> dict[str, Any]:
+    """Per worker count: every run's seconds and their median (and the median breakdown when
+    the runs are sweeps); ``ratio`` = median with 1 / median with 2."""
     out: dict[str, Any] = {}
     for w, rs in runs.items():
         walls = [r["wall"] if isinstance(r, dict) else r for r in rs]
@@ -293,9 +296,10 @@ def main() -> None:
     result = {
         "machine": f"{os.cpu_count()} cores",
         "python": platform.python_version(),
-        "spec": SPEC,
+        "spec": Path(SPEC).stem,
         "repeats": args.repeats,
         "sweep": summarise(sweep),
+        "cell_loop": summarise({w: [r["cells_loop"] for r in rs] for w, rs in sweep.items()}),
         "raw": summarise(raw),
     }
     out = Path(args.out)
