@@ -28,6 +28,8 @@ from physbench.errors import PhysbenchError, counted
 T = TypeVar("T")
 R = TypeVar("R")
 NAMES = ("serial", "processes", "dask")
+#: Items a local pool holds per worker: one running, one queued behind it.
+QUEUED = 2
 
 
 class Executor(Protocol):
@@ -125,10 +127,14 @@ class ProcessExecutor:
     """A pool of ``workers`` local processes, started with ``spawn`` (a fork would copy this
     process's threads, e.g. the progress bar's monitor, into a half-initialised child).
 
-    At most ``workers`` items are handed to the pool at a time, so when a worker dies (and the
-    pool with it) the items in flight are known: each is run again alone in a fresh process; one
-    that kills that process too is given to ``died``, the others yield their results, and the
-    remaining items go on in a fresh pool."""
+    At most :data:`QUEUED` items per worker are handed to the pool at a time (one running, one
+    waiting, so that a worker starts its next item without a round trip through this process),
+    so when a worker dies (and the pool with it) the items in flight are known: each is run again
+    alone in a fresh process, ``workers`` at a time; one that kills that process too is given to
+    ``died``, the others yield their results, and the remaining items go on in a fresh pool.
+
+    Leaving the block does not wait for the workers to exit: they finish in the background
+    (joined when this process exits) while the caller goes on, e.g. to the tables."""
 
     name = "processes"
 
@@ -154,7 +160,7 @@ class ProcessExecutor:
 
     def __exit__(self, *exc: object) -> None:
         if self._pool is not None:
-            self._pool.shutdown(wait=exc[0] is None, cancel_futures=True)
+            self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
 
     def map_unordered(
@@ -170,7 +176,8 @@ class ProcessExecutor:
             if suspects is not None:
                 self._pool.shutdown(wait=True)
                 self._pool = None
-                yield from self._each_alone(fn, suspects, died)
+                for i in range(0, len(suspects), self.workers):
+                    yield from self._each_alone(fn, suspects[i : i + self.workers], died)
 
     def _until_broken(
         self, fn: Callable[[T], R], pending: Any
@@ -183,7 +190,7 @@ class ProcessExecutor:
         window: dict[Any, T] = {}
         try:
             while pending or window:
-                while pending and len(window) < self.workers:
+                while pending and len(window) < QUEUED * self.workers:
                     item = pending.popleft()
                     try:
                         window[self._pool.submit(fn, item)] = item
@@ -210,7 +217,7 @@ class ProcessExecutor:
     def _each_alone(
         self, fn: Callable[[T], R], items: list[T], died: Callable[[T, str], R]
     ) -> Iterator[tuple[T, R]]:
-        """Run every item in a process of its own, all at once (``items`` are at most
+        """Run every item in a process of its own, all at once (the caller passes at most
         ``workers``), yielding its result or, if that process dies too, ``died``'s."""
         from multiprocessing.connection import wait
 

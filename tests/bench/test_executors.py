@@ -163,3 +163,59 @@ def test_a_killed_sweep_leaves_no_local_dask_worker_behind() -> None:
     while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not [pid for pid in workers if _alive(pid)]
+
+
+#: Worker functions for the pipelining and shutdown tests.
+STAMPING = """
+import atexit
+import os
+import time
+from pathlib import Path
+
+GO = Path(os.environ["PB_GO_FILE"])
+
+
+def started(x):
+    return time.time()
+
+
+def _wait_for_go():
+    deadline = time.monotonic() + 5
+    while not GO.exists() and time.monotonic() < deadline:
+        time.sleep(0.02)
+
+
+def lingering(x):
+    # at this worker's exit, wait (at most 5 s) until the test has created GO
+    atexit.register(_wait_for_go)
+    return x
+"""
+
+
+def test_a_worker_has_its_next_item_before_the_caller_takes_a_result(
+    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("PB_GO_FILE", str(tmp_path / "go"))
+    stamping = plugin("pb_stamping", STAMPING)
+    with make_executor("processes", workers=1) as ex:
+        results = ex.map_unordered(stamping.started, [0, 1], _never)
+        next(results)
+        time.sleep(1.0)  # the caller is busy (storing a cell, say)
+        busy_until = time.time()
+        _, second_started = next(results)
+    assert second_started < busy_until
+
+
+def test_leaving_the_pool_does_not_wait_for_its_workers_to_exit(
+    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    go = tmp_path / "go"
+    monkeypatch.setenv("PB_GO_FILE", str(go))
+    stamping = plugin("pb_stamping", STAMPING)
+    ex = make_executor("processes", workers=1)
+    with ex:
+        assert [r for _, r in ex.map_unordered(stamping.lingering, [7], _never)] == [7]
+        t0 = time.monotonic()
+    left_after = time.monotonic() - t0
+    go.touch()
+    assert left_after < 2.5  # waiting for the worker would take the 5 s it lingers

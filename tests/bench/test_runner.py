@@ -5,6 +5,7 @@ tests/commands/test_bench.py)."""
 from __future__ import annotations
 
 import json
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
@@ -250,3 +251,24 @@ def test_several_renderers_split_the_summary(tmp_path: Path, blocks: ModuleType)
     assert summary.columns.tolist() == ["scene", "renderer", "estimator", "Mass"]
     ours = summary[summary["estimator"] == "random"]
     assert ours["renderer"].tolist() == [DEFAULT_RENDERER, "blocks"]
+
+
+def test_the_tables_libraries_are_imported_while_the_cells_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from physbench.bench import runner
+
+    imported = threading.Event()
+    seen: list[bool] = []
+    run_cell = runner.run_cell
+
+    def waiting_cell(config: Any) -> dict[str, Any]:
+        # a cell long enough for the import to happen meanwhile (at most 5 s)
+        seen.append(imported.wait(timeout=5))
+        return run_cell(config)
+
+    monkeypatch.setattr(runner, "_import_tables", imported.set)
+    monkeypatch.setattr(runner, "run_cell", waiting_cell)
+    spec = parse_spec({**TINY, "seeds": 1, "estimators": ["random"]})
+    res = run_sweep(spec, tmp_path, executor="serial", progress=False)
+    assert res.ran == 2 and seen == [True, True]
