@@ -244,8 +244,6 @@ def _check_proposal(name: str, space: ParamSpace, proposal: object, iteration: i
 
 
 def _check_posterior(name: str, space: ParamSpace, posterior: object) -> None:
-    from physbench.posterior import Posterior
-
     if posterior is None:
         return
     if not isinstance(posterior, Posterior):
