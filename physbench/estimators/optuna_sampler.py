@@ -15,20 +15,21 @@ import numpy as np
 from physbench.errors import PhysbenchError
 from physbench.estimators.ask_tell import AskTellEstimator
 from physbench.estimators.options import choice_option, int_option
-from physbench.estimators.tpe import DEFAULT_STARTUP
 from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
     from physbench.estimators.base import Task
 
 SAMPLERS = ("tpe", "cmaes", "random", "qmc")
+#: Random trials before a model-based sampler models (the initial guess included).
+DEFAULT_STARTUP = 5
 #: Optuna's own TPE default, for comparison runs (``--option startup=10``).
 OPTUNA_STARTUP = 10
 
 
 class Optuna(AskTellEstimator):
     """Options: ``sampler`` (tpe, cmaes, random, qmc; default tpe) and ``startup`` (random trials
-    before tpe/cmaes model, default :data:`~physbench.estimators.tpe.DEFAULT_STARTUP`)."""
+    before tpe/cmaes model, default :data:`DEFAULT_STARTUP`)."""
 
     name: ClassVar[str] = "optuna"
 

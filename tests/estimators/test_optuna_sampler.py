@@ -12,8 +12,7 @@ import pytest
 
 from physbench.errors import PhysbenchError
 from physbench.estimators.options import EstimatorOptionError
-from physbench.estimators.optuna_sampler import Optuna
-from physbench.estimators.tpe import DEFAULT_STARTUP
+from physbench.estimators.optuna_sampler import DEFAULT_STARTUP, Optuna
 from physbench.plugins import get_registry
 from physbench.testing import run_toy
 

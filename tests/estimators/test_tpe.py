@@ -1,6 +1,6 @@
 """``tpe``: hyperopt's TPE works on the real pipeline, is deterministic in a fresh process, imports
-hyperopt lazily, has a small-budget ``startup`` default and refuses bad options clearly (the
-conformance kit runs it in tests/testing/test_builtins.py)."""
+hyperopt lazily, starts with a few uniform draws (a Latin hypercube on request) and refuses bad
+options clearly (the conformance kit runs it in tests/testing/test_builtins.py)."""
 
 from __future__ import annotations
 
@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 
 from physbench.estimators.options import EstimatorOptionError
-from physbench.estimators.tpe import DEFAULT_STARTUP, TPE
+from physbench.estimators.tpe import DEFAULT_STARTUP, HYPEROPT_STARTUP, TPE
 from physbench.plugins import get_registry
 from physbench.testing import run_toy
+from physbench.testing.toy import toy_task
 
 
 def test_registered_through_entry_points() -> None:
@@ -60,17 +61,49 @@ def test_importing_the_module_does_not_import_hyperopt(
     assert heavy_imports("physbench.estimators.tpe") == []
 
 
+def unit_points(h: Any) -> np.ndarray:
+    space = toy_task().space
+    return np.array([space.to_unit(r.params) for r in h.iterations])
+
+
+def slices_hit(points: np.ndarray) -> list[int]:
+    n = len(points)
+    return [len(set(np.floor(points[:, j] * n).astype(int))) for j in range(points.shape[1])]
+
+
 def test_startup_is_a_setting_with_a_small_budget_default() -> None:
-    assert TPE().options["startup"] == DEFAULT_STARTUP < 11
-    # With hyperopt's own default (20) every one of 11 proposals is a random draw; with the small
-    # default the proposals after the start-up phase differ from those random draws.
-    lib = run_toy(TPE, {"startup": 20}, seed=1, iterations=11)
-    ours = run_toy(TPE, {"startup": DEFAULT_STARTUP}, seed=1, iterations=11)
-    assert [r.params for r in lib.iterations[:DEFAULT_STARTUP]] == [
-        r.params for r in ours.iterations[:DEFAULT_STARTUP]
-    ]
+    assert TPE().options == {
+        "startup": DEFAULT_STARTUP,
+        "design": "random",
+        "candidates": 24,
+        "gamma": 0.25,
+    }
+    assert DEFAULT_STARTUP < 11
+    # With hyperopt's own default (20) every one of 11 proposals is one of its uniform draws; with
+    # the small default the proposals after the start-up phase differ from those draws.
+    lib = run_toy(TPE, {"startup": HYPEROPT_STARTUP}, seed=1, iterations=11)
+    ours = run_toy(TPE, {}, seed=1, iterations=11)
+    n = DEFAULT_STARTUP
+    assert [r.params for r in lib.iterations[:n]] == [r.params for r in ours.iterations[:n]]
     assert lib.iterations[-1].params != ours.iterations[-1].params
-    assert ours.options == {"startup": DEFAULT_STARTUP, "candidates": 24, "gamma": 0.25}
+    pts = unit_points(lib)[1:]
+    assert slices_hit(pts) != [10] * pts.shape[1]  # uniform draws: not stratified
+
+
+def test_a_latin_hypercube_start_up_covers_the_trials_the_budget_allows() -> None:
+    # startup 20 > 9 simulations: after the initial guess, 8 points, one per eighth of every
+    # unknown's range.
+    pts = unit_points(run_toy(TPE, {"design": "lhs", "startup": 20}, seed=1, iterations=9))[1:]
+    assert slices_hit(pts) == [8] * pts.shape[1]
+
+
+def test_tpe_models_after_a_latin_hypercube_start_up() -> None:
+    # startup 4: the guess and a 3-point hypercube, then TPE's own proposals.
+    h = run_toy(TPE, {"design": "lhs", "startup": 4}, seed=1, iterations=11)
+    pts = unit_points(h)
+    assert slices_hit(pts[1:4]) == [3] * pts.shape[1]
+    assert slices_hit(pts[1:]) != [10] * pts.shape[1]
+    assert len({tuple(p) for p in pts}) == 11
 
 
 def test_first_point_told_is_the_initial_guess() -> None:
@@ -84,6 +117,7 @@ def test_first_point_told_is_the_initial_guess() -> None:
     [
         ({"startup": -1}, r"tpe: startup = -1: expected a whole number >= 0"),
         ({"gamma": "high"}, r"tpe: gamma = 'high': expected a number in \(0, 1\]"),
+        ({"design": "sobol"}, r"tpe: design = 'sobol': expected one of lhs, random"),
     ],
 )
 def test_bad_options_name_the_option_and_the_accepted_values(

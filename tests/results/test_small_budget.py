@@ -1,0 +1,62 @@
+"""The committed small-budget study (``results/small_budget``, issue 16 item 1) and the claims the
+estimators' docstrings and docs/estimators.md draw from it.
+
+The sweep (``physbench bench benchmarks/small_budget.toml``, about 10 minutes on 2 cores) is a
+benchmark, not a test; ``benchmarks/small_budget.py`` condenses it into ``final.csv``, which these
+tests read.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+RESULTS = ROOT / "results" / "small_budget"
+_spec = importlib.util.spec_from_file_location(
+    "small_budget", ROOT / "benchmarks" / "small_budget.py"
+)
+assert _spec and _spec.loader
+study = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(study)
+geo_ratio, report = study.geo_ratio, study.report
+
+
+@pytest.fixture(scope="module")
+def wide() -> dict[str, pd.DataFrame]:
+    final = pd.read_csv(RESULTS / "final.csv")
+    return {
+        r: g.pivot(index="seed", columns="estimator", values="best_nmse")
+        for r, g in final.groupby("row")
+    }
+
+
+def test_every_table_1_row_has_400_seeds_of_every_setting(wide: dict[str, pd.DataFrame]) -> None:
+    assert len(wide) == 8
+    for w in wide.values():
+        assert w.shape == (400, 8) and not w.isna().any().any()
+
+
+def test_the_start_up_design_halves_cmaes_error(wide: dict[str, pd.DataFrame]) -> None:
+    point, lo, hi = geo_ratio(wide, "cmaes", "cmaes at the guess")
+    assert 0.45 < lo <= point <= hi < 0.6
+    # and moves CMA-ES from worse than random search to better
+    assert geo_ratio(wide, "cmaes at the guess", "random")[1] > 1.2
+    assert geo_ratio(wide, "cmaes", "random")[2] < 0.85
+
+
+def test_no_latin_hypercube_start_up_measurably_changes_tpe(
+    wide: dict[str, pd.DataFrame],
+) -> None:
+    for variant in ("tpe lhs 5", "tpe lhs 7", "tpe lhs 20"):
+        _, lo, hi = geo_ratio(wide, variant, "tpe")
+        assert lo < 1 < hi, variant
+    assert geo_ratio(wide, "tpe", "random")[2] < 0.9
+
+
+def test_the_committed_summary_is_made_from_the_committed_values() -> None:
+    final = pd.read_csv(RESULTS / "final.csv")
+    assert report(final) == (RESULTS / "small_budget.md").read_text()
