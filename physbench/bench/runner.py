@@ -87,6 +87,13 @@ def run_cell(config: RunConfig) -> dict[str, Any]:
     return out
 
 
+def libraries(config: RunConfig) -> tuple[str, ...]:
+    """What a cell's first run in a process imports beyond physbench (its estimator's, engines'
+    and renderer's libraries, up to a second): the executor's ``affinity``, so that a worker keeps
+    to the cells whose libraries it has loaded."""
+    return (config.estimator, config.engine, config.observe_engine or "", config.renderer)
+
+
 def died_cell(config: RunConfig, error: str) -> dict[str, Any]:
     """The failed cell for a ``config`` whose process died running it (see
     :mod:`~physbench.bench.executors`); called by the executor in the main process."""
@@ -308,7 +315,8 @@ def _run_locked(
     try:
         if todo:
             with ex:
-                for config, data in ex.map_unordered(run_cell, [c.config for c in todo], died_cell):
+                configs = [c.config for c in todo]
+                for config, data in ex.map_unordered(run_cell, configs, died_cell, libraries):
                     key = by_config[id(config)].key
                     store.save(key, {**data, "stamp": stamps[key]})
                     if data["status"] != "ok":
