@@ -252,10 +252,17 @@ def _import_tables() -> None:
     """Import what :func:`assemble`, :func:`write_table` and the summary need; run in a thread
     while the cells run, so that building the tables after the last cell does not start with
     the imports."""
-    import pyarrow  # noqa: F401  (the parquet writer)
-    import scipy.stats  # noqa: F401  (the bootstrap intervals)
+    # pandas and pyarrow.parquet (DataFrame.to_parquet imports them on its first call, pandas
+    # takes ~0.2 s), the bootstrap intervals, the posterior scores of the stats
+    import pandas  # noqa: F401
+    import pyarrow.pandas_compat
+    import pyarrow.parquet  # noqa: F401
+    import scipy.stats  # noqa: F401
 
-    import physbench.bench.summary  # noqa: F401  (pandas, numpy)
+    import physbench.bench.summary
+    import physbench.calibration  # noqa: F401
+
+    versions()  # for run.json
 
 
 def _run_locked(
