@@ -161,13 +161,23 @@ def breakdown(ev: dict[str, Any], launched: float, ended: float, workers: int) -
     }
 
 
+def _cpu_of_children() -> float:
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def run_sweep_once(spec: str, workers: int, tmp: Path) -> dict[str, float]:
     out, events = tmp / f"w{workers}", tmp / f"events{workers}.json"
     cmd = [sys.executable, __file__, "--child", spec, str(workers), str(out), str(events)]
-    launched = time.time()
+    cpu, launched = _cpu_of_children(), time.time()
     subprocess.run(cmd, check=True, env={**os.environ, "PYTHONPATH": os.getcwd()})
     ended = time.time()
-    return breakdown(json.loads(events.read_text()), launched, ended, workers)
+    res = breakdown(json.loads(events.read_text()), launched, ended, workers)
+    # the sweep's workers were joined by it, so their CPU time is counted with it
+    res["cpu"] = _cpu_of_children() - cpu
+    return res
 
 
 # ---------------------------------------------------------------- raw engine episodes
@@ -234,6 +244,7 @@ PHASES = {
     "after_summary": "run.json, printing",
     "exit": "interpreter exit",
     "wall": "end to end",
+    "cpu": "CPU time, parent + workers (user + system)",
 }
 
 
