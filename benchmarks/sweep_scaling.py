@@ -169,7 +169,8 @@ def _cpu_of_children() -> float:
 
 
 def run_sweep_once(spec: str, workers: int, tmp: Path) -> dict[str, float]:
-    out, events = tmp / f"w{workers}", tmp / f"events{workers}.json"
+    # a folder per spec: --fresh would otherwise time deleting the other spec's cells
+    out, events = tmp / f"{Path(spec).stem}_w{workers}", tmp / f"events{workers}.json"
     cmd = [sys.executable, __file__, "--child", spec, str(workers), str(out), str(events)]
     cpu, launched = _cpu_of_children(), time.time()
     subprocess.run(cmd, check=True, env={**os.environ, "PYTHONPATH": os.getcwd()})
