@@ -1,9 +1,10 @@
-"""Sweep scaling: the smoke sweep with 1 and 2 workers against raw engine episodes with 1 and 2
-processes, in the same run, and where the sweep's time goes.
+"""Sweep scaling: the smoke sweep (and smoke48, the same cells with 4x the seeds) with 1 and 2
+workers against raw engine episodes with 1 and 2 processes, in the same run, and where the
+sweep's time goes.
 
-    python benchmarks/sweep_scaling.py [--repeats 5] [--out results/sweep_scaling]
+    python benchmarks/sweep_scaling.py [--repeats 5] [--out results/sweep_scaling] [--specs ...]
 
-Sweep: ``physbench bench benchmarks/smoke.toml --fresh -q --workers N`` in a fresh interpreter
+Sweep: ``physbench bench SPEC --fresh -q --workers N`` in a fresh interpreter
 (end to end: start-up, imports, cells, tables), 1 and 2 workers alternating, median of the
 repeats. Each run is instrumented from the outside (wrappers installed before the CLI runs, none
 in physbench): phase boundaries in the parent, the start and end of every cell in its worker.
@@ -13,7 +14,12 @@ Raw engine: for every cell of the spec, the same number of simulations its estim
 (no render, no estimator, no store), over a warmed pool of 1 or 2 processes: the ceiling a sweep
 of these cells could reach.
 
-Writes ``OUT/sweep_scaling.json`` (every repeat) and ``OUT/sweep_scaling.md`` (the tables).
+Amdahl bound: from the 1-worker run, the cells' own time (``run_cell`` in the worker, with each
+estimator's first-cell imports, which workers split by estimator) is the part 2 workers can
+split; the rest of the wall time (parent and pool start-up, storing cells, tables, exit) is not,
+so the best 2-worker time is ``rest + cells / 2``.
+
+Writes ``OUT/sweep_scaling.json`` (every repeat, the load average) and ``OUT/sweep_scaling.md``.
 """
 
 from __future__ import annotations
@@ -30,7 +36,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-SPEC = "benchmarks/smoke.toml"
+SPECS = ("benchmarks/smoke.toml", "benchmarks/smoke48.toml")
 WORKERS = (1, 2)
 
 # ---------------------------------------------------------------- instrumented sweep (child)
@@ -71,7 +77,7 @@ def timed_run_cell(config: Any) -> dict[str, Any]:
     return data
 
 
-def child(workers: int, out: str, events: str) -> None:
+def child(spec: str, workers: int, out: str, events: str) -> None:
     _mark("interpreter")
     import physbench.cli as cli
 
@@ -100,7 +106,7 @@ def child(workers: int, out: str, events: str) -> None:
         tot["cell_dumps"] = tot.get("cell_dumps", 0.0) + took - wrote
 
     store.CellStore.save = save_timed  # type: ignore[method-assign]
-    rc = cli.main(["bench", SPEC, "--out", out, "--fresh", "-q", "--workers", str(workers)])
+    rc = cli.main(["bench", spec, "--out", out, "--fresh", "-q", "--workers", str(workers)])
     _mark("done")
     Path(events).write_text(json.dumps(_EVENTS))
     sys.exit(rc)
@@ -123,6 +129,13 @@ def breakdown(ev: dict[str, Any], launched: float, ended: float, workers: int) -
     median_cell = statistics.median(cell_times)
     # a worker's first cell also imports the estimators' libraries
     first_cells = [t1 - t0 for pid, t0, t1, _, _ in cells if t0 == first_start[pid]]
+    # ... and so does its first cell of each estimator: that one's time less the estimator's median
+    per_est: dict[str, list[float]] = {}
+    firsts: dict[tuple[int, str], float] = {}
+    for pid, t0, t1, _, est in sorted(cells, key=lambda c: c[1]):
+        per_est.setdefault(est, []).append(t1 - t0)
+        firsts.setdefault((pid, est), t1 - t0)
+    imports = sum(t - statistics.median(per_est[est]) for (_, est), t in firsts.items())
     return {
         "wall": ended - launched,
         "interpreter_start": p["interpreter"] - launched,
@@ -130,6 +143,8 @@ def breakdown(ev: dict[str, Any], launched: float, ended: float, workers: int) -
         "before_cells": p["pool_enter_start"] - p["run_sweep_start"],
         "pool_start": statistics.mean(per_worker_first) - p["pool_enter_start"],
         "first_cell_imports": statistics.mean(first_cells) - median_cell,
+        "estimator_imports": imports,
+        "estimator_imports_per_worker": imports / len(first_start),
         "cells_loop": loop,
         "cell_run_sum": sum(busy.values()),
         "cell_median_ms": 1000 * median_cell,
@@ -146,24 +161,35 @@ def breakdown(ev: dict[str, Any], launched: float, ended: float, workers: int) -
     }
 
 
-def run_sweep_once(workers: int, tmp: Path) -> dict[str, float]:
-    out, events = tmp / f"w{workers}", tmp / f"events{workers}.json"
-    cmd = [sys.executable, __file__, "--child", str(workers), str(out), str(events)]
-    launched = time.time()
+def _cpu_of_children() -> float:
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def run_sweep_once(spec: str, workers: int, tmp: Path) -> dict[str, float]:
+    # a folder per spec: --fresh would otherwise time deleting the other spec's cells
+    out, events = tmp / f"{Path(spec).stem}_w{workers}", tmp / f"events{workers}.json"
+    cmd = [sys.executable, __file__, "--child", spec, str(workers), str(out), str(events)]
+    cpu, launched = _cpu_of_children(), time.time()
     subprocess.run(cmd, check=True, env={**os.environ, "PYTHONPATH": os.getcwd()})
     ended = time.time()
-    return breakdown(json.loads(events.read_text()), launched, ended, workers)
+    res = breakdown(json.loads(events.read_text()), launched, ended, workers)
+    # the sweep's workers were joined by it, so their CPU time is counted with it
+    res["cpu"] = _cpu_of_children() - cpu
+    return res
 
 
 # ---------------------------------------------------------------- raw engine episodes
 
 
-def episodes() -> list[tuple[str, int, int, str]]:
-    """(scene, seed, simulations, engine) for every cell of the spec."""
+def episodes(spec: str) -> list[tuple[str, int, int, str]]:
+    """(scene, seed, simulations, engine) for every cell of ``spec``."""
     from physbench.bench.spec import load_spec
 
     out = []
-    for c in load_spec(SPEC).cells():
+    for c in load_spec(spec).cells():
         cfg = c.config
         sims = cfg.iterations + 1 + 2 * len(cfg.params)
         out.append((cfg.scene, cfg.seed, sims, cfg.engine))
@@ -203,6 +229,8 @@ PHASES = {
     "before_cells": "spec, size check, stamps (parent)",
     "pool_start": "pool start-up to a worker's first cell (spawn + imports)",
     "first_cell_imports": "first cell's extra time in a worker (estimator imports)",
+    "estimator_imports": "each worker's first cell of each estimator, less its median, summed",
+    "estimator_imports_per_worker": "  the same per worker",
     "cells_loop": "cell loop (pool start to last result)",
     "cell_run_sum": "  run_cell time summed over workers",
     "worker_busy": "  worker busy fraction of the loop",
@@ -217,6 +245,7 @@ PHASES = {
     "after_summary": "run.json, printing",
     "exit": "interpreter exit",
     "wall": "end to end",
+    "cpu": "CPU time, parent + workers (user + system)",
 }
 
 
@@ -224,35 +253,69 @@ def median_of(runs: list[dict[str, float]], key: str) -> float:
     return statistics.median(r[key] for r in runs)
 
 
+def amdahl(sweep: dict[str, Any]) -> dict[str, float]:
+    """From the 1-worker medians: seconds 2 workers can split (the cells' own time) and the
+    rest; the best 2-worker time and ratio they allow."""
+    work = sweep["1"]["breakdown"]["cell_run_sum"]
+    rest = sweep["1"]["median_s"] - work
+    best = rest + work / 2
+    return {
+        "parallel_s": round(work, 3),
+        "serial_s": round(rest, 3),
+        "best_2_workers_s": round(best, 3),
+        "best_ratio": round(sweep["1"]["median_s"] / best, 3),
+    }
+
+
 def markdown(result: dict[str, Any]) -> str:
-    sw, raw = result["sweep"], result["raw"]
+    load = result["load"]
     lines = [
         "# Sweep scaling",
         "",
-        f"Machine: {result['machine']}. {result['repeats']} repeats, medians; "
-        "`python benchmarks/sweep_scaling.py`.",
+        f"Machine: {result['machine']}. {result['repeats']} repeats (1 and 2 workers alternating), "
+        "medians; `python benchmarks/sweep_scaling.py`. Load average (1 min) at each repeat: "
+        + ", ".join(f"{x:.1f}" for x in load)
+        + " (another job shared the cores).",
         "",
-        "| what | 1 worker s | 2 workers s | ratio (1 / 2) |",
-        "|---|---|---|---|",
+        "| what | 1 worker s | 2 workers s | ratio (1 / 2) | runs, 1 worker | runs, 2 workers |",
+        "|---|---|---|---|---|---|",
     ]
-    for name, rows in (
-        ("smoke sweep, end to end", sw),
-        ("its cell loop (pool start to last result)", result["cell_loop"]),
-        ("raw engine episodes (simulate only)", raw),
-    ):
-        t1, t2 = rows["1"]["median_s"], rows["2"]["median_s"]
-        lines.append(f"| {name} | {t1:.2f} | {t2:.2f} | {rows['ratio']:.2f} |")
+    for name, res in result["specs"].items():
+        for what, rows in (
+            (f"{name} sweep, end to end", res["sweep"]),
+            (f"{name}: its cell loop (pool start to last result)", res["cell_loop"]),
+            (f"{name}: raw engine episodes (simulate only)", res["raw"]),
+        ):
+            t1, t2 = rows["1"]["median_s"], rows["2"]["median_s"]
+            r1, r2 = (" ".join(f"{x:.2f}" for x in rows[w]["runs_s"]) for w in ("1", "2"))
+            lines.append(f"| {what} | {t1:.2f} | {t2:.2f} | {rows['ratio']:.2f} | {r1} | {r2} |")
     lines += [
         "",
-        "Where the sweep's time goes (medians, seconds unless noted):",
+        "Amdahl bound (from the 1-worker medians): the cells' own time (imports included) "
+        "splits over 2 workers, the rest of the wall time does not.",
         "",
-        "| phase | 1 worker | 2 workers |",
-        "|---|---|---|",
+        "| spec | parallel s | serial s | best with 2 workers s | best ratio | measured ratio |",
+        "|---|---|---|---|---|---|",
     ]
-    for key, label in PHASES.items():
-        a, b = sw["1"]["breakdown"][key], sw["2"]["breakdown"][key]
-        fmt = "{:.2f}" if key != "cell_median_ms" else "{:.1f}"
-        lines.append(f"| {label} | {fmt.format(a)} | {fmt.format(b)} |")
+    for name, res in result["specs"].items():
+        a = res["amdahl"]
+        lines.append(
+            f"| {name} | {a['parallel_s']:.2f} | {a['serial_s']:.2f} | "
+            f"{a['best_2_workers_s']:.2f} | {a['best_ratio']:.2f} | {res['sweep']['ratio']:.2f} |"
+        )
+    for name, res in result["specs"].items():
+        sw = res["sweep"]
+        lines += [
+            "",
+            f"Where the {name} sweep's time goes (medians, seconds unless noted):",
+            "",
+            "| phase | 1 worker | 2 workers |",
+            "|---|---|---|",
+        ]
+        for key, label in PHASES.items():
+            a, b = sw["1"]["breakdown"][key], sw["2"]["breakdown"][key]
+            fmt = "{:.2f}" if key != "cell_median_ms" else "{:.1f}"
+            lines.append(f"| {label} | {fmt.format(a)} | {fmt.format(b)} |")
     return "\n".join(lines) + "\n"
 
 
@@ -275,33 +338,46 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--out", default="results/sweep_scaling")
-    ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    ap.add_argument("--specs", nargs="+", default=list(SPECS))
+    ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
-        child(int(args.child[0]), args.child[1], args.child[2])
+        child(args.child[0], int(args.child[1]), args.child[2], args.child[3])
         return
-    sweep: dict[int, list[dict[str, float]]] = {w: [] for w in WORKERS}
-    raw: dict[int, list[float]] = {w: [] for w in WORKERS}
-    items = episodes()
+    sweep = {s: {w: [] for w in WORKERS} for s in args.specs}
+    raw: dict[str, dict[int, list[float]]] = {s: {w: [] for w in WORKERS} for s in args.specs}
+    items = {s: episodes(s) for s in args.specs}
+    load = []
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(args.repeats):
-            for w in WORKERS if r % 2 == 0 else WORKERS[::-1]:
-                sweep[w].append(run_sweep_once(w, Path(tmp)))
-                raw[w].append(run_raw_once(w, items))
-                print(
-                    f"repeat {r + 1}/{args.repeats}, {w} worker(s): sweep "
-                    f"{sweep[w][-1]['wall']:.2f} s, raw {raw[w][-1]:.2f} s",
-                    file=sys.stderr,
-                )
-    result = {
+            load.append(os.getloadavg()[0])
+            for spec in args.specs:
+                for w in WORKERS if r % 2 == 0 else WORKERS[::-1]:
+                    sweep[spec][w].append(run_sweep_once(spec, w, Path(tmp)))
+                    raw[spec][w].append(run_raw_once(w, items[spec]))
+                    print(
+                        f"repeat {r + 1}/{args.repeats}, {Path(spec).stem}, {w} worker(s): sweep "
+                        f"{sweep[spec][w][-1]['wall']:.2f} s, raw {raw[spec][w][-1]:.2f} s, "
+                        f"load {os.getloadavg()[0]:.1f}",
+                        file=sys.stderr,
+                    )
+    result: dict[str, Any] = {
         "machine": f"{os.cpu_count()} cores",
         "python": platform.python_version(),
-        "spec": Path(SPEC).stem,
         "repeats": args.repeats,
-        "sweep": summarise(sweep),
-        "cell_loop": summarise({w: [r["cells_loop"] for r in rs] for w, rs in sweep.items()}),
-        "raw": summarise(raw),
+        "load": load,
+        "specs": {},
     }
+    for spec in args.specs:
+        res = {
+            "sweep": summarise(sweep[spec]),
+            "cell_loop": summarise(
+                {w: [r["cells_loop"] for r in rs] for w, rs in sweep[spec].items()}
+            ),
+            "raw": summarise(raw[spec]),
+        }
+        res["amdahl"] = amdahl(res["sweep"])
+        result["specs"][Path(spec).stem] = res
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep_scaling.json").write_text(json.dumps(result, indent=1) + "\n")

@@ -11,6 +11,11 @@ A cell that kills its interpreter (``os._exit``, a segfault in an extension) is 
 ``died`` with what happened, and the sweep goes on. ``serial`` runs cells in this very process, so
 it cannot contain that. Local worker processes (a LocalCluster's too) die with the process that
 started them.
+
+The caller may group items by what their first run in a process costs (``affinity``: a cell's
+estimator and engine, whose libraries take up to a second to import): the ``processes`` executor
+then gives a free worker the items of groups it has already run, so each group's imports are paid
+by as few workers as the load allows instead of by every worker.
 """
 
 from __future__ import annotations
@@ -20,8 +25,8 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Generator, Iterator, Sequence
-from typing import Any, Protocol, TypeVar
+from collections.abc import Callable, Generator, Hashable, Iterator, Sequence
+from typing import Any, Generic, Protocol, TypeVar
 
 from physbench.errors import PhysbenchError, counted
 
@@ -39,7 +44,11 @@ class Executor(Protocol):
     def __enter__(self) -> Executor: ...
     def __exit__(self, *exc: object) -> None: ...
     def map_unordered(
-        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+        self,
+        fn: Callable[[T], R],
+        items: Sequence[T],
+        died: Callable[[T, str], R],
+        affinity: Callable[[T], Hashable] | None = None,
     ) -> Iterator[tuple[T, R]]: ...
     def describe(self) -> str: ...
 
@@ -114,7 +123,11 @@ class SerialExecutor:
         pass
 
     def map_unordered(
-        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+        self,
+        fn: Callable[[T], R],
+        items: Sequence[T],
+        died: Callable[[T, str], R],
+        affinity: Callable[[T], Hashable] | None = None,
     ) -> Iterator[tuple[T, R]]:
         for item in items:
             yield item, fn(item)
@@ -123,15 +136,59 @@ class SerialExecutor:
         return "serial"
 
 
-class ProcessExecutor:
-    """A pool of ``workers`` local processes, started with ``spawn`` (a fork would copy this
-    process's threads, e.g. the progress bar's monitor, into a half-initialised child).
+class Pending(Generic[T]):
+    """The items a :class:`ProcessExecutor` has yet to hand out, grouped by ``affinity`` (all in
+    one group without it), each group in the callers' order; asked by the executor each time a
+    worker has room for another item."""
 
-    At most :data:`QUEUED` items per worker are handed to the pool at a time (one running, one
-    waiting, so that a worker starts its next item without a round trip through this process),
-    so when a worker dies (and the pool with it) the items in flight are known: each is run again
-    alone in a fresh process, ``workers`` at a time; one that kills that process too is given to
-    ``died``, the others yield their results, and the remaining items go on in a fresh pool.
+    def __init__(self, items: Sequence[T], affinity: Callable[[T], Hashable] | None) -> None:
+        from collections import deque
+
+        self._groups: dict[Hashable, deque[T]] = {}
+        for item in items:
+            key = affinity(item) if affinity is not None else None
+            self._groups.setdefault(key, deque()).append(item)
+        self._started: set[Hashable] = set()
+        self._affinity = affinity
+
+    def __len__(self) -> int:
+        return sum(len(q) for q in self._groups.values())
+
+    def take(self, ran: set[Hashable]) -> T:
+        """The next item for a worker that has run the groups ``ran`` (updated): one of those
+        groups if any is left; else a group no worker has started, in the callers' order; else
+        one from the group with the most items left, so that stragglers share the longest one."""
+        key = next((k for k, q in self._groups.items() if q and k in ran), None)
+        if key is None:
+            key = next((k for k, q in self._groups.items() if q and k not in self._started), None)
+        if key is None:
+            key = max(self._groups, key=lambda k: len(self._groups[k]))
+        ran.add(key)
+        self._started.add(key)
+        item = self._groups[key].popleft()
+        if not self._groups[key]:
+            del self._groups[key]
+        return item
+
+    def put_back(self, item: T) -> None:
+        """Return ``item`` to the front of its group: the worker it was taken for was gone."""
+        from collections import deque
+
+        key = self._affinity(item) if self._affinity is not None else None
+        self._groups.setdefault(key, deque()).appendleft(item)
+
+
+class ProcessExecutor:
+    """``workers`` local processes, started with ``spawn`` (a fork would copy this process's
+    threads, e.g. the progress bar's monitor, into a half-initialised child), each its own
+    single-process pool so that this process chooses which worker runs which item (see
+    :class:`Pending`).
+
+    At most :data:`QUEUED` items per worker are handed out at a time (one running, one waiting,
+    so that a worker starts its next item without a round trip through this process), so when a
+    worker dies (and its pool with it) the items in flight are known: each is run again alone in
+    a fresh process, ``workers`` at a time; one that kills that process too is given to ``died``,
+    the others yield their results, and the remaining items go on in fresh pools.
 
     Leaving the block does not wait for the workers to exit: they finish in the background
     (joined when this process exits) while the caller goes on, e.g. to the tables."""
@@ -140,7 +197,7 @@ class ProcessExecutor:
 
     def __init__(self, workers: int | None = None) -> None:
         self.workers = workers or default_workers()
-        self._pool: Any = None
+        self._pools: list[Any] = []
 
     def _context(self) -> Any:
         import multiprocessing
@@ -150,65 +207,81 @@ class ProcessExecutor:
     def __enter__(self) -> ProcessExecutor:
         from concurrent.futures import ProcessPoolExecutor
 
-        self._pool = ProcessPoolExecutor(
-            self.workers,
-            mp_context=self._context(),
-            initializer=die_with_parent,
-            initargs=(os.getpid(),),
-        )
+        self._pools = [
+            ProcessPoolExecutor(
+                1,
+                mp_context=self._context(),
+                initializer=die_with_parent,
+                initargs=(os.getpid(),),
+            )
+            for _ in range(self.workers)
+        ]
         return self
 
     def __exit__(self, *exc: object) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = None
+        for pool in self._pools:
+            pool.shutdown(wait=False, cancel_futures=True)
+        self._pools = []
 
     def map_unordered(
-        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+        self,
+        fn: Callable[[T], R],
+        items: Sequence[T],
+        died: Callable[[T, str], R],
+        affinity: Callable[[T], Hashable] | None = None,
     ) -> Iterator[tuple[T, R]]:
-        from collections import deque
-
-        pending = deque(items)
+        pending = Pending(items, affinity)
         while pending:
-            if self._pool is None:
+            if not self._pools:
                 self.__enter__()
             suspects = yield from self._until_broken(fn, pending)
             if suspects is not None:
-                self._pool.shutdown(wait=True)
-                self._pool = None
+                for pool in self._pools:
+                    pool.shutdown(wait=True)
+                self._pools = []
                 for i in range(0, len(suspects), self.workers):
                     yield from self._each_alone(fn, suspects[i : i + self.workers], died)
 
     def _until_broken(
-        self, fn: Callable[[T], R], pending: Any
+        self,
+        fn: Callable[[T], R],
+        pending: Pending[T],
     ) -> Generator[tuple[T, R], None, list[T] | None]:
-        """Yield results from the pool until ``pending`` is empty (then return ``None``) or the
-        pool breaks (then return the items that were in flight, maybe none)."""
-        from concurrent.futures import FIRST_COMPLETED, wait
+        """Yield results from the pools until ``pending`` is empty (then return ``None``) or a
+        pool breaks (then, once the other pools' items in flight are done, return the broken
+        pools' items, maybe none)."""
+        from concurrent.futures import ALL_COMPLETED, FIRST_COMPLETED, wait
         from concurrent.futures.process import BrokenProcessPool
 
-        window: dict[Any, T] = {}
+        window: dict[Any, tuple[int, T]] = {}  # future -> (worker, item)
+        ran: list[set[Hashable]] = [set() for _ in self._pools]
+        queued = [0] * len(self._pools)
+        suspects: list[T] = []
+        broken = False
         try:
             while pending or window:
-                while pending and len(window) < QUEUED * self.workers:
-                    item = pending.popleft()
-                    try:
-                        window[self._pool.submit(fn, item)] = item
-                    except BrokenProcessPool:
-                        pending.appendleft(item)
-                        break
-                done, _ = wait(window, return_when=FIRST_COMPLETED)
-                if not done or any(isinstance(f.exception(), BrokenProcessPool) for f in done):
-                    wait(window)  # a broken pool fails every future it holds
-                    for fut, item in list(window.items()):
-                        if not isinstance(fut.exception(), BrokenProcessPool):
-                            del window[fut]
-                            yield item, fut.result()
-                    suspects = list(window.values())
-                    window.clear()
-                    return suspects
+                for w, pool in enumerate(self._pools):
+                    while pending and queued[w] < QUEUED and not broken:
+                        item = pending.take(ran[w])
+                        try:
+                            window[pool.submit(fn, item)] = (w, item)
+                        except BrokenProcessPool:
+                            pending.put_back(item)
+                            broken = True
+                            break
+                        queued[w] += 1
+                # once a pool broke, wait for all: a broken pool fails every future it holds
+                done = wait(window, return_when=ALL_COMPLETED if broken else FIRST_COMPLETED).done
                 for fut in done:
-                    yield window.pop(fut), fut.result()
+                    w, item = window.pop(fut)
+                    queued[w] -= 1
+                    if isinstance(fut.exception(), BrokenProcessPool):
+                        suspects.append(item)
+                        broken = True
+                    else:
+                        yield item, fut.result()
+                if broken and not window:
+                    return suspects
             return None
         finally:
             for fut in window:
@@ -330,8 +403,13 @@ class DaskExecutor:
         self._client = self._cluster = None
 
     def map_unordered(
-        self, fn: Callable[[T], R], items: Sequence[T], died: Callable[[T, str], R]
+        self,
+        fn: Callable[[T], R],
+        items: Sequence[T],
+        died: Callable[[T, str], R],
+        affinity: Callable[[T], Hashable] | None = None,
     ) -> Iterator[tuple[T, R]]:
+        """``affinity`` is ignored: the Dask scheduler places tasks itself."""
         from distributed import KilledWorker, as_completed
 
         running: dict[str, tuple[Any, T]] = {}

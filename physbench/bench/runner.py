@@ -87,6 +87,13 @@ def run_cell(config: RunConfig) -> dict[str, Any]:
     return out
 
 
+def libraries(config: RunConfig) -> tuple[str, ...]:
+    """What a cell's first run in a process imports beyond physbench (its estimator's, engines'
+    and renderer's libraries, up to a second): the executor's ``affinity``, so that a worker keeps
+    to the cells whose libraries it has loaded."""
+    return (config.estimator, config.engine, config.observe_engine or "", config.renderer)
+
+
 def died_cell(config: RunConfig, error: str) -> dict[str, Any]:
     """The failed cell for a ``config`` whose process died running it (see
     :mod:`~physbench.bench.executors`); called by the executor in the main process."""
@@ -245,10 +252,17 @@ def _import_tables() -> None:
     """Import what :func:`assemble`, :func:`write_table` and the summary need; run in a thread
     while the cells run, so that building the tables after the last cell does not start with
     the imports."""
-    import pyarrow  # noqa: F401  (the parquet writer)
-    import scipy.stats  # noqa: F401  (the bootstrap intervals)
+    # pandas and pyarrow.parquet (DataFrame.to_parquet imports them on its first call, pandas
+    # takes ~0.2 s), the bootstrap intervals, the posterior scores of the stats
+    import pandas  # noqa: F401
+    import pyarrow.pandas_compat
+    import pyarrow.parquet  # noqa: F401
+    import scipy.stats  # noqa: F401
 
-    import physbench.bench.summary  # noqa: F401  (pandas, numpy)
+    import physbench.bench.summary
+    import physbench.calibration  # noqa: F401
+
+    versions()  # for run.json
 
 
 def _run_locked(
@@ -308,7 +322,8 @@ def _run_locked(
     try:
         if todo:
             with ex:
-                for config, data in ex.map_unordered(run_cell, [c.config for c in todo], died_cell):
+                configs = [c.config for c in todo]
+                for config, data in ex.map_unordered(run_cell, configs, died_cell, libraries):
                     key = by_config[id(config)].key
                     store.save(key, {**data, "stamp": stamps[key]})
                     if data["status"] != "ok":

@@ -47,25 +47,27 @@ NOTE = (
 )
 
 
-def _cost(rows: pd.DataFrame, threshold: float) -> tuple[float, float]:
-    """(simulations, seconds) until ``rows`` (one cell's iterations) first reach ``threshold``;
+def _cost(
+    best: np.ndarray,
+    iteration: np.ndarray,
+    sim: np.ndarray,
+    ren: np.ndarray,
+    est: np.ndarray,
+    start: float,
+    threshold: float,
+) -> tuple[float, float]:
+    """(simulations, seconds) until one cell's iterations (in order) first reach ``threshold``;
     (+inf, +inf) when they never do."""
-    rows = rows.sort_values("iteration")
-    best = rows["best_nmse"].to_numpy(dtype=float)
     hit = np.flatnonzero(best <= threshold)
     if hit.size == 0:
         return math.inf, math.inf
     k = int(hit[0])
-    sim = rows["t_simulate"].to_numpy(dtype=float)
-    ren = rows["t_render"].to_numpy(dtype=float)
-    est = rows["t_estimator"].to_numpy(dtype=float)
-    start = float(rows["t_start"].iloc[0]) if "t_start" in rows.columns else math.nan
     seconds = (
         (0.0 if math.isnan(start) else start)
         + float(np.sum(sim[:k] + ren[:k] + est[:k]))
         + float(sim[k] + ren[k])
     )
-    return float(int(rows["iteration"].iloc[k]) + 1), seconds
+    return float(int(iteration[k]) + 1), seconds
 
 
 def threshold_for(scene: str, unknowns: str, threshold: float | None) -> tuple[float, str]:
@@ -90,25 +92,45 @@ def per_seed(df: pd.DataFrame, *, threshold: float | None = None) -> pd.DataFram
         raise PhysbenchError(f"threshold {threshold!r}: expected a finite normalized MSE > 0")
     df = upgrade(df)
     ok = df[(df["status"] == "ok") & df["iteration"].notna()]
-    out = []
-    for _, rows in ok.groupby("cell", sort=False):
-        first = rows.iloc[0]
-        limit, _ = threshold_for(str(first["scene"]), str(first["unknowns"]), threshold)
-        if math.isnan(limit):
-            continue
-        sims, secs = _cost(rows, limit)
-        out.append(
-            {
-                **{c: first[c] for c in CONFIG},
-                "cell_index": int(first["cell_index"]),
-                "seed": int(first["seed"]),
-                "threshold": limit,
-                "simulations": sims,
-                "seconds": secs,
-            }
-        )
     cols = [*CONFIG, "cell_index", "seed", "threshold", "simulations", "seconds"]
-    return pd.DataFrame(out, columns=cols)
+    # each cell's rows by iteration, the cells in order of first appearance (groupby's order)
+    order = pd.factorize(ok["cell"])[0]
+    by = np.lexsort((ok["iteration"].to_numpy(dtype=float), order))
+    ok, cell = ok.iloc[by], order[by]
+    starts = np.flatnonzero(np.r_[True, cell[1:] != cell[:-1]]) if len(ok) else np.array([], int)
+    first = ok.iloc[starts]
+    limits = {
+        key: threshold_for(str(key[0]), str(key[1]), threshold)[0]
+        for key in set(zip(first["scene"], first["unknowns"], strict=True))
+    }
+    limit = np.array(
+        [limits[k] for k in zip(first["scene"], first["unknowns"], strict=True)], dtype=float
+    )
+    best, it = ok["best_nmse"].to_numpy(dtype=float), ok["iteration"].to_numpy(dtype=float)
+    sim, ren, est = (ok[c].to_numpy(dtype=float) for c in ("t_simulate", "t_render", "t_estimator"))
+    t_start = first["t_start"].to_numpy(dtype=float) if "t_start" in ok.columns else None
+    sims, seconds = np.full(len(starts), math.inf), np.full(len(starts), math.inf)
+    ends = np.r_[starts[1:], len(ok)] if len(starts) else starts
+    for i, (lo, hi) in enumerate(zip(starts, ends, strict=True)):
+        sims[i], seconds[i] = _cost(
+            best[lo:hi],
+            it[lo:hi],
+            sim[lo:hi],
+            ren[lo:hi],
+            est[lo:hi],
+            math.nan if t_start is None else t_start[i],
+            limit[i],
+        )
+    keep = ~np.isnan(limit)
+    # plain lists: the columns' types inferred as from rows of Python values
+    data = {c: first[c].to_numpy(dtype=object)[keep].tolist() for c in CONFIG}
+    data["cell_index"] = [int(x) for x in first["cell_index"].to_numpy()[keep]]
+    data["seed"] = [int(x) for x in first["seed"].to_numpy()[keep]]
+    for c, v in (("threshold", limit), ("simulations", sims), ("seconds", seconds)):
+        data[c] = v[keep].tolist()
+    if not keep.any():
+        return pd.DataFrame([], columns=cols)
+    return pd.DataFrame(data, columns=cols)
 
 
 def _censored_median(values: np.ndarray) -> float:

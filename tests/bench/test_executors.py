@@ -18,7 +18,9 @@ import pytest
 
 from physbench.bench.executors import (
     NAMES,
+    QUEUED,
     DaskExecutor,
+    Pending,
     ProcessExecutor,
     SerialExecutor,
     default_workers,
@@ -88,6 +90,48 @@ def test_processes_yield_every_item_once_with_its_result() -> None:
     assert sorted(got) == sorted((x, abs(x)) for x in ITEMS)
 
 
+def _group(item: str) -> str:
+    return item[0]
+
+
+def test_a_worker_keeps_to_the_groups_it_has_run_then_starts_a_new_one() -> None:
+    pending = Pending(["a1", "b1", "a2", "b2", "c1", "a3"], _group)
+    first: set[object] = set()
+    second: set[object] = set()
+    taken = [pending.take(first), pending.take(second), pending.take(second)]
+    assert taken == ["a1", "b1", "b2"]  # the second worker starts b, a group nobody has started
+    assert [pending.take(first), pending.take(first), pending.take(second)] == ["a2", "a3", "c1"]
+    assert first == {"a"} and second == {"b", "c"} and not pending
+
+
+def test_a_worker_with_nothing_of_its_own_helps_with_the_longest_group() -> None:
+    pending = Pending(["a1", "b1", "b2", "c1", "c2", "c3"], _group)
+    first: set[object] = set()
+    assert [pending.take(set()), pending.take(set()), pending.take(set())] == ["a1", "b1", "c1"]
+    assert pending.take(first) == "c2" and first == {"c"}  # c has 2 left, b 1
+    pending.put_back("c2")
+    assert pending.take({"c"}) == "c2" and len(pending) == 2
+
+
+def test_without_affinity_items_go_in_the_callers_order() -> None:
+    pending = Pending(ITEMS, None)
+    assert [pending.take(set()) for _ in ITEMS] == ITEMS
+
+
+def test_processes_run_each_group_in_the_worker_that_started_it(
+    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("PB_GO_FILE", str(tmp_path / "go"))
+    stamping = plugin("pb_stamping", STAMPING)
+    # QUEUED items of each group: all are handed out at once, so none is left to share.
+    items = [f"{g}{i}" for i in range(QUEUED) for g in "ab"]
+    with make_executor("processes", workers=2) as ex:
+        pids = dict(ex.map_unordered(stamping.pid_of, items, _never, _group))
+    assert sorted(pids) == sorted(items)
+    assert {pids[f"a{i}"] for i in range(QUEUED)} == {pids["a0"]}
+    assert {pids[f"b{i}"] for i in range(QUEUED)} == {pids["b0"]} != {pids["a0"]}
+
+
 #: A worker function that kills its process for some items, and logs every call to ``LOG``.
 DYING = """
 import os
@@ -110,15 +154,19 @@ def crash_on(x):
 """
 
 
+@pytest.mark.parametrize("affinity", [None, lambda x: x % 2], ids=["one group", "odd and even"])
 def test_items_that_kill_their_worker_are_retried_once_then_given_to_died(
-    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+    affinity: Callable[[int], int] | None,
+    tmp_path: Path,
+    plugin: Callable[..., ModuleType],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     log = tmp_path / "calls.txt"
     monkeypatch.setenv("PB_DYING_LOG", str(log))
     dying = plugin("pb_dying", DYING)
     items = [1, 3, 2, 11, 4, 5, 6, 7]
     with make_executor("processes", workers=2) as ex:
-        got = dict(ex.map_unordered(dying.crash_on, items, lambda x, error: error))
+        got = dict(ex.map_unordered(dying.crash_on, items, lambda x, error: error, affinity))
     again = ", also when run again alone in a fresh process"
     assert got == {
         **{x: -x for x in items if x not in (3, 11)},
@@ -177,6 +225,10 @@ GO = Path(os.environ["PB_GO_FILE"])
 
 def started(x):
     return time.time()
+
+
+def pid_of(x):
+    return os.getpid()
 
 
 def _wait_for_go():

@@ -253,6 +253,43 @@ def test_several_renderers_split_the_summary(tmp_path: Path, blocks: ModuleType)
     assert ours["renderer"].tolist() == [DEFAULT_RENDERER, "blocks"]
 
 
+#: Builds a finished sweep's tables in a fresh interpreter after ``_import_tables`` and prints
+#: the modules that building them still imported.
+LATE_IMPORTS = """
+import sys
+from pathlib import Path
+from physbench.bench import runner
+from physbench.bench.spec import parse_spec
+from physbench.bench.store import CellStore
+from physbench.bench.summary import write_summary
+from physbench.plugins import get_registry
+
+out = Path(sys.argv[1])
+cells = parse_spec(SPEC).cells()
+get_registry()  # a sweep has loaded the plugins before its cells run
+runner._import_tables()
+before = set(sys.modules)
+table = runner.assemble(cells, CellStore(out))
+runner.write_table(table, out)
+write_summary(table, out, title="tiny")
+print(" ".join(sorted(set(sys.modules) - before)))
+"""
+
+
+def test_building_the_tables_imports_no_library_after_the_cells(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    spec = {**TINY, "seeds": 1, "estimators": ["random"]}
+    run_sweep(parse_spec(spec), tmp_path, executor="serial", progress=False)
+    code = LATE_IMPORTS.replace("SPEC", repr(spec))
+    late = subprocess.run(
+        [sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, check=True
+    ).stdout.split()
+    libraries = {"pandas", "pyarrow.parquet", "pyarrow.pandas_compat", "scipy.stats"}
+    assert not set(late) & {*libraries, "physbench.calibration"}
+
+
 def test_the_tables_libraries_are_imported_while_the_cells_run(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
