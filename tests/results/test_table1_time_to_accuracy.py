@@ -36,7 +36,7 @@ def test_resnet3d_reaches_the_papers_value_in_a_median_of_two_simulations(
     assert len(r) == 8 and (r["source"] == "paper NN").all()
     assert (r["share"] >= 0.82).all()
     assert sorted(r["median_simulations"]) == [2.0] * 7 + [3.0]  # 3: three circles, elasticity
-    assert r["median_seconds"].between(0.05, 0.12).all()
+    assert r["median_seconds"].between(0.04, 0.08).all()
 
 
 def test_the_gradient_free_estimators_mostly_do_not_within_11_simulations(
@@ -45,8 +45,9 @@ def test_the_gradient_free_estimators_mostly_do_not_within_11_simulations(
     g = committed[committed["estimator"] != "resnet3d"]
     assert len(g) == 32 and g["share"].max() == 0.6
     finite = g[g["median_simulations"] < float("inf")]
-    # only second order elasticity, where TPE and Optuna need 11 and 8.5 of the 11 simulations
+    # only second order elasticity, where TPE, CMA-ES and Optuna need 11, 11 and 8.5 of the 11
     assert set(zip(finite["scene"], finite["unknowns"], finite["estimator"], strict=True)) == {
         ("second_order", "elasticity", "tpe"),
+        ("second_order", "elasticity", "cmaes"),
         ("second_order", "elasticity", "optuna"),
     }
