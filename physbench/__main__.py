@@ -17,21 +17,34 @@ def _interrupted_while_starting(signum: int, frame: object) -> None:
 signal.signal(signal.SIGINT, _interrupted_while_starting)
 
 
+#: The status the process ends with; 1 until :func:`main` returns (an exception escaped it).
+_status = 1
+
+
 def main() -> int:
     """Called once per process, by the ``physbench`` script or ``python -m physbench``; runs the
-    command in :data:`sys.argv`."""
+    command in :data:`sys.argv`. The process then ends without the interpreter's teardown
+    (:mod:`physbench.teardown`)."""
+    global _status
+    from physbench.teardown import skip_at_exit
+
+    skip_at_exit(lambda: _status)
     from physbench.cli import main as run_command
 
     try:
         # From here Ctrl-C raises KeyboardInterrupt, so the command cleans up (saves finished
         # cells, ...) and run_command turns it into the line and 130.
         signal.signal(signal.SIGINT, signal.default_int_handler)
-        return run_command()
+        _status = run_command()
+    except SystemExit as exc:  # argparse's usage errors and --help
+        _status = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+        raise
     except KeyboardInterrupt:  # before run_command's own guard, or re-raised by --debug
         if "--debug" in sys.argv[1:]:
             raise
         print("physbench: interrupted", file=sys.stderr)
-        return 130
+        _status = 130
+    return _status
 
 
 if __name__ == "__main__":

@@ -201,3 +201,31 @@ def test_the_issue_tracker_comes_from_the_package_metadata(
     assert issue_tracker() == "https://example.org/pb/issues"
     monkeypatch.setattr(md, "metadata", lambda name: Meta(urls[:1]))
     assert issue_tracker() is None
+
+
+@pytest.mark.parametrize(
+    ("args", "status"),
+    [
+        (("--version",), 0),
+        (("bench", "no-such-spec.toml", "--out", "o"), 2),  # physbench's error
+        (("bench", "no-such-spec.toml"), 2),  # argparse's
+        (("bench", "--help"), 0),
+    ],
+)
+def test_the_script_keeps_its_status_and_output_when_it_skips_the_teardown(
+    args: tuple[str, ...], status: int, tmp_path: Path
+) -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "physbench", *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=os.environ,
+        cwd=tmp_path,
+    )
+    assert proc.returncode == status, proc.stderr
+    if status == 0:
+        assert proc.stdout.startswith(("physbench ", "usage: physbench bench")), proc.stdout
+    else:
+        assert "physbench bench: error:" in proc.stderr, proc.stderr
+        assert "no-such-spec.toml" in proc.stderr or "--out" in proc.stderr

@@ -86,6 +86,18 @@ def die_with_parent(parent: int) -> None:
     threading.Thread(target=watch, name="physbench-parent-watch", daemon=True).start()
 
 
+def start_worker(parent: int) -> None:
+    """The initializer of every :class:`ProcessExecutor` worker: it ends with its parent
+    (:func:`die_with_parent`) and, once its pool shuts it down, without the interpreter's
+    teardown (:mod:`physbench.teardown`), which would otherwise keep a core busy after the cells
+    are done. Its exit status is then always 0, which nothing reads: a worker that dies while it
+    works is told apart by its pool before it reaches that exit."""
+    from physbench.teardown import skip_at_exit
+
+    die_with_parent(parent)
+    skip_at_exit(lambda: 0)
+
+
 def how_it_died(exitcode: int | None) -> str:
     """``exit code 3`` or ``signal 11 (SIGSEGV)``, from a process's ``exitcode``."""
     if exitcode is not None and exitcode < 0:
@@ -211,7 +223,7 @@ class ProcessExecutor:
             ProcessPoolExecutor(
                 1,
                 mp_context=self._context(),
-                initializer=die_with_parent,
+                initializer=start_worker,
                 initargs=(os.getpid(),),
             )
             for _ in range(self.workers)

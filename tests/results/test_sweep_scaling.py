@@ -43,6 +43,19 @@ def test_the_amdahl_bound_follows_from_the_one_worker_run() -> None:
         assert data["sweep"]["ratio"] <= a["best_ratio"] + 0.05
 
 
+def test_the_cpu_bound_follows_from_the_two_worker_run() -> None:
+    for _, data in _specs():
+        a, two = data["amdahl"], data["sweep"]["2"]
+        assert abs(a["cpu_2_workers_s"] - two["breakdown"]["cpu"]) <= 1e-3
+        assert (
+            abs(a["cpu_bound_ratio"] - data["sweep"]["1"]["median_s"] * 2 / a["cpu_2_workers_s"])
+            < 0.01
+        )
+        # 2 cores: a run's wall time is at least half its CPU time (medians: a little noise)
+        assert two["median_s"] >= a["cpu_2_workers_s"] / 2 - 0.05
+        assert data["sweep"]["ratio"] <= a["cpu_bound_ratio"] + 0.05
+
+
 def _check_medians(data: dict) -> None:
     for row in ROWS:
         one, two = data[row]["1"], data[row]["2"]
@@ -107,3 +120,6 @@ def test_docs_quote_the_committed_figures() -> None:
         )
         assert quoted in docs, quoted
         assert f"{data['amdahl']['best_ratio']:.2f}×" in docs
+        assert f"{data['amdahl']['cpu_bound_ratio']:.2f}×" in docs
+        for w in ("1", "2"):  # the phase the teardown skip shortened
+            assert data["sweep"][w]["breakdown"]["exit"] < 0.1
