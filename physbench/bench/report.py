@@ -42,9 +42,10 @@ def build(
     *,
     title: str,
     run_log: Mapping[str, Any] | None = None,
+    threshold: float | None = None,
 ) -> Path:
-    """Write ``out/report.html`` from the long table ``df`` and the figure files; returns its
-    path."""
+    """Write ``out/report.html`` from the long table ``df`` and the figure files (the time to
+    accuracy to ``threshold`` when given, else to the paper's value); returns its path."""
     from physbench.bench import time_to_accuracy
     from physbench.bench.store import atomic_write
     from physbench.bench.tables import (
@@ -101,7 +102,7 @@ def build(
         "of the mean over seeds.</p>",
         _table(detail(st)),
     ]
-    tta = time_to_accuracy.table(df)
+    tta = time_to_accuracy.table(df, threshold=threshold)
     if len(tta):
         parts += [
             f"<h2>Time to accuracy</h2><p class='note'>{html.escape(time_to_accuracy.NOTE)}</p>",

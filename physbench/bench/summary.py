@@ -25,14 +25,17 @@ if TYPE_CHECKING:
     import pandas as pd
 
 
-def write_summary(df: pd.DataFrame, out: Path, *, title: str) -> pd.DataFrame:
+def write_summary(
+    df: pd.DataFrame, out: Path, *, title: str, threshold: float | None = None
+) -> pd.DataFrame:
     """Write ``stats.csv`` (numbers), ``time_to_accuracy.csv``
     (:mod:`physbench.bench.time_to_accuracy`), ``summary.csv`` / ``summary.md`` / ``summary.tex``
     (the paper's layout; the Markdown adds the per-configuration details and the time to
-    accuracy); returns the stats. Called by ``physbench bench`` after a sweep and by
-    ``physbench plot``, which rebuilds them from ``results.parquet`` alone."""
+    accuracy, to ``threshold`` when given, else to the paper's value); returns the stats. Called
+    by ``physbench bench`` after a sweep and by ``physbench plot``, which rebuilds them from
+    ``results.parquet`` alone."""
     st = stats(df)
-    tta = time_to_accuracy.table(df)
+    tta = time_to_accuracy.table(df, threshold=threshold)
     layout = paper_layout(st)
     iters = ", ".join(str(i) for i in dict.fromkeys(st["iterations"]))
     caption = (

@@ -66,6 +66,11 @@ def test_plot_command_writes_figures_and_report(
     [
         (["--seeds", "0"], "--seeds 0: expected a whole number >= 1"),
         (["--landscape-seeds", "-1"], "--landscape-seeds -1: expected a whole number >= 0"),
+        (["--threshold", "0"], "--threshold 0: expected a finite normalized MSE > 0, e.g. 1e-3"),
+        (
+            ["--threshold", "nan"],
+            "--threshold nan: expected a finite normalized MSE > 0, e.g. 1e-3",
+        ),
     ],
 )
 def test_bad_counts_are_refused_before_reading(
@@ -73,6 +78,45 @@ def test_bad_counts_are_refused_before_reading(
 ) -> None:
     assert main(["plot", str(tmp_path / "missing"), *argv]) == 2
     assert capsys.readouterr().err == f"physbench plot: error: {message}\n"
+
+
+def test_a_given_threshold_replaces_the_papers_on_every_row(tmp_path: Path) -> None:
+    spec = parse_spec(
+        {
+            "name": "t",
+            "estimators": ["random"],
+            "seeds": 3,
+            "iterations": 3,
+            "resolution": 16,
+            # second_order mass+elasticity has no paper value: left out unless a threshold is given
+            "scenes": [
+                {"name": "three_circles", "unknowns": ["mass"]},
+                {"name": "second_order", "unknowns": ["mass+elasticity"]},
+            ],
+        }
+    )
+    run_sweep(spec, tmp_path, executor="serial", progress=False)
+    read = lambda: pd.read_csv(tmp_path / "time_to_accuracy.csv").set_index("unknowns")  # noqa: E731
+    argv = ["plot", str(tmp_path), "--landscape-seeds", "0", "-q"]
+    assert main(argv) == 0
+    default = read()
+    assert (
+        default.loc["mass", "source"] == "paper NN" and default.loc["mass", "threshold"] == 2.6e-3
+    )
+    assert default.loc["mass+elasticity", "source"] != "given"
+    assert pd.isna(default.loc["mass+elasticity", "threshold"])
+    # any answer is at or below 1e9: every seed reaches it with the initial guess
+    assert main([*argv, "--threshold", "1e9"]) == 0
+    loose = read()
+    assert (loose["threshold"] == 1e9).all() and (loose["source"] == "given").all()
+    assert (loose["reached"] == 3).all() and (loose["median_simulations"] == 1).all()
+    assert "at or below 1e+09" not in (tmp_path / "summary.md").read_text()
+    assert "1.00e+09 (given)" in (tmp_path / "summary.md").read_text()
+    assert "1.00e+09 (given)" in (tmp_path / "report.html").read_text()
+    # and none reaches 1e-30
+    assert main([*argv, "--threshold", "1e-30"]) == 0
+    tight = read()
+    assert (tight["reached"] == 0).all() and (tight["median_simulations"] == float("inf")).all()
 
 
 def test_an_empty_table_says_to_run_the_sweep_first(
