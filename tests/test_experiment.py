@@ -48,7 +48,7 @@ def test_checks_fail_fast_naming_the_bad_choice() -> None:
 
 
 def test_component_factories_list_the_options_they_take() -> None:
-    with pytest.raises(PhysbenchError, match="its options: startup, candidates, gamma"):
+    with pytest.raises(PhysbenchError, match="its options: startup, design, candidates, gamma"):
         make_estimator("tpe", {"colour": 1})
     with pytest.raises(PhysbenchError, match="its options: resolution, mode"):
         make_renderer("raster", {"colour": 1}, resolution=32, mode="mark")
