@@ -40,10 +40,10 @@ def main() -> int:
         _status = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
         raise
     except KeyboardInterrupt:  # before run_command's own guard, or re-raised by --debug
+        _status = 130
         if "--debug" in sys.argv[1:]:
             raise
         print("physbench: interrupted", file=sys.stderr)
-        _status = 130
     return _status
 
 

@@ -81,6 +81,16 @@ def threshold_for(scene: str, unknowns: str, threshold: float | None) -> tuple[f
     return ref[0], f"paper {REFERENCE}"
 
 
+def check_threshold(threshold: float, what: str = "threshold") -> float:
+    """``threshold`` if it is a finite normalized MSE > 0, else :class:`PhysbenchError` naming it
+    as ``what`` (``--threshold`` for the command line)."""
+    if not (math.isfinite(threshold) and threshold > 0):
+        raise PhysbenchError(
+            f"{what} {threshold:g}: expected a finite normalized MSE > 0, e.g. 1e-3"
+        )
+    return float(threshold)
+
+
 def per_seed(df: pd.DataFrame, *, threshold: float | None = None) -> pd.DataFrame:
     """One row per finished cell of the long table ``df``: its :data:`CONFIG`, ``seed``,
     ``threshold`` and the ``simulations`` / ``seconds`` it took to reach it (+inf: never). Rows
@@ -88,8 +98,8 @@ def per_seed(df: pd.DataFrame, *, threshold: float | None = None) -> pd.DataFram
     time-to-accuracy figure."""
     import pandas as pd
 
-    if threshold is not None and not (math.isfinite(threshold) and threshold > 0):
-        raise PhysbenchError(f"threshold {threshold!r}: expected a finite normalized MSE > 0")
+    if threshold is not None:
+        check_threshold(threshold)
     df = upgrade(df)
     ok = df[(df["status"] == "ok") & df["iteration"].notna()]
     cols = [*CONFIG, "cell_index", "seed", "threshold", "simulations", "seconds"]

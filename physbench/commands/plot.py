@@ -67,7 +67,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     import json
-    import math
     from pathlib import Path
 
     from physbench.errors import PhysbenchError, counted
@@ -78,10 +77,10 @@ def main(args: argparse.Namespace) -> int:
         raise PhysbenchError(
             f"--landscape-seeds {args.landscape_seeds}: expected a whole number >= 0"
         )
-    if args.threshold is not None and not (math.isfinite(args.threshold) and args.threshold > 0):
-        raise PhysbenchError(
-            f"--threshold {args.threshold:g}: expected a finite normalized MSE > 0, e.g. 1e-3"
-        )
+    if args.threshold is not None:  # before reading the table
+        from physbench.bench.time_to_accuracy import check_threshold
+
+        check_threshold(args.threshold, "--threshold")
 
     from physbench.bench import plots, report
     from physbench.bench.store import atomic_write
