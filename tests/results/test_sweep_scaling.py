@@ -28,7 +28,8 @@ def _specs() -> list[tuple[str, dict]]:
 
 
 def test_medians_and_ratios_follow_from_the_runs() -> None:
-    assert _all()["machine"] == "2 cores" and _all()["repeats"] >= 3
+    data = _all()
+    assert data["machine"] == "2 cores" and data["repeats"] >= 3
     for _, data in _specs():
         _check_medians(data)
 
@@ -88,6 +89,7 @@ def _check_breakdown(data: dict) -> None:
         ]
         assert sum(b[k] for k in serial) <= b["wall"]
         assert 0 < b["worker_busy"] <= 1
+        assert b["exit"] < 0.1  # the phase the teardown skip shortened (0.30-0.37 s before)
         # medians over the repeats, each taken alone: their sum may pass the total's median a bit
         assert b["parent_cell_dumps"] + b["parent_cell_write"] <= 1.05 * b["parent_cell_save"]
     # one worker does every cell in the loop, so its run time cannot exceed the loop's
@@ -121,5 +123,3 @@ def test_docs_quote_the_committed_figures() -> None:
         assert quoted in docs, quoted
         assert f"{data['amdahl']['best_ratio']:.2f}×" in docs
         assert f"{data['amdahl']['cpu_bound_ratio']:.2f}×" in docs
-        for w in ("1", "2"):  # the phase the teardown skip shortened
-            assert data["sweep"][w]["breakdown"]["exit"] < 0.1
