@@ -34,9 +34,9 @@ def problem(scene_name: str, params: str, seed: int):  # type: ignore[no-untyped
     from physbench.experiment import make_renderer
     from physbench.loop import draw_problem
     from physbench.observation import simulate_observation
-    from physbench.params import ParamSpace, split_params
     from physbench.plugins import create
     from physbench.scenes.generator import resolve_scene
+    from physbench.unknowns import ParamSpace, split_params
 
     scene = resolve_scene(scene_name, seed)
     space = ParamSpace.from_scene(scene, split_params(params))

@@ -27,10 +27,10 @@ if TYPE_CHECKING:
     from physbench.estimators.base import CorrectionEstimator
     from physbench.loop import History, Iteration
     from physbench.observation import Observation
-    from physbench.params import ParamSpace
     from physbench.render.base import Renderer
     from physbench.render.camera import CameraRenderer
     from physbench.scene import Scene
+    from physbench.unknowns import ParamSpace
 
 #: The scene of a run that names none (and observes no file that carries one).
 DEFAULT_SCENE = "three_circles"
@@ -289,7 +289,7 @@ def model_engine(config: RunConfig, observed: Observation | None = None) -> str:
 
 def config_space(config: RunConfig, scene: Scene | None = None) -> ParamSpace:
     """The unknowns of ``config`` on its scene instance (``scene`` saves regenerating it)."""
-    from physbench.params import ParamSpace
+    from physbench.unknowns import ParamSpace
 
     scene = observed_scene(config) if scene is None else scene
     return ParamSpace.from_scene(
@@ -353,14 +353,14 @@ def run_config(
     :func:`~physbench.loop.refine`. The history's ``meta`` records the observation settings.
     ``callback`` receives each iteration's record; ``save_observation`` writes the frames used.
     ``probe``: first check that every unknown changes the rendered frames
-    (:mod:`physbench.identifiability`; the unseen are in ``History.unseen``, and ``notice``
-    receives one sentence about them before the loop starts)."""
+    (:mod:`physbench.posterior.identifiability`; the unseen are in ``History.unseen``, and
+    ``notice`` receives one sentence about them before the loop starts)."""
     _check_observation(config)
     from physbench.loop import draw_problem, refine
     from physbench.observation import save_observation as save_obs
     from physbench.observation import simulate_observation
     from physbench.plugins import create
-    from physbench.render.observe import ObservationModel
+    from physbench.render.sensor import SensorModel
 
     observed = load_observed(config)
     scene = observed_scene(config, observed)
@@ -385,7 +385,7 @@ def run_config(
     if observed is not None:
         obs = observed
     elif config.video:
-        from physbench.video.observe import video_observation
+        from physbench.video.footage import video_observation
 
         obs = video_observation(
             config.video,
@@ -398,7 +398,7 @@ def run_config(
             marked=marked,
         )
     elif config.observer:
-        from physbench.video.observe import filmed_observation
+        from physbench.video.footage import filmed_observation
 
         obs = filmed_observation(
             scene,
@@ -415,13 +415,13 @@ def run_config(
             create("simulator", config.observer_engine),
             renderer(),
             marked=marked,
-            camera=ObservationModel(blur=config.blur, noise=config.noise, seed=config.seed),
+            sensor=SensorModel(blur=config.blur, noise=config.noise, seed=config.seed),
         )
     if save_observation:
         save_obs(save_observation, obs)
     unseen: tuple[str, ...] = ()
     if probe:
-        from physbench import identifiability
+        from physbench.posterior import identifiability
 
         probes = identifiability.probe(scene, space, simulator, model_renderer, initial)
         unseen = identifiability.unseen(probes)

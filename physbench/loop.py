@@ -26,9 +26,9 @@ from physbench.errors import PhysbenchError, SimulationError
 from physbench.estimators.base import Step, Task
 from physbench.metrics import image_mse
 from physbench.observation import Observation, expected_shape, validate
-from physbench.params import Params, ParamSpace
 from physbench.plugins import guard
-from physbench.posterior import Posterior
+from physbench.posterior.samples import Posterior
+from physbench.unknowns import Params, ParamSpace
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -108,10 +108,11 @@ class History:
     options: dict[str, Any] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
     #: Unknowns that moved no pixel when probed before the run
-    #: (:mod:`physbench.identifiability`): their estimates are guesses. Empty when not probed.
+    #: (:mod:`physbench.posterior.identifiability`): their estimates are guesses. Empty when not
+    #: probed.
     unseen: tuple[str, ...] = ()
     #: Unknowns whose best estimate lies at an end of their range
-    #: (:meth:`~physbench.params.ParamSpace.at_bound`): the range, not the data, may hold them.
+    #: (:meth:`~physbench.unknowns.ParamSpace.at_bound`): the range, not the data, may hold them.
     at_bound: tuple[str, ...] = ()
     #: How sure the estimator is (:meth:`CorrectionEstimator.posterior`); ``None`` for an
     #: estimator that gives a point only.
@@ -249,7 +250,7 @@ def _check_posterior(name: str, space: ParamSpace, posterior: object) -> None:
     if not isinstance(posterior, Posterior):
         raise EstimatorError(
             f"estimator {name!r}: posterior() returned {type(posterior).__name__}, expected a "
-            "physbench.posterior.Posterior or None"
+            "physbench.posterior.samples.Posterior or None"
         )
     if posterior.keys != space.keys:
         raise EstimatorError(

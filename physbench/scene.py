@@ -203,7 +203,7 @@ class Joint:
     kind: Literal["pivot"] = "pivot"
 
 
-#: Unit of each body parameter, for the :class:`~physbench.params.Parameter` of an unknown.
+#: Unit of each body parameter, for the :class:`~physbench.unknowns.Parameter` of an unknown.
 BODY_UNITS: dict[str, str] = {"mass": "kg", "elasticity": "", "friction": "", "moment": "kg·m²"}
 
 

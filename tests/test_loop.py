@@ -26,8 +26,8 @@ from physbench.observation import (
     ObservationError,
     simulate_observation,
 )
-from physbench.params import ParamSpace
 from physbench.testing import ToyRenderer, ToySimulator, toy_task
+from physbench.unknowns import ParamSpace
 
 
 class Scripted(CorrectionEstimator):

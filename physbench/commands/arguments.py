@@ -15,7 +15,7 @@ The vocabulary (tests/commands/test_vocabulary.py walks every parser against it)
   :data:`DEFAULT_SCENE` where the command makes its own data (run, simulate, train) and is
   required where it must describe given data (track, discover).
 - ``--params`` takes one set of unknowns spelled ``mass+elasticity``, ``mass,elasticity`` or
-  ``mass elasticity`` (:func:`physbench.params.split_params`).
+  ``mass elasticity`` (:func:`physbench.unknowns.split_params`).
 - ``-q/--quiet`` on every command that prints more than its result or shows progress; progress
   goes to stderr and only on a terminal (:mod:`physbench.commands.console`).
 """
@@ -36,7 +36,7 @@ DEFAULT_SCENE = "three_circles"
 MAX_RESOLUTION = 4096
 #: Seeds go to numpy, random, torch and optuna; this is the range all of them accept.
 MAX_SEED = 2**32 - 1
-#: The widest ``--noise``: physbench.render.observe.MAX_NOISE, kept here for the same reason.
+#: The widest ``--noise``: physbench.render.sensor.MAX_NOISE, kept here for the same reason.
 MAX_NOISE = 1.0
 #: The epilog of the commands that refuse a job too big for this machine (physbench.cost; kept
 #: here so that building a parser imports nothing else).
@@ -125,7 +125,7 @@ def add_scene_argument(p: argparse.ArgumentParser, *, required: bool, help: str 
 
 def add_params_argument(p: argparse.ArgumentParser, *, help: str = "") -> None:
     """``--params``: one set of unknowns, as words, or joined by ``+`` or ``,``; read it with
-    :func:`physbench.params.split_params`."""
+    :func:`physbench.unknowns.split_params`."""
     p.add_argument(
         "--params",
         nargs="+",

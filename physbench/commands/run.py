@@ -235,7 +235,7 @@ def main(args: argparse.Namespace) -> int:
         default_render_mode,
         run_config,
     )
-    from physbench.params import split_params
+    from physbench.unknowns import split_params
 
     params = split_params(args.params)
     bodies = (

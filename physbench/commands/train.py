@@ -154,14 +154,14 @@ def main(args: argparse.Namespace) -> int:
     from physbench.commands.console import show_progress, wrote
     from physbench.errors import PhysbenchError
     from physbench.estimators.resnet3d import sidecar
-    from physbench.estimators.resnet3d.data import DataSpec
-    from physbench.estimators.resnet3d.model import NetConfig
+    from physbench.estimators.resnet3d.network import NetConfig
     from physbench.estimators.resnet3d.train import TrainConfig, train, weights_name
+    from physbench.estimators.resnet3d.training_data import DataSpec
     from physbench.experiment import make_renderer
-    from physbench.params import ParamSpace, split_params
     from physbench.plugins import get_registry
     from physbench.requirements import require
     from physbench.scenes.generator import resolve_scene
+    from physbench.unknowns import ParamSpace, split_params
 
     if args.posterior:
         return _posterior(args)
@@ -250,7 +250,7 @@ def main(args: argparse.Namespace) -> int:
         f"{meta['training']['samples_seen']} samples in {meta['training']['wall_s']:.0f} s"
     )
     if args.eval_seeds:
-        from physbench.estimators.resnet3d.evaluate import evaluate_weights
+        from physbench.bench.held_out import evaluate_weights
 
         rows = evaluate_weights(path, seeds=range(args.eval_seeds), iterations=11)
         for it in (1, 2, 11):
@@ -270,13 +270,13 @@ def _posterior(args: argparse.Namespace) -> int:
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
     from physbench.commands.console import wrote
     from physbench.errors import PhysbenchError
-    from physbench.estimators.npe.data import NPEDataSpec
     from physbench.estimators.npe.estimator import NPEEstimator
     from physbench.estimators.npe.train import NPETrainConfig, train, weights_name
+    from physbench.estimators.npe.training_data import NPEDataSpec
     from physbench.experiment import make_renderer
-    from physbench.params import ParamSpace, split_params
     from physbench.requirements import require
     from physbench.scenes.generator import is_scene_file, resolve_scene
+    from physbench.unknowns import ParamSpace, split_params
 
     require("estimator", "npe", NPEEstimator)
     params = split_params(args.params)

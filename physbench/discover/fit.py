@@ -330,8 +330,8 @@ def estimator_fit(
     ``random``, ...), one simulation per iteration, on the mean squared residual of the fit part;
     returns the best values found (the model's values are set to them)."""
     from physbench.estimators.base import Step, Task
-    from physbench.params import ParamSpace
     from physbench.plugins import create
+    from physbench.unknowns import ParamSpace
 
     est = create("estimator", estimator, **(options or {}))
     if type(est).per_object:

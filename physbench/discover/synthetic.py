@@ -520,9 +520,9 @@ def filmed_run(case: SyntheticRun, seed: int = 0, **camera: Any) -> Run:
     true motion: filmed by the ``camera`` renderer (options :data:`FILM`, overridden by
     ``camera``; the view frames where the bodies go), encoded, tracked with a four-point
     calibration, keeping the recording's fields
-    (:func:`~physbench.video.observe.filmed_recording`)."""
+    (:func:`~physbench.video.footage.filmed_recording`)."""
     from physbench.render.camera import CameraRenderer
-    from physbench.video.observe import filmed_recording, frame_trajectory, motion_view
+    from physbench.video.footage import filmed_recording, frame_trajectory, motion_view
 
     run, rec = case.run, case.run.recording
     if case.trajectory is None or rec is None:

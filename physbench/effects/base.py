@@ -72,7 +72,7 @@ class Effect(Requirements):
     """Base class of every effect (plugin contract).
 
     Subclasses set the class attributes :attr:`name` and :attr:`params` (each
-    :class:`~physbench.params.Parameter` with a ``default`` inside its range) and the traits they
+    :class:`~physbench.unknowns.Parameter` with a ``default`` inside its range) and the traits they
     need, and override :meth:`forces`, :meth:`restitution` or :meth:`measure` accordingly;
     :meth:`configure` is the place to precompute from the scene. Constructor keywords:
     ``bodies`` (names of the bodies it acts on; default all), ``label`` (the key prefix of its

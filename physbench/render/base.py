@@ -7,7 +7,7 @@ pose, a background, ...) is its own keyword option, given on the command line wi
 ``--renderer-option KEY=VALUE`` and in a sweep spec as ``renderer = {name = ..., options = {...}}``.
 
 An observation model (camera blur, pixel noise) is not part of a renderer: the framework applies
-:class:`~physbench.render.observe.ObservationModel` to the observed frames only, whatever renderer
+:class:`~physbench.render.sensor.SensorModel` to the observed frames only, whatever renderer
 made them.
 """
 

@@ -11,7 +11,7 @@ Model, in the order light goes through it:
   maps to the undistorted image by the homography ``K [r1 r2 t]``. A steep view may see past
   the plane's horizon: those pixels are dark (and textures alias near it, as they would).
 - **Lens**: Brown's radial distortion ``k1``, ``k2`` about the image centre, normalised by the
-  focal length in pixels (:class:`physbench.video.calibration.Lens`).
+  focal length in pixels (:class:`physbench.calibration.Lens`).
 - **Exposure**: the shutter is open for ``shutter`` of the frame interval, centred on the frame
   time; ``subframes`` poses (from each body's pose and velocity) are averaged: motion blur that
   keeps the blob's centroid at the frame-time position.
@@ -20,7 +20,7 @@ Model, in the order light goes through it:
 - **Sensor**: Gaussian noise of std ``noise``, quantised to 8 bits; optionally a real H.264
   encode and decode (``bitrate`` or ``crf``), so the frames are what a video file would hold.
 
-Pixel convention (that of :mod:`physbench.video.calibration`): ``u`` right, ``v`` down, pixel
+Pixel convention (that of :mod:`physbench.calibration`): ``u`` right, ``v`` down, pixel
 centres at integer coordinates. :meth:`CameraRenderer.calibration` is the true map.
 
 Every pixel's scene coordinates, the background and the light field are computed once per scene
@@ -39,10 +39,10 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from physbench.calibration import Calibration, Lens
 from physbench.hookspecs import hookimpl
 from physbench.render.base import Renderer, RenderError
 from physbench.scene import Circle, Segment
-from physbench.video.calibration import Calibration, Lens
 
 if TYPE_CHECKING:
     from physbench.scene import Scene

@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from physbench.calibration import Calibration
 from physbench.render.base import RenderError
 from physbench.render.camera import CameraRenderer
 from physbench.scene import Body, Box, Circle, Scene
 from physbench.testing import Check, Subject, parametrize_with_checks
 from physbench.testing.renderers import probe_scene, probe_trajectory
 from physbench.trajectory import Trajectory
-from physbench.video.calibration import Calibration
 
 #: A clean picture: no noise, no uneven or changing light, a uniform background.
 CLEAN = {"noise": 0.0, "light": 0.0, "flicker": 0.0, "background": "plain"}

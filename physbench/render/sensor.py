@@ -1,4 +1,4 @@
-"""How a camera degrades what a renderer draws: the observation model (:class:`ObservationModel`)
+"""How a camera degrades what a renderer draws: the observation model (:class:`SensorModel`)
 and its image filters, Gaussian blur and pixel noise (both take and return ``(..., H, W)`` float32
 arrays). The framework applies it to observed frames only, whatever renderer made them."""
 
@@ -59,7 +59,7 @@ def _nonneg(name: str, value: object) -> float:
 
 
 @dataclass(frozen=True)
-class ObservationModel:
+class SensorModel:
     """How a camera degrades what a renderer draws: Gaussian blur of ``blur`` pixels, then
     Gaussian pixel noise of standard deviation ``noise`` (drawn from ``seed`` afresh for every
     call, so an observation is a pure function of its inputs), clipped to [0, 1]. Applied to

@@ -12,7 +12,7 @@ from physbench.recording import Recording, Track
 from physbench.render.camera import CameraRenderer
 from physbench.render.raster import RasterRenderer
 from physbench.scenes import resolve_scene
-from physbench.video.observe import (
+from physbench.video.footage import (
     filmed_observation,
     filmed_recording,
     frame_trajectory,

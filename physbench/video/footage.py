@@ -23,6 +23,7 @@ import numpy as np
 from physbench.video.segment import SegmentError
 
 if TYPE_CHECKING:
+    from physbench.calibration import Calibration
     from physbench.observation import Observation
     from physbench.recording import Recording
     from physbench.render.base import Renderer
@@ -30,7 +31,6 @@ if TYPE_CHECKING:
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
     from physbench.trajectory import Trajectory
-    from physbench.video.calibration import Calibration
     from physbench.video.reader import Frame
 
 
@@ -93,12 +93,12 @@ def video_observation(
     marked: Iterable[str] = (),
 ) -> Observation:
     """The observation of a video file in ``renderer``'s frames (see the module docstring).
-    ``calibration``: a :class:`~physbench.video.calibration.Calibration` or a TOML file (default:
+    ``calibration``: a :class:`~physbench.calibration.Calibration` or a TOML file (default:
     ``scene.bounds`` fill the frame); ``background``: an image of the empty scene (array or file;
     default: the video's median)."""
+    from physbench.calibration import load_calibration
     from physbench.observation import Observation
     from physbench.video.background import load_plate, median_background
-    from physbench.video.calibration import load_calibration
     from physbench.video.reader import VideoReader
     from physbench.video.segment import (
         Segmenter,
@@ -175,7 +175,7 @@ def filmed_observation(
     """Simulate ``scene`` with the true parameters, film it with ``camera`` into an encoded video
     file, and read that back with :func:`video_observation`: calibrated from the four corners of
     ``scene.bounds`` as a user would click them, with the camera's plate as the background."""
-    from physbench.video.calibration import Calibration
+    from physbench.calibration import Calibration
 
     traj = simulator.simulate(scene, dict(truth))
     xmin, ymin, xmax, ymax = scene.bounds
@@ -233,7 +233,7 @@ def filmed_recording(
     the tracks in the scene's metres; ``fields`` and ``run`` label the recording."""
     from dataclasses import replace
 
-    from physbench.video.calibration import Calibration
+    from physbench.calibration import Calibration
     from physbench.video.track import track_video
 
     xmin, ymin, xmax, ymax = camera.view if camera.view is not None else scene.bounds
