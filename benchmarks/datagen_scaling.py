@@ -70,9 +70,9 @@ def simulate_groups(item: tuple[str, str, int, int]) -> int:
     parameters, ``simulate`` only; returns how many succeeded."""
     import numpy as np
 
+    from physbench.components import create
     from physbench.errors import SimulationError
     from physbench.estimators.resnet3d.training_data import TRAIN_SEED0
-    from physbench.plugins import create
     from physbench.unknowns import ParamSpace
 
     scene_name, params, seed, n = item

@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
+from physbench.components import create
 from physbench.estimators.smc import SMCEstimator
 from physbench.loop import draw_problem, refine
 from physbench.observation import simulate_observation
-from physbench.plugins import create
 from physbench.render.sensor import SensorModel
 from physbench.scenes import resolve_scene
 from physbench.unknowns import ParamSpace

@@ -12,23 +12,21 @@ and the engine that made it.
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from physbench.components import create, make_estimator, make_observer, make_renderer
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.estimators.base import DEFAULT_ESTIMATOR
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
-    from physbench.estimators.base import CorrectionEstimator
     from physbench.loop import History, Iteration
     from physbench.observation import Observation
     from physbench.render.base import Renderer
-    from physbench.render.camera import CameraRenderer
     from physbench.scene import Scene
     from physbench.unknowns import ParamSpace
 
@@ -123,97 +121,6 @@ _LATER = (
     "video_start",
     "video_end",
 )
-
-
-def _accepted(cls: type) -> str:
-    try:
-        names = [
-            q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")
-        ]
-    except (TypeError, ValueError):
-        names = []
-    return ", ".join(names) or "none"
-
-
-def _build(kind: str, name: str, options: Mapping[str, Any], **standard: Any) -> Any:
-    """The registered ``kind`` ``name`` built with ``options`` (and the kind's ``standard``
-    keywords); a constructor that refuses them becomes one sentence naming the options."""
-    from physbench.plugins import get_registry
-    from physbench.requirements import require
-
-    cls = get_registry().get(kind, name)
-    require(kind, name, cls)
-    try:
-        return cls(**standard, **dict(options))
-    except PhysbenchError:
-        raise
-    except TypeError as exc:
-        raise PhysbenchError(
-            f"{kind} {name!r} does not take options {dict(options)}: {exc}; "
-            f"its options: {_accepted(cls)}"
-        ) from None
-    except ValueError as exc:  # a plugin's own check, not phrased as a PhysbenchError
-        raise PhysbenchError(f"{kind} {name!r} refused options {dict(options)}: {exc}") from None
-
-
-def make_estimator(name: str, options: Mapping[str, Any]) -> CorrectionEstimator:
-    """Instantiate the registered estimator ``name``; options it does not take are refused with
-    the list of those it does."""
-    return _build("estimator", name, options)
-
-
-def default_render_mode(name: str) -> str:
-    """The channel layout of the registered renderer ``name`` when none is asked for: the first
-    it declares (``mark`` for raster, ``rgb`` for camera)."""
-    from physbench.plugins import get_registry
-
-    try:
-        cls = get_registry().get("renderer", name)
-    except UnknownNameError as exc:
-        raise PhysbenchError(str(exc)) from None
-    return str(cls.modes[0])
-
-
-def make_renderer(
-    name: str,
-    options: Mapping[str, Any],
-    *,
-    resolution: int | tuple[int, int],
-    mode: str | None,
-) -> Renderer:
-    """Instantiate the registered renderer ``name`` with its ``options`` and the standard
-    ``resolution`` and ``mode`` (``None``: :func:`default_render_mode`); options it does not take
-    are refused with the list of those it does."""
-    clash = sorted({"resolution", "mode"} & set(options))
-    if clash:
-        raise PhysbenchError(
-            f"renderer option {clash[0]!r}: set it with --resolution / --render-mode (in a sweep "
-            "spec: the resolution and render_mode axes), not as a renderer option"
-        )
-    if mode is None:
-        mode = default_render_mode(name)
-    return _build("renderer", name, options, resolution=resolution, mode=mode)
-
-
-#: Image width of an observer camera whose options name no ``resolution``.
-OBSERVER_RESOLUTION = 640
-
-
-def make_observer(name: str, options: Mapping[str, Any]) -> CameraRenderer:
-    """The camera renderer ``name`` that films a simulated observation: its ``options`` may hold
-    ``resolution`` (default :data:`OBSERVER_RESOLUTION`); it draws ``rgb`` frames and must be a
-    :class:`~physbench.render.camera.CameraRenderer` (the video path needs its plate)."""
-    from physbench.render.camera import CameraRenderer
-
-    opts = dict(options)
-    resolution = opts.pop("resolution", OBSERVER_RESOLUTION)
-    cam = _build("renderer", name, opts, resolution=resolution, mode="rgb")
-    if not isinstance(cam, CameraRenderer):
-        raise PhysbenchError(
-            f"observer {name!r} is a {type(cam).__name__}; an observer films the observation as "
-            "a video, so it must be a camera renderer (e.g. 'camera')"
-        )
-    return cam
 
 
 def _check_observation(config: RunConfig) -> None:
@@ -359,7 +266,6 @@ def run_config(
     from physbench.loop import draw_problem, refine
     from physbench.observation import save_observation as save_obs
     from physbench.observation import simulate_observation
-    from physbench.plugins import create
     from physbench.render.sensor import SensorModel
 
     observed = load_observed(config)

@@ -26,13 +26,12 @@ def evaluate_weights(
     so small seeds are held out. ``scene_options`` override the training ones (e.g. ``n_balls``);
     ``bodies`` restricts the unknowns to those bodies (the others keep the scene's values).
     """
+    from physbench.components import create, make_renderer
     from physbench.estimators.resnet3d import weights
     from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
     from physbench.estimators.resnet3d.training_data import DataSpec
-    from physbench.experiment import make_renderer
     from physbench.loop import draw_problem, refine
     from physbench.observation import simulate_observation
-    from physbench.plugins import create
     from physbench.render.sensor import SensorModel
     from physbench.unknowns import ParamSpace
 

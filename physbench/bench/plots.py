@@ -270,9 +270,8 @@ def landscape_data(
     ``body.param`` moved across its range, per key: ``{"x": Δp grid (points,), key: (seeds,
     points)}``, Δp relative to the nominal value (the range's middle); frames from ``renderer``
     with ``renderer_options``."""
-    from physbench.experiment import make_renderer
+    from physbench.components import create, make_renderer
     from physbench.metrics import image_mse
-    from physbench.plugins import create
     from physbench.scenes import resolve_scene
 
     sim = create("simulator", engine)

@@ -480,7 +480,8 @@ def load_spec(path: str | Path) -> Spec:
 def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
     """Build every estimator and renderer once and look up every name, so a bad spec fails
     before anything runs; errors name the spec file and the key."""
-    from physbench.experiment import config_space, make_estimator, make_observer, make_renderer
+    from physbench.components import make_estimator, make_observer, make_renderer
+    from physbench.experiment import config_space
     from physbench.plugins import get_registry
     from physbench.render.sensor import SensorModel
     from physbench.scenes import resolve_scene

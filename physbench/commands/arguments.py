@@ -232,7 +232,7 @@ def renderer_choice(args: argparse.Namespace) -> tuple[str, dict[str, Any]]:
 
 def make_renderer_from(args: argparse.Namespace) -> Any:
     """The renderer the parsed ``args`` choose, built with their resolution and render mode."""
-    from physbench.experiment import make_renderer
+    from physbench.components import make_renderer
 
     name, options = renderer_choice(args)
     return make_renderer(name, options, resolution=args.resolution, mode=args.render_mode)

@@ -228,13 +228,8 @@ def main(args: argparse.Namespace) -> int:
 
     from physbench.commands.arguments import parse_key_values, renderer_choice
     from physbench.commands.console import progress_bar, wrote
-    from physbench.experiment import (
-        DEFAULT_SCENE,
-        RunConfig,
-        check_config,
-        default_render_mode,
-        run_config,
-    )
+    from physbench.components import default_render_mode
+    from physbench.experiment import DEFAULT_SCENE, RunConfig, check_config, run_config
     from physbench.unknowns import split_params
 
     params = split_params(args.params)

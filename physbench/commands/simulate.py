@@ -79,8 +79,8 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
 
 def make_effects(items: list[str]) -> list:
     """Effect instances from ``--effect NAME[:KEY=VALUE,...]`` items."""
+    from physbench.components import create
     from physbench.errors import PhysbenchError
-    from physbench.plugins import create
 
     out = []
     for item in items:
@@ -96,7 +96,7 @@ def make_effects(items: list[str]) -> list:
                 raise PhysbenchError(
                     f"--effect {item!r}: expected NAME[:KEY=NUMBER,...], e.g. linear_drag:c=0.3"
                 ) from None
-        out.append(create("effect", name.strip(), **values))
+        out.append(create("effect", name.strip(), values))
     return out
 
 
@@ -106,9 +106,9 @@ def main(args: argparse.Namespace) -> int:
     import numpy as np
 
     from physbench.commands.console import wrote
+    from physbench.components import create
     from physbench.errors import PhysbenchError
-    from physbench.plugins import create
-    from physbench.render.camera import CameraRenderer
+    from physbench.render.base import Camera
     from physbench.scenes import resolve_scene
 
     suffix = Path(args.out).suffix.lower() if args.out else ""
@@ -133,7 +133,7 @@ def main(args: argparse.Namespace) -> int:
     scene = resolve_scene(args.scene or DEFAULT_SCENE, args.seed)
     scene = scene.with_params(parse_overrides(args.set)).validate()
     renderer = make_renderer_from(args)  # a bad renderer or option fails before simulating
-    camera = renderer if isinstance(renderer, CameraRenderer) else None
+    camera = renderer if isinstance(renderer, Camera) else None
     for flag, value, wants in (
         ("--out", args.out if video else None, "a video"),
         ("--plate", args.plate, "a plate"),
@@ -174,8 +174,10 @@ def main(args: argparse.Namespace) -> int:
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     if args.out and video:
+        from physbench.video.writer import write_clip
+
         assert camera is not None
-        camera.write(args.out, scene, traj)
+        write_clip(camera, args.out, scene, traj)
         wrote(args.out)
     elif args.out:
         from physbench.scene_toml import dumps_scene

@@ -152,12 +152,12 @@ def main(args: argparse.Namespace) -> int:
 
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
     from physbench.commands.console import show_progress, wrote
+    from physbench.components import make_renderer
     from physbench.errors import PhysbenchError
     from physbench.estimators.resnet3d import sidecar
     from physbench.estimators.resnet3d.network import NetConfig
     from physbench.estimators.resnet3d.train import TrainConfig, train, weights_name
     from physbench.estimators.resnet3d.training_data import DataSpec
-    from physbench.experiment import make_renderer
     from physbench.plugins import get_registry
     from physbench.requirements import require
     from physbench.scenes.generator import resolve_scene
@@ -269,11 +269,11 @@ def _posterior(args: argparse.Namespace) -> int:
 
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
     from physbench.commands.console import wrote
+    from physbench.components import make_renderer
     from physbench.errors import PhysbenchError
     from physbench.estimators.npe.estimator import NPEEstimator
     from physbench.estimators.npe.train import NPETrainConfig, train, weights_name
     from physbench.estimators.npe.training_data import NPEDataSpec
-    from physbench.experiment import make_renderer
     from physbench.requirements import require
     from physbench.scenes.generator import is_scene_file, resolve_scene
     from physbench.unknowns import ParamSpace, split_params

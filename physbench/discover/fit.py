@@ -329,11 +329,11 @@ def estimator_fit(
     """Search ``free`` with a registered black-box estimator (``tpe``, ``cmaes``, ``optuna``,
     ``random``, ...), one simulation per iteration, on the mean squared residual of the fit part;
     returns the best values found (the model's values are set to them)."""
+    from physbench.components import create
     from physbench.estimators.base import Step, Task
-    from physbench.plugins import create
     from physbench.unknowns import ParamSpace
 
-    est = create("estimator", estimator, **(options or {}))
+    est = create("estimator", estimator, options)
     if type(est).per_object:
         raise DiscoverError(
             f"estimator {estimator!r} corrects marked objects in images; discovery needs a "

@@ -139,6 +139,12 @@ class Effect(Requirements):
     # ----------------------------------------------------------------- configuration
 
     @classmethod
+    def option_names(cls) -> tuple[str, ...]:
+        """Called by the component factory when a user's options are refused: the options this
+        effect takes, ``bodies``, ``label`` and its parameters (each also as ``<key>.<param>``)."""
+        return ("bodies", "label", *(p.name for p in cls.params))
+
+    @classmethod
     def neutral(cls) -> dict[str, float] | None:
         """Parameter values at which the effect changes nothing (the simulated and measured
         trajectory equal those without it), or ``None`` when there are none (a contact law

@@ -21,13 +21,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from physbench.video.segment import SegmentError
+from physbench.video.writer import write_clip
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
     from physbench.observation import Observation
     from physbench.recording import Recording
-    from physbench.render.base import Renderer
-    from physbench.render.camera import CameraRenderer
+    from physbench.render.base import Camera, Renderer
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
     from physbench.trajectory import Trajectory
@@ -167,7 +167,7 @@ def filmed_observation(
     scene: Scene,
     truth: Mapping[str, float],
     simulator: Simulator,
-    camera: CameraRenderer,
+    camera: Camera,
     renderer: Renderer,
     *,
     marked: Iterable[str] = (),
@@ -184,7 +184,7 @@ def filmed_observation(
     cal = Calibration.from_points(camera.image_points(scene, corners), corners, lens=true.lens)
     with tempfile.TemporaryDirectory(prefix="physbench-film-") as tmp:
         clip = Path(tmp) / "observation.mp4"
-        camera.write(clip, scene, traj)
+        write_clip(camera, clip, scene, traj)
         obs = video_observation(
             clip, scene, renderer, calibration=cal, background=camera.plate(scene), marked=marked
         )
@@ -222,7 +222,7 @@ def frame_trajectory(traj: Trajectory, times: np.ndarray) -> Trajectory:
 def filmed_recording(
     scene: Scene,
     traj: Trajectory,
-    camera: CameraRenderer,
+    camera: Camera,
     *,
     fields: tuple[str, ...] | None = None,
     run: str = "",
@@ -243,7 +243,7 @@ def filmed_recording(
     )
     with tempfile.TemporaryDirectory(prefix="physbench-film-") as tmp:
         clip = Path(tmp) / "run.mp4"
-        camera.write(clip, scene, traj)
+        write_clip(camera, clip, scene, traj)
         rec = track_video(clip, scene, cal, background=camera.plate(scene)).recording
     return replace(
         rec,

@@ -8,9 +8,9 @@ from typing import Any
 
 import pytest
 
+from physbench.components import create
 from physbench.loop import History, draw_problem, refine
 from physbench.observation import simulate_observation
-from physbench.plugins import create
 from physbench.scenes import resolve_scene
 from physbench.unknowns import ParamSpace
 

@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from physbench.components import create
 from physbench.estimators.options import EstimatorOptionError
 from physbench.estimators.smc import SMCEstimator, next_beta, systematic_resample
 from physbench.loop import History, draw_problem, refine
 from physbench.observation import simulate_observation
-from physbench.plugins import create
 from physbench.render.sensor import SensorModel
 from physbench.scenes import resolve_scene
 from physbench.testing.toy import ToyRenderer, ToySimulator, toy_scene

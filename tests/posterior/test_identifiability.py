@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
+from physbench.components import create
 from physbench.experiment import RunConfig, config_space, run_config
 from physbench.loop import History, draw_problem
-from physbench.plugins import create
 from physbench.posterior.identifiability import describe, probe, unseen
 from physbench.render.raster import RasterRenderer
 from physbench.scenes.generator import resolve_scene

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from physbench.calibration import Calibration
-from physbench.plugins import create
+from physbench.components import create
 from physbench.render.camera import CameraRenderer
 from physbench.render.raster import RasterRenderer
 from physbench.scene import Body, Box, Circle, Scene

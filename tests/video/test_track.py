@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from physbench.calibration import Calibration
-from physbench.plugins import create
+from physbench.components import create
 from physbench.scene import Body, Box, Circle, Scene
 from physbench.scenes import bouncing_balls
 from physbench.video.reader import Frame, VideoReader
@@ -157,7 +157,7 @@ def test_touching_boxes_and_a_ball_split_along_their_outlines(film) -> None:
 def test_a_folder_of_images_is_tracked_at_the_scenes_frame_rate(tmp_path) -> None:
     from PIL import Image
 
-    from physbench.plugins import create
+    from physbench.components import create
     from physbench.render.camera import CameraRenderer
 
     scene = bouncing_balls.generate(1, n_balls=2)

@@ -58,9 +58,8 @@ def unit_vector(space: ParamSpace, keys: list[str], params: dict[str, float]) ->
 def simulate_pairs(spec: NPEDataSpec, seeds: range) -> tuple[np.ndarray, np.ndarray]:
     """Features ``(N, F)`` and unit targets ``(N, P)``, one row per unknown body of each seed's
     simulation (a simulation that fails is skipped). Called by training for its data sets."""
+    from physbench.components import create, make_renderer
     from physbench.errors import SimulationError
-    from physbench.experiment import make_renderer
-    from physbench.plugins import create
     from physbench.unknowns import ParamSpace
 
     sim = create("simulator", spec.engine)

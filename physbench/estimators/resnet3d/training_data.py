@@ -83,8 +83,7 @@ class PairMaker:
     """Builds sample groups for one :class:`DataSpec` (one per worker process)."""
 
     def __init__(self, spec: DataSpec) -> None:
-        from physbench.experiment import make_renderer
-        from physbench.plugins import create
+        from physbench.components import create, make_renderer
 
         self.spec = spec
         spec.instance(0)  # an unknown name or a bad file fails here, not in a worker
