@@ -48,11 +48,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from physbench.commands.arguments import MAX_RESOLUTION, MAX_SEED
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
+from physbench.limits import MAX_NOISE, MAX_RESOLUTION, MAX_SEED
 from physbench.render.base import DEFAULT_RENDERER
-from physbench.render.sensor import MAX_NOISE
 from physbench.simulators.base import DEFAULT_SIMULATOR
 from physbench.unknowns import split_params
 

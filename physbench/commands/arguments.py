@@ -28,16 +28,12 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from physbench.limits import MAX_RESOLUTION, MAX_SCENE_ARGUMENT, MAX_SEED
+
 #: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
 RENDER_MODES = ("mark", "instance", "mask", "rgb")
 #: physbench.experiment.DEFAULT_SCENE, for the same reason.
 DEFAULT_SCENE = "three_circles"
-#: The widest frame in pixels: a (T, C, H, W) float32 sequence at 4096 px already takes GiBs.
-MAX_RESOLUTION = 4096
-#: Seeds go to numpy, random, torch and optuna; this is the range all of them accept.
-MAX_SEED = 2**32 - 1
-#: The widest ``--noise``: physbench.render.sensor.MAX_NOISE, kept here for the same reason.
-MAX_NOISE = 1.0
 #: The epilog of the commands that refuse a job too big for this machine (physbench.cost; kept
 #: here so that building a parser imports nothing else).
 SIZE_CHECK_HELP = (
@@ -46,8 +42,6 @@ SIZE_CHECK_HELP = (
     "is available or more than 24 h of compute is refused, naming the estimate. Set the "
     "environment variable PHYSBENCH_NO_SIZE_CHECK=1 to run it anyway (docs/architecture.md)."
 )
-#: The longest ``--scene``: Linux's PATH_MAX (a longer path cannot name a file).
-MAX_SCENE_ARGUMENT = 4096
 
 
 def bounded_int(low: int, high: int | None = None) -> Callable[[str], int]:

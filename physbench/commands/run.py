@@ -14,8 +14,6 @@ import sys
 from typing import Any
 
 from physbench.commands.arguments import (
-    MAX_NOISE,
-    MAX_RESOLUTION,
     SIZE_CHECK_HELP,
     add_json_argument,
     add_params_argument,
@@ -27,6 +25,7 @@ from physbench.commands.arguments import (
     positive_int,
     seed_int,
 )
+from physbench.limits import MAX_NOISE, MAX_RESOLUTION
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from physbench.limits import MAX_NOISE
 from physbench.render.base import RenderError
 
 
@@ -40,11 +41,6 @@ def add_noise(frames: np.ndarray, sigma: float, rng: np.random.Generator) -> np.
         out += rng.standard_normal(out.shape, dtype=np.float32) * np.float32(sigma)
         np.clip(out, 0.0, 1.0, out=out)
     return out
-
-
-#: The widest pixel noise (standard deviation): pixel values lie in [0, 1], so noise of 1 already
-#: drowns every frame; more is a typo.
-MAX_NOISE = 1.0
 
 
 def _nonneg(name: str, value: object) -> float:
