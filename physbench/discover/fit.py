@@ -330,7 +330,8 @@ def estimator_fit(
     ``random``, ...), one simulation per iteration, on the mean squared residual of the fit part;
     returns the best values found (the model's values are set to them)."""
     from physbench.components import create
-    from physbench.estimators.base import Step, Task
+    from physbench.estimators.base import Task
+    from physbench.loop import Evaluation, drive
     from physbench.unknowns import ParamSpace
 
     est = create("estimator", estimator, options)
@@ -346,28 +347,31 @@ def estimator_fit(
     current = {k: min(max(model.values[k], p.low), p.high) for k, p in zip(free, ps, strict=True)}
     r0 = model.residuals("fit", current)
     worst = FAILED_RESIDUAL**2 * max(float(np.mean(r0 * r0)), 1e-18)
-    est.start(
-        Task(
-            scene=model.problem.runs[0].scene,
-            space=space,
-            observation=np.zeros((0, 1, 1, 1), np.float32),
-            initial=current,
-            renderer=None,
-            iterations=iterations,
-        ),
-        seed=seed,
-    )
-    best, best_loss = dict(current), float(np.mean(r0 * r0))
-    params = dict(current)
-    for k in range(iterations):
+    none = np.zeros((0, 1, 1, 1), np.float32)  # no frames: the loss is on trajectories
+
+    def evaluate(params: dict[str, float]) -> Evaluation:
         try:
             r = model.residuals("fit", params)
-            loss = float(np.mean(r * r))
-        except SimulationError:
-            loss = worst
-        if loss < best_loss:
-            best, best_loss = dict(params), loss
-        params = dict(est.propose(Step(k, dict(params), np.zeros((0, 1, 1, 1), np.float32), loss)))
+            return Evaluation(float(np.mean(r * r)), none)
+        except SimulationError as exc:
+            return Evaluation(worst, none, failed=str(exc))
+
+    best, best_loss = dict(current), float(np.mean(r0 * r0))
+
+    def visit(k: int, params: dict[str, float], ev: Evaluation, t_estimator: float) -> None:
+        nonlocal best, best_loss
+        if ev.loss < best_loss:
+            best, best_loss = dict(params), ev.loss
+
+    task = Task(
+        scene=model.problem.runs[0].scene,
+        space=space,
+        observation=none,
+        initial=current,
+        renderer=None,
+        iterations=iterations,
+    )
+    drive(est, task, evaluate, seed=seed, visit=visit)
     model.values.update(best)
     return best
 
