@@ -146,8 +146,8 @@ def render_frames(
 
 
 def _config_settings(settings: Mapping[str, Any]) -> dict[str, Any]:
-    """``run``'s keywords as :class:`~physbench.experiment.RunConfig` fields: a single parameter
-    or body may be given as a string, lists as tuples, the scene file as a path."""
+    """``run``'s keywords as :class:`~physbench.experiment.RunConfig` fields: a single parameter,
+    body or effect may be given as a string, lists as tuples, the scene file as a path."""
     from physbench.experiment import RunConfig
 
     known = [f.name for f in fields(RunConfig)]
@@ -164,7 +164,11 @@ def _config_settings(settings: Mapping[str, Any]) -> dict[str, Any]:
             f"run(scene={type(scene).__name__}): expected a registered scene name or a scene "
             "TOML path; write a Scene object with physbench.scene_toml.save_scene first"
         )
-    for key in ("params", "bodies"):
+    if kw.get("params") is not None:
+        from physbench.unknowns import split_params
+
+        kw["params"] = split_params(kw["params"])  # "mass+elasticity" as on the command line
+    for key in ("bodies", "effects"):
         value = kw.get(key)
         if isinstance(value, str):
             kw[key] = (value,)
@@ -178,12 +182,15 @@ def run(**settings: Any) -> History:
     of :class:`~physbench.experiment.RunConfig` (``scene``, ``params``, ``estimator``,
     ``options``, ``seed``, ``iterations``, ``engine``, ``renderer``, ``resolution``, ...), with
     the same defaults. An unknown that moves no pixel is named in a :class:`UserWarning` and kept
-    in ``History.unseen``.
+    in ``History.unseen``. ``params`` may name scene-level unknowns by key and give any unknown a
+    range, as ``--params`` does (``"gravity=-11:-9"``); ``effects`` are ``--effect`` texts.
 
     Example::
 
         h = physbench.run(scene="three_circles", params="mass", estimator="cmaes", iterations=5)
         h.truth, h.best.params, h.best_nmse
+        g = physbench.run(scene="toss.toml", video="toss.mp4", params="gravity", iterations=40)
+        d = physbench.run(scene="toss.toml", effects="linear_drag", params="linear_drag.c=0:0.5")
     """
     import warnings
 

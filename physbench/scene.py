@@ -207,6 +207,21 @@ class Joint:
 BODY_UNITS: dict[str, str] = {"mass": "kg", "elasticity": "", "friction": "", "moment": "kg·m²"}
 
 
+#: The scene's gravity along y as an unknown (``--params gravity``): scenes are y-up, so this is
+#: minus g. The default range spans Earth's g with room for a wrong scale or clock (a ball toss
+#: filmed with a tape off by a few per cent); it is a typical span, not a limit, so a run may set
+#: another (``gravity=-2:2`` for a tilted table seen from above). The x component stays as the
+#: scene says: a horizontal pull is the same as a rotated camera, which is discovery's question.
+GRAVITY = Parameter(
+    "gravity",
+    -12.0,
+    -8.0,
+    unit="m/s²",
+    doc="gravity along y (minus g in a y-up scene)",
+    extensible=True,
+)
+
+
 def body_unknown(body: str, param: str, low: float, high: float) -> Parameter:
     """The declaration that ``body.param`` is unknown and lies somewhere in ``[low, high]``."""
     unit = BODY_UNITS.get(param, "") if isinstance(param, str) else ""  # validated later
@@ -263,11 +278,16 @@ class Scene:
         )
 
     def with_params(self, params: Mapping[str, float]) -> Scene:
-        """A copy with ``{"body.param": value}`` applied. Called once per simulation."""
+        """A copy with ``{"body.param": value}`` (and ``{"gravity": gy}``, :data:`GRAVITY`)
+        applied. Called once per simulation."""
         if not params:
             return self
         changes: dict[str, dict[str, float]] = {}
+        world: dict[str, object] = {}
         for key, value in params.items():
+            if key == GRAVITY.key:
+                world["gravity"] = (self.gravity[0], float(value))
+                continue
             body, _, param = key.rpartition(".")
             if param not in BODY_PARAMS:
                 raise SceneError(
@@ -283,7 +303,7 @@ class Scene:
         bodies = tuple(
             replace(b, **changes[b.name]) if b.name in changes else b for b in self.bodies
         )
-        return replace(self, bodies=bodies)
+        return replace(self, bodies=bodies, **world)  # type: ignore[arg-type]
 
     def validate(self) -> Scene:
         """Check every value; raise :class:`SceneError` naming the first bad key. Returns self."""
@@ -384,6 +404,12 @@ def _check_param(key: str, param: str, value: float) -> None:
             raise SceneError(f"{param} must be > 0", key=key, value=value)
     elif not lo <= value <= hi:
         raise SceneError(f"{param} must lie in [{lo}, {hi}]", key=key, value=value)
+
+
+def check_body_param(key: str, param: str, value: float) -> None:
+    """Raise :class:`SceneError` naming ``key`` when ``value`` is not a value body parameter
+    ``param`` can take (a mass in :data:`MASS`, an elasticity in [0, 1], ...)."""
+    _check_param(key, param, value)
 
 
 def validate_scene(scene: Scene) -> None:

@@ -64,7 +64,20 @@ def _add_problem_arguments(p: argparse.ArgumentParser) -> None:
         help="with an --observation file that carries its scene, that scene instance, which "
         "--scene must name",
     )
-    add_params_argument(p)
+    add_params_argument(
+        p,
+        help="or a scene-level key: gravity, camera.scale, camera.clock, an --effect's parameter "
+        "(linear_drag.c); KEY=LOW:HIGH gives any of them a range (gravity=-11:-9)",
+    )
+    p.add_argument(
+        "--effect",
+        action="append",
+        default=[],
+        metavar="NAME[:KEY=VALUE,...]",
+        help="simulate the model (and a simulated observation) with this effect, e.g. linear_drag "
+        "or linear_drag:c=0.3 (repeatable; see `physbench plugins`); --params may name its "
+        "parameters (linear_drag.c)",
+    )
     p.add_argument(
         "--bodies",
         nargs="+",
@@ -304,6 +317,7 @@ def _build_config(args: argparse.Namespace) -> Any:
         background=args.background,
         video_start=args.start,
         video_end=args.end,
+        effects=tuple(args.effect),
     )
     check_config(config)  # a bad name or option: fail before the progress bar appears
     return config
@@ -372,7 +386,7 @@ def _warn_about_result(history: Any) -> None:
         print(
             f"physbench run: warning: {', '.join(history.at_bound)} ended at an end of "
             "its range: the range, not the data, may hold the estimate; widen the unknown's range "
-            "in the scene (a scene TOML's [[unknowns]]) and run again",
+            "(--params KEY=LOW:HIGH, or a scene TOML's [[unknowns]]) and run again",
             file=sys.stderr,
         )
     post = history.posterior

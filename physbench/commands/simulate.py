@@ -80,25 +80,9 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
 
 def make_effects(items: list[str]) -> list:
     """Effect instances from ``--effect NAME[:KEY=VALUE,...]`` items."""
-    from physbench.components import create
-    from physbench.errors import PhysbenchError
+    from physbench.components import make_effect
 
-    out = []
-    for item in items:
-        name, _, rest = item.partition(":")
-        values: dict[str, float] = {}
-        for pair in filter(None, (p.strip() for p in rest.split(","))):
-            key, sep, value = pair.partition("=")
-            try:
-                if not sep or not key.strip():
-                    raise ValueError
-                values[key.strip()] = float(value)
-            except ValueError:
-                raise PhysbenchError(
-                    f"--effect {item!r}: expected NAME[:KEY=NUMBER,...], e.g. linear_drag:c=0.3"
-                ) from None
-        out.append(create("effect", name.strip(), values))
-    return out
+    return [make_effect(item) for item in items]
 
 
 def main(args: argparse.Namespace) -> int:
