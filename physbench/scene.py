@@ -305,6 +305,46 @@ class Scene:
         )
         return replace(self, bodies=bodies, **world)  # type: ignore[arg-type]
 
+    def scaled(self, factor: float) -> Scene:
+        """A copy with every length multiplied by ``factor`` about the origin (positions,
+        velocities, gravity, shapes, statics, anchors) and the bounds kept: the scene as a
+        calibration off by ``1 / factor`` shows it in the same frame. Called for every point a run
+        simulates with a ``camera.scale`` (:func:`physbench.unknowns.simulate_seen`)."""
+        f = float(factor)
+
+        def v(p: Vec) -> Vec:
+            return (f * p[0], f * p[1])
+
+        def shape(sh: Shape) -> Shape:
+            if isinstance(sh, Circle):
+                return Circle(f * sh.radius)
+            if isinstance(sh, Box):
+                return Box(f * sh.width, f * sh.height)
+            return Polygon(tuple(v(p) for p in sh.points))
+
+        def static(st: Static) -> Static:
+            if isinstance(st, Segment):
+                return replace(st, a=v(st.a), b=v(st.b), radius=f * st.radius)
+            return replace(st, points=tuple(v(p) for p in st.points))
+
+        bodies = tuple(
+            replace(
+                b,
+                shape=shape(b.shape),
+                position=v(b.position),
+                velocity=v(b.velocity),
+                com_offset=v(b.com_offset),
+            )
+            for b in self.bodies
+        )
+        return replace(
+            self,
+            bodies=bodies,
+            statics=tuple(static(st) for st in self.statics),
+            joints=tuple(replace(j, anchor=v(j.anchor)) for j in self.joints),
+            gravity=v(self.gravity),
+        )
+
     def validate(self) -> Scene:
         """Check every value; raise :class:`SceneError` naming the first bad key. Returns self."""
         validate_scene(self)

@@ -42,9 +42,9 @@ AT_BOUND = 1e-3
 #: Owner of the measurement parameters: the camera (or other recorder) that made the observation.
 CAMERA = "camera"
 #: The calibration's scale error: true metres per metre of the calibration the observation was
-#: measured with (1: the calibration is right). A tape measure off by 2 % is 1.02. It scales the
-#: observation about the scene's origin, positions and sizes alike, so the model is seen through
-#: the same error: the rendered world's bounds are multiplied by it.
+#: measured with (1: the calibration is right; 1.02 when what it calls 1 m is truly 1.02 m). It
+#: scales the observation about the scene's origin, positions and sizes alike, so the model is
+#: seen through the same error: every length of the simulated world is divided by it.
 CAMERA_SCALE = Parameter(
     "scale", 0.9, 1.1, owner=CAMERA, doc="true metres per metre of the calibration"
 )
@@ -137,20 +137,6 @@ def with_range(p: Parameter, bounds: tuple[float, float] | None, *, body: bool) 
     return replace(p, low=low, high=high)
 
 
-def camera_view(scene: Scene, params: Mapping[str, float]) -> tuple[Scene, Params]:
-    """``scene`` as the camera of ``params`` sees it, and the other values: ``camera.scale``
-    multiplies the world's bounds (so whatever is drawn in them looks that much smaller),
-    ``camera.clock`` divides the frame rate the world is sampled at. Without camera values, the
-    scene itself."""
-    rest = {k: v for k, v in params.items() if k not in _CAMERA_KEYS}
-    if len(rest) == len(params):
-        return scene, rest
-    s = float(params.get(CAMERA_SCALE.key, 1.0))
-    c = float(params.get(CAMERA_CLOCK.key, 1.0))
-    bounds = tuple(s * b for b in scene.bounds)
-    return replace(scene, bounds=bounds, fps=scene.fps / c), rest  # type: ignore[arg-type]
-
-
 def scene_values(params: Mapping[str, float], effects: Iterable[Effect] = ()) -> Params:
     """The values of ``params`` that :meth:`Scene.with_params <physbench.scene.Scene.with_params>`
     takes: the body parameters and gravity, without the camera's and the ``effects``'."""
@@ -165,16 +151,26 @@ def simulate_seen(
     effects: Sequence[Effect] = (),
 ) -> tuple[Scene, Trajectory]:
     """Called for every point a run simulates (the observation's truth, each iteration, each
-    probe): simulate ``params`` on ``scene`` as the camera sees it (:func:`camera_view`), the
-    body, gravity and effect values applied by the simulator, then pass the trajectory through
-    every measurement effect (:attr:`~physbench.effects.base.Effect.measures`). Returns the
-    scene to render the trajectory in and the trajectory."""
-    view, rest = camera_view(scene, params)
-    traj = simulator.simulate(view, rest, effects=effects)
+    probe): simulate ``params`` on ``scene``, the body, gravity and effect values applied by the
+    simulator, pass the trajectory through every measurement effect
+    (:attr:`~physbench.effects.base.Effect.measures`), and see it through the camera's values:
+    ``camera.clock`` samples the world at ``fps / clock``, ``camera.scale`` divides every length
+    of the world and its motion by the scale (:meth:`Scene.scaled
+    <physbench.scene.Scene.scaled>`), as a calibration off by it shows them, in the same frame.
+    Returns the scene to render the trajectory in and the trajectory."""
+    rest = {k: v for k, v in params.items() if k not in _CAMERA_KEYS}
+    clock, scale = params.get(CAMERA_CLOCK.key), params.get(CAMERA_SCALE.key)
+    timed = scene if clock is None else replace(scene, fps=scene.fps / float(clock))
+    traj = simulator.simulate(timed, rest, effects=effects)
     for eff in effects:
         if eff.measures:
             traj = eff.measure(traj)
-    return view, traj
+    if scale is None:
+        return scene, traj
+    f = 1.0 / float(scale)
+    states = traj.states.copy()
+    states[..., [0, 1, 3, 4]] *= f
+    return scene.scaled(f), type(traj)(traj.bodies, traj.times, states, engine=traj.engine)
 
 
 @dataclass(frozen=True)

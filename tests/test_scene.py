@@ -13,6 +13,7 @@ import pytest
 from physbench.errors import SceneError, UnknownNameError
 from physbench.scene import (
     BODY_PARAMS,
+    GRAVITY,
     Body,
     Box,
     Circle,
@@ -296,3 +297,10 @@ def test_polygon_geometry_matches_the_box_it_draws() -> None:
 def test_inertia_is_the_shapes_unless_the_moment_is_set() -> None:
     assert A.inertia() == 0.5 * 2.0 * 0.25
     assert dataclasses.replace(A, moment=0.125).inertia() == 0.125
+
+
+def test_with_params_sets_gravity_along_y_and_keeps_x() -> None:
+    tilted = dataclasses.replace(GOOD, gravity=(0.5, -9.81))
+    got = tilted.with_params({"gravity": -9.7, "a.mass": 2.0})
+    assert got.gravity == (0.5, -9.7) and got.bodies[0].mass == 2.0
+    assert GRAVITY.key == "gravity" and GRAVITY.extensible
