@@ -311,8 +311,10 @@ class ParamSpace:
 
     def normalized_mse(self, estimate: Mapping[str, float], truth: Mapping[str, float]) -> float:
         """The paper's metric: each parameter divided by the maximum of its range, MSE over
-        unknowns."""
-        d = (self.to_vector(estimate) - self.to_vector(truth)) / self.high
+        unknowns. (A range below zero, gravity's, is divided by its largest magnitude; for the
+        body parameters, never negative, that is the maximum.)"""
+        scale = np.maximum(np.abs(self.low), np.abs(self.high))
+        d = (self.to_vector(estimate) - self.to_vector(truth)) / scale
         return float(np.mean(d * d))
 
     def subset(self, body: str) -> ParamSpace:

@@ -180,6 +180,41 @@ def test_refine_is_the_loop_with_every_part_given() -> None:
     assert len(h) == 3 and h.keys == ("a.mass", "b.mass")
 
 
+def test_run_and_refine_take_scene_level_unknowns_as_the_command_line_does() -> None:
+    from physbench.components import create
+    from physbench.effects import LinearDrag
+    from physbench.observation import simulate_observation
+
+    h = physbench.run(
+        scene="three_circles",
+        params="mass+gravity=-11:-9+linear_drag.c=0:0.5",  # the words of run --params
+        effects="linear_drag",
+        iterations=2,
+        resolution=16,
+    )
+    assert h.keys == ("a.mass", "b.mass", "gravity", "linear_drag.c")
+    assert -11 <= h.truth["gravity"] <= -9 and h.meta["effects"] == ["linear_drag"]
+    sc = physbench.make_scene("three_circles")
+    sim, ren, drag = PymunkSimulator(), create("renderer", "raster", resolution=16), LinearDrag()
+    obs = simulate_observation(
+        sc, {"gravity": -9.5, "linear_drag.c": 0.3}, sim, ren, effects=[drag]
+    )
+    h = physbench.refine(
+        obs,
+        sc,
+        ["gravity", "linear_drag.c"],
+        sim,
+        ren,
+        create("estimator", "random"),
+        iterations=3,
+        effects=[drag],
+    )
+    assert h.keys == ("gravity", "linear_drag.c") and h.truth == {
+        "gravity": -9.5,
+        "linear_drag.c": 0.3,
+    }
+
+
 # ---------------------------------------------------------------- sweeps and their table
 
 

@@ -304,3 +304,21 @@ def test_with_params_sets_gravity_along_y_and_keeps_x() -> None:
     got = tilted.with_params({"gravity": -9.7, "a.mass": 2.0})
     assert got.gravity == (0.5, -9.7) and got.bodies[0].mass == 2.0
     assert GRAVITY.key == "gravity" and GRAVITY.extensible
+
+
+def test_scaled_multiplies_every_length_about_the_origin_and_keeps_the_bounds() -> None:
+    scene = dataclasses.replace(
+        GOOD,
+        statics=(
+            Segment((0.0, 0.0), (4.0, 0.0), radius=0.1),
+            StaticPolygon(((1, 1), (2, 1), (2, 2))),
+        ),
+        joints=(Joint("a", (1.0, 2.0)),),
+    )
+    half = scene.scaled(0.5)
+    assert half.bounds == scene.bounds and half.gravity == (0.0, -9.81 / 2)
+    assert half.bodies[0].shape == Circle(0.25) and half.bodies[0].position == (0.5, 0.5)
+    assert half.bodies[1].shape == Box(0.5, 0.25) and half.bodies[1].mass == B.mass
+    assert half.statics[0] == Segment((0.0, 0.0), (2.0, 0.0), radius=0.05)
+    assert half.statics[1].points == ((0.5, 0.5), (1.0, 0.5), (1.0, 1.0))
+    assert half.joints[0].anchor == (0.5, 1.0)

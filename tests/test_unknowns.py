@@ -173,3 +173,8 @@ def test_the_camera_changes_how_the_world_is_seen_and_the_rest_goes_to_the_simul
     # A measurement effect measures what was simulated.
     _, shifted = simulate_seen(sim, scene, {"sensor_offset.dx": 0.3}, [SensorOffset()])
     np.testing.assert_allclose(shifted.states[:, 0, 0], sim.simulate(scene).states[:, 0, 0] + 0.3)
+
+
+def test_the_normalized_error_of_gravity_divides_by_its_largest_magnitude() -> None:
+    space = ParamSpace.from_scene(_toss(), ["gravity=-12:0"], offered=scene_parameters())
+    assert space.normalized_mse({"gravity": -9.0}, {"gravity": -10.2}) == pytest.approx(0.01)
