@@ -86,7 +86,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--init",
         default="",
-        help="fine-tune: start from these weights (.safetensors) instead of a fresh network",
+        help="fine-tune: start from these weights (.safetensors) instead of a fresh network; "
+        "their --widths must match, --resolution and --frames may differ (a bigger input from "
+        "the same tensors); training draws scene instances after the ones they were trained on",
     )
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
     add_renderer_choice(p)

