@@ -34,3 +34,19 @@ def test_integer_factor_resize_is_the_block_mean_to_the_last_bit(
     out = resize(frames, size)
     assert out.dtype == np.float32 and out.shape == block_mean.shape
     assert np.array_equal(out, block_mean)
+
+
+def test_make_input_writes_into_a_given_slot_and_refuses_a_wrong_one() -> None:
+    rng = np.random.default_rng(1)
+    obs, sim = rng.random((2, 30, 2, 64, 64), dtype=np.float32)
+    batch = np.zeros((2, 2, 30, 32, 32), np.float32)
+    x = make_input(obs, sim, frames=15, resolution=32, out=batch[1])
+    assert x is batch[1] or np.shares_memory(x, batch)
+    assert np.array_equal(batch[1], make_input(obs, sim, frames=15, resolution=32))
+    assert not batch[0].any()
+    # Every frame at the input's own size: the sequences as they are, observed first.
+    full = make_input(obs, sim, frames=30, resolution=64)
+    assert np.array_equal(full[:, :30], obs.transpose(1, 0, 2, 3))
+    assert np.array_equal(full[:, 30:], sim.transpose(1, 0, 2, 3))
+    with pytest.raises(ValueError, match="expected"):
+        make_input(obs, sim, frames=15, resolution=32, out=np.zeros((2, 30, 16, 16), np.float32))
