@@ -37,6 +37,7 @@ training curve, under ``ARM/``).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -447,6 +448,24 @@ def main() -> int:
         "seeds_asked": args.seeds,
     }
     procs = launch(args, runs, workers)
+    try:
+        return run(args, info, procs, runs, out, t0, cores)
+    finally:  # whatever failed, no trainer or data worker outlives this script
+        for p in procs.values():
+            if p.poll() is None:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(p.pid, signal.SIGKILL)
+
+
+def run(
+    args: argparse.Namespace,
+    info: dict[str, Any],
+    procs: dict[str, Any],
+    runs: Path,
+    out: Path,
+    t0: float,
+    cores: int,
+) -> int:
     if args.device.startswith("cuda"):
         probe = subprocess.run(
             [sys.executable, "-c", "import torch; print(torch.cuda.get_device_name(0))"],
@@ -472,6 +491,9 @@ def main() -> int:
             if path is not None:
                 models[row][arm] = str(path)
     print(f"[{time.time() - t0:5.0f} s] weights: {made}", flush=True)
+    result: dict[str, Any] = {"info": info, "exit": codes, "weights": made, "models": models}
+    # Written now and again after the evaluation: the weights come back even if it never ends.
+    write_outputs(out, runs, args.arms, {**result, "training": curves(runs)}, None)
 
     cells = evaluate(models, args.seeds, t0 + args.deadline, t0, cores)
     errors = [c for c in cells if c["error"]]
@@ -483,25 +505,29 @@ def main() -> int:
     except Exception as exc:
         summary = [{"error": f"{type(exc).__name__}: {exc}"}]
     train = curves(runs)
-    result = {
-        "info": info,
-        "exit": codes,
-        "weights": made,
-        "models": models,
-        "summary": summary,
-        "training": train,
-        "cells": cells,
-        "wall_s": round(time.time() - t0, 1),
-    }
-    (out / "results.json").write_text(json.dumps(result, indent=1))
+    result.update(summary=summary, training=train, cells=cells, wall_s=round(time.time() - t0, 1))
     try:
-        (out / "summary.md").write_text(markdown(summary, train, info))
+        text = markdown(summary, train, info)
     except Exception as exc:
-        (out / "summary.md").write_text(f"summary failed: {type(exc).__name__}: {exc}\n")
+        text = f"summary failed: {type(exc).__name__}: {exc}\n"
+    write_outputs(out, runs, args.arms, result, text)
+    print(text, flush=True)
+    print(f"[{time.time() - t0:5.0f} s] done", flush=True)
+    return 0
+
+
+def write_outputs(
+    out: Path, runs: Path, arms: list[str], result: dict[str, Any], summary: str | None
+) -> None:
+    """results.json, summary.md (when given) and one tar per row of each arm's weights (int8,
+    with sidecar), log and training curve."""
+    (out / "results.json").write_text(json.dumps(result, indent=1))
+    if summary is not None:
+        (out / "summary.md").write_text(summary)
     for scene, params in ROWS:
         row = row_name(scene, params)
         with tarfile.open(out / f"weights_{row}.tar", "w") as tar:
-            for arm in args.arms:
+            for arm in arms:
                 d = runs / row / arm
                 for f in (
                     d / f"{row}.safetensors",
@@ -513,9 +539,6 @@ def main() -> int:
                 ):
                     if f.is_file():
                         tar.add(f, arcname=f"{arm}/{f.relative_to(d)}")
-    print((out / "summary.md").read_text(), flush=True)
-    print(f"[{time.time() - t0:5.0f} s] done", flush=True)
-    return 0
 
 
 if __name__ == "__main__":
