@@ -5,8 +5,8 @@ engine's episodes per second with as many processes, in the same run.
         [--scene three_circles] [--params mass] [--out results/datagen_scaling]
 
 Pairs: the data pipeline of ``physbench train`` (``--workers N``): the same torch ``DataLoader``
-over :func:`physbench.estimators.resnet3d.data.stream` with ``N`` worker processes, batches of
-32 and the shipped models' blur augmentation (``--blur-max 4``, as in
+over :func:`physbench.estimators.resnet3d.training_data.stream` with ``N`` worker processes,
+batches of 32 and the shipped models' blur augmentation (``--blur-max 4``, as in
 ``benchmarks/train_resnet3d.py``), drained by a main process that does no training, so the
 workers have the cores to themselves. After a warm-up (every worker's first batches: process
 start, imports, the first groups), pairs per second over ``--seconds``.
@@ -35,7 +35,7 @@ BLUR_MAX = 4.0
 
 
 def data_spec(scene: str, params: str) -> Any:
-    from physbench.estimators.resnet3d.data import DataSpec
+    from physbench.estimators.resnet3d.training_data import DataSpec
 
     return DataSpec(scene, tuple(params.split(",")), blur_max=BLUR_MAX)
 
@@ -70,10 +70,10 @@ def simulate_groups(item: tuple[str, str, int, int]) -> int:
     parameters, ``simulate`` only; returns how many succeeded."""
     import numpy as np
 
+    from physbench.components import create
     from physbench.errors import SimulationError
-    from physbench.estimators.resnet3d.data import TRAIN_SEED0
-    from physbench.params import ParamSpace
-    from physbench.plugins import create
+    from physbench.estimators.resnet3d.training_data import TRAIN_SEED0
+    from physbench.unknowns import ParamSpace
 
     scene_name, params, seed, n = item
     spec = data_spec(scene_name, params)

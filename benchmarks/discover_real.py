@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from physbench.components import create
 from physbench.datasets import DatasetRun, load
 from physbench.datasets.ball_drops import BALLS, check_drag_laws
 from physbench.datasets.billiards import cushion_bounces, rolling_segments, straight_stretches
@@ -45,7 +46,6 @@ from physbench.discover import Discovery, Settings, discover, runs_from_dataset
 from physbench.discover.report import write_report
 from physbench.discover.verdict import text, to_dict
 from physbench.errors import PhysbenchError
-from physbench.plugins import create
 from physbench.scene import body_unknown
 
 DEFAULT_OUT = Path(__file__).resolve().parents[1] / "results" / "discover"

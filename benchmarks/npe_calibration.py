@@ -30,13 +30,12 @@ LEVELS = (0.5, 0.8, 0.9, 0.95)
 
 def problem(scene_name: str, params: str, seed: int):  # type: ignore[no-untyped-def]
     """The Table 1 task of ``seed`` for an estimator that marks bodies, and its truth."""
+    from physbench.components import create, make_renderer
     from physbench.estimators.base import Task
-    from physbench.experiment import make_renderer
     from physbench.loop import draw_problem
     from physbench.observation import simulate_observation
-    from physbench.params import ParamSpace, split_params
-    from physbench.plugins import create
     from physbench.scenes.generator import resolve_scene
+    from physbench.unknowns import ParamSpace, split_params
 
     scene = resolve_scene(scene_name, seed)
     space = ParamSpace.from_scene(scene, split_params(params))

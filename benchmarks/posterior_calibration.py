@@ -25,13 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
+from physbench.components import create
 from physbench.estimators.smc import SMCEstimator
 from physbench.loop import draw_problem, refine
 from physbench.observation import simulate_observation
-from physbench.params import ParamSpace
-from physbench.plugins import create
-from physbench.render.observe import ObservationModel
+from physbench.render.sensor import SensorModel
 from physbench.scenes import resolve_scene
+from physbench.unknowns import ParamSpace
 
 LEVELS = (0.5, 0.8, 0.9, 0.95)
 #: Seeds are held out from nothing here (smc is not trained), but start far from the training
@@ -53,8 +53,8 @@ def run_case(scene_name: str, params: list[str], seed: int, args: argparse.Names
     truth, _ = draw_problem(space, SEED_OFFSET + seed)
     sim = create("simulator", "pymunk")
     ren = create("renderer", "raster", resolution=args.resolution)
-    camera = ObservationModel(noise=args.noise, seed=SEED_OFFSET + seed)
-    obs = simulate_observation(scene, truth, sim, ren, camera=camera)
+    camera = SensorModel(noise=args.noise, seed=SEED_OFFSET + seed)
+    obs = simulate_observation(scene, truth, sim, ren, sensor=camera)
     t = time.perf_counter()
     est = SMCEstimator(particles=args.particles)
     h = refine(obs, scene, space, sim, ren, est, iterations=args.iterations, seed=seed)

@@ -12,8 +12,8 @@ import sys
 
 import numpy as np
 
+from physbench.bench.held_out import evaluate_weights
 from physbench.estimators.resnet3d import weights
-from physbench.estimators.resnet3d.evaluate import evaluate_weights
 
 
 def main(seeds: int = 10) -> int:

@@ -201,7 +201,7 @@ def episodes(spec: str) -> list[tuple[str, int, int, str]]:
 
 def raw_episode(item: tuple[str, int, int, str]) -> float:
     """Runs in a pool process: the item's simulations, ``simulate`` only."""
-    from physbench.plugins import create
+    from physbench.components import create
     from physbench.scenes import resolve_scene
 
     scene_name, seed, n, engine = item

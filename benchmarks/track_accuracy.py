@@ -17,11 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
-from physbench.plugins import create
+from physbench.components import create
 from physbench.render.camera import CameraRenderer
 from physbench.scenes import bouncing_balls
 from physbench.video.accuracy import pixel_errors
 from physbench.video.track import track_video
+from physbench.video.writer import write_clip
 
 
 def main() -> None:
@@ -40,7 +41,7 @@ def main() -> None:
                     640, shutter=0.5, subframes=8, noise=0.02, bitrate=1_500_000, seed=seed
                 )
                 path = Path(tmp) / "clip.mp4"
-                cam.write(path, scene, traj)
+                write_clip(cam, path, scene, traj)
                 res = track_video(path, scene, cam.calibration(scene), background=cam.plate(scene))
                 errors, swaps = pixel_errors(scene, traj, cam, res.pixels)
                 missing = scene.frames * len(scene.bodies) - errors.size

@@ -21,11 +21,12 @@ import tracemalloc
 from dataclasses import replace
 from pathlib import Path
 
-from physbench.plugins import create
+from physbench.components import create
 from physbench.render.camera import CameraRenderer
 from physbench.scenes import bouncing_balls
 from physbench.video.reader import VideoReader
 from physbench.video.track import track_video
+from physbench.video.writer import write_clip
 
 
 def decode_fps(path: Path) -> float:
@@ -48,7 +49,7 @@ def main() -> None:
             traj = create("simulator", "pymunk").simulate(scene)
             cam = CameraRenderer(640, shutter=0.5, subframes=4, noise=0.02, bitrate=1_500_000)
             path = Path(tmp) / f"clip{seconds}.mp4"
-            cam.write(path, scene, traj)
+            write_clip(cam, path, scene, traj)
             plate, cal = cam.plate(scene), cam.calibration(scene)
             decode = max(decode_fps(path) for _ in range(2))
             for background in ("plate", "median"):

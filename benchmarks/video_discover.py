@@ -53,7 +53,7 @@ def cases(seeds: list[int]) -> list[tuple[str | None, str, str, int]]:
 def body_px(effect: str | None, scene: str, engine: str, seed: int) -> float:
     """The smallest body's radius in the filmed image (px): how big the camera saw it."""
     from physbench.render.camera import CameraRenderer
-    from physbench.video.observe import frame_trajectory, motion_view
+    from physbench.video.footage import frame_trajectory, motion_view
 
     case = make_case(effect, scene, seed, ENGINES[engine]())
     sc = case.run.scene

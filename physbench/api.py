@@ -86,10 +86,10 @@ def _scene(scene: Scene | str | Path) -> Scene:
 
 
 def _effects(effects: Effects) -> list[Effect]:
-    from physbench.plugins import create
+    from physbench.components import create
 
     if isinstance(effects, Mapping):
-        return [create("effect", name, **dict(opts)) for name, opts in effects.items()]
+        return [create("effect", name, opts) for name, opts in effects.items()]
     if isinstance(effects, str):  # one name, not its letters
         effects = [effects]
     return [create("effect", e) if isinstance(e, str) else e for e in effects]
@@ -112,8 +112,8 @@ def simulate(
         traj = physbench.simulate("ball_drop", effects={"linear_drag": {"c": 0.3}})
         traj.states.shape  # (frames, bodies, x y angle vx vy omega)
     """
+    from physbench.components import create
     from physbench.effects import apply_measurements
-    from physbench.plugins import create
 
     sc = _scene(scene)
     made = _effects(effects)
@@ -139,7 +139,7 @@ def render_frames(
 
         frames = physbench.render_frames(scene, traj, "camera", resolution=160, tilt=10)
     """
-    from physbench.experiment import make_renderer
+    from physbench.components import make_renderer
 
     r = make_renderer(renderer, options, resolution=resolution, mode=mode)
     return r.render(_scene(scene), trajectory)

@@ -1,173 +1,365 @@
-"""Scoring posteriors against truths: is an estimator as sure as it should be?
+"""Camera calibration: image pixels to the scene's metres, for a planar scene.
 
-Per run and unknown (:func:`score`): whether the truth lies in the central 50/80/90/95 %
-intervals, its SBC rank (the share of samples below it), the 90 % interval's width as a share of
-the range, and the truth's negative log density. Over many runs (:func:`summarize`): the observed
-coverage of each interval with a binomial interval, a test that the ranks are uniform, the mean
-width and the mean negative log density. A calibrated posterior covers the truth at the nominal
-rate and gives uniform ranks when the truth is drawn from the prior, which is what a sweep does
-(each unknown uniform on its range). Called by the sweep's tables
-(:mod:`physbench.bench.tables`) and plots.
+A :class:`Calibration` is a plane homography ``H`` (3 x 3) from undistorted pixel coordinates
+``(u, v)`` (``u`` to the right, ``v`` down, pixel centres at integers) to scene coordinates
+``(x, y)`` in metres (``y`` up), plus optional radial lens distortion. It is made in one of three
+ways, each a small TOML file (:func:`load_calibration`):
+
+``[scale]``
+    ``metres_per_pixel`` and ``origin_pixel`` (the pixel of the scene's origin): a camera looking
+    straight at the plane of motion.
+``[[points]]``
+    four or more ``image = [u, v]`` / ``scene = [x, y]`` pairs: any view of the plane, oblique
+    included. The homography is the direct linear transform on normalised coordinates, refined by
+    least squares on the reprojection error in pixels.
+``[body]``
+    ``pixels`` and ``metres``: the size of an object of known size in the image (e.g. a ball's
+    diameter) and in the scene, with ``origin_pixel``; the same as ``[scale]`` with the scale from
+    that object.
+
+``[lens]`` (optional, with any of them) holds Brown's radial distortion ``k1``, ``k2`` about the
+principal point ``centre`` (pixels) with focal length ``focal`` (pixels): a pixel at normalised
+radius ``r`` from the centre was seen at ``r (1 + k1 r² + k2 r⁴)``.
+
+:attr:`Calibration.reprojection_error` is the RMS distance in pixels between the given image
+points and the scene points mapped back into the image (0 for a scale, which fits no points).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+import tomllib
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from physbench.errors import PhysbenchError
 
-if TYPE_CHECKING:
-    from physbench.posterior import Posterior
-
-#: The central intervals whose coverage is measured.
-LEVELS = (0.5, 0.8, 0.9, 0.95)
-#: The interval whose width is reported.
-WIDTH_LEVEL = 0.9
-#: The smallest kernel width of the density estimate, as a share of the range: a posterior whose
-#: samples are (nearly) all equal still has a finite density everywhere.
-MIN_BANDWIDTH = 1e-3
-#: Confidence of the binomial interval around an observed coverage.
-CONFIDENCE = 0.95
+#: Largest ratio of the smallest to the largest singular value of the centred scene or image
+#: points below which the points count as collinear: they cannot fix a plane homography.
+COLLINEAR = 1e-6
+_KEYS = {"scale", "points", "body", "lens"}
+_LENS_KEYS = {"k1", "k2", "centre", "focal"}
 
 
-def level_name(level: float) -> str:
-    """``0.9`` -> ``"in90"``: the field saying whether the truth is in the ``level`` interval."""
-    return f"in{round(100 * level)}"
+class CalibrationError(PhysbenchError, ValueError):
+    """A calibration that cannot map pixels to metres: names the key or points and why."""
 
 
 @dataclass(frozen=True)
-class Score:
-    """One unknown of one run: ``inside[i]`` for ``LEVELS[i]``; ``rank`` in [0, 1];
-    ``width90`` the 90 % interval over the range; ``nld`` the truth's negative log density in
-    unit-range units (0: as likely as under the uniform prior, negative: more)."""
+class Lens:
+    """Brown's radial distortion: ``k1``, ``k2`` about ``centre`` (px), normalised by ``focal``
+    (px)."""
 
-    inside: tuple[bool, ...]
-    rank: float
-    width90: float
-    nld: float
+    k1: float = 0.0
+    k2: float = 0.0
+    centre: tuple[float, float] = (0.0, 0.0)
+    focal: float = 1.0
 
-    def to_dict(self) -> dict[str, bool | float]:
-        return {
-            **{level_name(lv): b for lv, b in zip(LEVELS, self.inside, strict=True)},
-            "rank": self.rank,
-            "width90": self.width90,
-            "nld": self.nld,
-        }
+    def distort(self, uv: np.ndarray) -> np.ndarray:
+        """Where undistorted pixels ``(..., 2)`` appear in the image."""
+        p = (np.asarray(uv, dtype=float) - self.centre) / self.focal
+        r2 = (p * p).sum(axis=-1, keepdims=True)
+        return p * (1 + self.k1 * r2 + self.k2 * r2 * r2) * self.focal + self.centre
+
+    def undistort(self, uv: np.ndarray) -> np.ndarray:
+        """The undistorted pixels of image pixels ``(..., 2)`` (fixed-point inverse of
+        :meth:`distort`, converged to 1e-12 of the focal length for the distortion of real
+        lenses)."""
+        q = (np.asarray(uv, dtype=float) - self.centre) / self.focal
+        p = q.copy()
+        for _ in range(50):
+            r2 = (p * p).sum(axis=-1, keepdims=True)
+            nxt = q / (1 + self.k1 * r2 + self.k2 * r2 * r2)
+            if np.abs(nxt - p).max(initial=0.0) < 1e-12:
+                p = nxt
+                break
+            p = nxt
+        return p * self.focal + self.centre
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Pixels -> metres on the scene's plane (see the module docstring)."""
+
+    homography: np.ndarray  # (3, 3): undistorted (u, v, 1) -> (x, y, 1) up to scale
+    lens: Lens | None = None
+    reprojection_error: float = 0.0  # px, RMS over the fitted points
+    source: str = ""
+
+    def to_scene(self, uv: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Scene metres ``(..., 2)`` of image pixels ``(..., 2)``."""
+        uv = np.asarray(uv, dtype=float)
+        if self.lens is not None:
+            uv = self.lens.undistort(uv)
+        return _apply(self.homography, uv)
+
+    def to_image(self, xy: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Image pixels ``(..., 2)`` of scene metres ``(..., 2)``."""
+        uv = _apply(np.linalg.inv(self.homography), np.asarray(xy, dtype=float))
+        return uv if self.lens is None else self.lens.distort(uv)
+
+    def metres_per_pixel(self, uv: Sequence[float]) -> float:
+        """The local scale at pixel ``uv``: the geometric mean of how far one pixel right and one
+        pixel down move in the scene."""
+        p = np.asarray(uv, dtype=float)
+        x0, xu, xv = self.to_scene(p + np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]))
+        return math.sqrt(float(np.linalg.norm(xu - x0) * np.linalg.norm(xv - x0)))
+
+    # ----------------------------------------------------------------- the three ways
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, bool | float]) -> Score:
-        return cls(
-            inside=tuple(bool(d[level_name(lv)]) for lv in LEVELS),
-            rank=float(d["rank"]),
-            width90=float(d["width90"]),
-            nld=float(d["nld"]),
+    def from_scale(
+        cls,
+        metres_per_pixel: float,
+        origin_pixel: Sequence[float],
+        *,
+        lens: Lens | None = None,
+        source: str = "",
+    ) -> Calibration:
+        """A camera looking straight at the plane: ``metres_per_pixel``, and the pixel of the
+        scene's origin (``y`` up, so ``v`` down is ``-y``)."""
+        s = _positive("scale.metres_per_pixel", metres_per_pixel)
+        u0, v0 = _pair("scale.origin_pixel", origin_pixel)
+        h = np.array([[s, 0.0, -s * u0], [0.0, -s, s * v0], [0.0, 0.0, 1.0]])
+        return cls(h, lens, 0.0, source)
+
+    @classmethod
+    def from_points(
+        cls,
+        image: Sequence[Sequence[float]] | np.ndarray,
+        scene: Sequence[Sequence[float]] | np.ndarray,
+        *,
+        lens: Lens | None = None,
+        source: str = "",
+    ) -> Calibration:
+        """The homography through four or more image <-> scene point pairs (image points are
+        undistorted with ``lens`` first)."""
+        uv = np.asarray(image, dtype=float)
+        xy = np.asarray(scene, dtype=float)
+        if uv.ndim != 2 or uv.shape[1:] != (2,) or uv.shape != xy.shape:
+            raise CalibrationError(
+                f"points: expected pairs of [u, v] image and [x, y] scene points, got "
+                f"{uv.shape[0] if uv.ndim else 0} image and {xy.shape[0] if xy.ndim else 0} scene "
+                "points"
+            )
+        if len(uv) < 4:
+            raise CalibrationError(
+                f"points: {len(uv)} pairs given; a plane homography needs at least 4"
+            )
+        if not (np.isfinite(uv).all() and np.isfinite(xy).all()):
+            raise CalibrationError("points: every coordinate must be a finite number")
+        for what, pts in (("scene", xy), ("image", uv)):
+            if _collinear(pts):
+                raise CalibrationError(
+                    f"points: the {what} points {pts.tolist()} lie on one line (or coincide); "
+                    "they cannot fix the plane: give 4 or more points, no 3 of them on a line"
+                )
+        und = uv if lens is None else lens.undistort(uv)
+        h = _refine(_dlt(und, xy), und, xy)
+        cal = cls(h, lens, 0.0, source)
+        err = np.linalg.norm(cal.to_image(xy) - uv, axis=1)
+        return cls(h, lens, float(np.sqrt(np.mean(err * err))), source)
+
+    @classmethod
+    def from_body_size(
+        cls,
+        pixels: float,
+        metres: float,
+        origin_pixel: Sequence[float],
+        *,
+        lens: Lens | None = None,
+        source: str = "",
+    ) -> Calibration:
+        """The scale from an object of known size: ``pixels`` across in the image, ``metres``
+        across in the scene."""
+        p = _positive("body.pixels", pixels)
+        m = _positive("body.metres", metres)
+        return cls.from_scale(m / p, origin_pixel, lens=lens, source=source)
+
+    # ----------------------------------------------------------------- files
+
+    def to_toml(self) -> str:
+        """The calibration as a ``[homography]`` TOML table (what :func:`load_calibration` reads
+        back exactly), with the lens and the reprojection error."""
+        import tomli_w
+
+        data: dict[str, Any] = {
+            "homography": {"matrix": [[float(v) for v in row] for row in self.homography]},
+            "reprojection_error_px": float(self.reprojection_error),
+        }
+        if self.lens is not None:
+            data["lens"] = {
+                "k1": self.lens.k1,
+                "k2": self.lens.k2,
+                "centre": list(self.lens.centre),
+                "focal": self.lens.focal,
+            }
+        return tomli_w.dumps(data)
+
+
+def _apply(h: np.ndarray, p: np.ndarray) -> np.ndarray:
+    q = p @ h[:, :2].T + h[:, 2]
+    return q[..., :2] / q[..., 2:3]
+
+
+def _collinear(pts: np.ndarray) -> bool:
+    centred = pts - pts.mean(axis=0)
+    s = np.linalg.svd(centred, compute_uv=False)
+    return bool(s[0] == 0 or s[-1] / s[0] < COLLINEAR)
+
+
+def _normaliser(pts: np.ndarray) -> np.ndarray:
+    """Hartley's normalisation: centre on the mean, mean distance sqrt(2)."""
+    c = pts.mean(axis=0)
+    d = np.sqrt(((pts - c) ** 2).sum(axis=1)).mean()
+    s = math.sqrt(2) / d
+    return np.array([[s, 0, -s * c[0]], [0, s, -s * c[1]], [0, 0, 1]])
+
+
+def _dlt(uv: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """The direct linear transform ``uv -> xy`` on normalised points."""
+    tu, tx = _normaliser(uv), _normaliser(xy)
+    a, b = _apply(tu, uv), _apply(tx, xy)
+    rows = []
+    for (u, v), (x, y) in zip(a, b, strict=True):
+        rows.append([-u, -v, -1, 0, 0, 0, x * u, x * v, x])
+        rows.append([0, 0, 0, -u, -v, -1, y * u, y * v, y])
+    _, _, vt = np.linalg.svd(np.asarray(rows))
+    hn = vt[-1].reshape(3, 3)
+    h = np.linalg.inv(tx) @ hn @ tu
+    return h / h[2, 2]
+
+
+def _refine(h0: np.ndarray, uv: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """``h0`` refined to the least-squares reprojection error in pixels (scene points mapped into
+    the image), which is what a person marking points in the image gets wrong."""
+    if len(uv) == 4:
+        return h0  # exact through four points
+    from scipy.optimize import least_squares
+
+    def residuals(p: np.ndarray) -> np.ndarray:
+        inv = np.append(p, 1.0).reshape(3, 3)
+        return (_apply(inv, xy) - uv).ravel()
+
+    inv0 = np.linalg.inv(h0)
+    fit = least_squares(residuals, (inv0 / inv0[2, 2]).ravel()[:8], method="lm")
+    h = np.linalg.inv(np.append(fit.x, 1.0).reshape(3, 3))
+    return h / h[2, 2]
+
+
+def _number(key: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise CalibrationError(f"{key} = {value!r}: expected a finite number")
+    return float(value)
+
+
+def _positive(key: str, value: object) -> float:
+    v = _number(key, value)
+    if v <= 0:
+        raise CalibrationError(f"{key} = {value!r}: expected a number > 0")
+    return v
+
+
+def _pair(key: str, value: object) -> tuple[float, float]:
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        raise CalibrationError(f"{key} = {value!r}: expected a pair [u, v] of numbers")
+    return (_number(f"{key}[0]", value[0]), _number(f"{key}[1]", value[1]))
+
+
+def _table(data: Mapping[str, Any], key: str, allowed: set[str]) -> Mapping[str, Any]:
+    table = data[key]
+    if not isinstance(table, dict):
+        raise CalibrationError(f"{key}: expected a table [{key}], got {table!r}")
+    extra = sorted(set(table) - allowed)
+    if extra:
+        raise CalibrationError(
+            f"{key}.{extra[0]}: unknown key; known: {', '.join(sorted(allowed))}"
         )
+    return table
 
 
-def _neg_log_density(unit: np.ndarray, t: float) -> float:
-    """``-log p(t)`` under a Gaussian KDE of ``unit`` (samples on the unit range), reflected at 0
-    and 1 so that mass the kernels would put outside the range stays inside (a flat posterior
-    then gives about 0, not ``log 2`` at the ends). The kernel width is
-    :class:`scipy.stats.gaussian_kde`'s (Scott's rule), at least :data:`MIN_BANDWIDTH`; the sum
-    is evaluated here because gaussian_kde refuses equal samples (a singular covariance) and
-    whitens the whole sample on every call (slow for one point)."""
-    from scipy.special import logsumexp
-    from scipy.stats import norm
-
-    n = unit.size
-    h = max(float(unit.std(ddof=1)) * n**-0.2, MIN_BANDWIDTH)
-    at = np.array([t, -t, 2.0 - t])
-    logp = norm.logpdf(at[:, None], loc=unit[None, :], scale=h)
-    return -float(logsumexp(logp) - math.log(n))
-
-
-def score(posterior: Posterior, truth: Mapping[str, float]) -> dict[str, Score]:
-    """Each unknown of ``posterior`` scored against ``truth`` (which must hold every key);
-    called per finished cell when its table rows are made."""
-    missing = [k for k in posterior.keys if k not in truth]
+def _lens(data: Mapping[str, Any]) -> Lens | None:
+    if "lens" not in data:
+        return None
+    t = _table(data, "lens", _LENS_KEYS)
+    missing = sorted({"centre", "focal"} - set(t))
     if missing:
-        raise PhysbenchError(
-            f"truth lacks {', '.join(missing)}: a posterior over {list(posterior.keys)} needs a "
-            "truth value for each of its unknowns"
+        raise CalibrationError(
+            f"lens: missing {', '.join(missing)} (the principal point and focal)"
         )
-    intervals = {lv: posterior.interval(lv) for lv in LEVELS}
-    out = {}
-    for j, k in enumerate(posterior.keys):
-        s, t = posterior.samples[:, j], float(truth[k])
-        lo, hi = posterior.low[j], posterior.high[j]
-        span = hi - lo
-        w_lo, w_hi = posterior.interval(WIDTH_LEVEL)[k]
-        # ties (samples clipped to a bound the truth sits on) count half: mid-rank
-        rank = (np.count_nonzero(s < t) + 0.5 * np.count_nonzero(s == t)) / s.size
-        out[k] = Score(
-            inside=tuple(intervals[lv][k][0] <= t <= intervals[lv][k][1] for lv in LEVELS),
-            rank=float(rank),
-            width90=(w_hi - w_lo) / span if span > 0 else 0.0,
-            nld=_neg_log_density((s - lo) / span, (t - lo) / span) if span > 0 else math.nan,
+    return Lens(
+        k1=_number("lens.k1", t.get("k1", 0.0)),
+        k2=_number("lens.k2", t.get("k2", 0.0)),
+        centre=_pair("lens.centre", t["centre"]),
+        focal=_positive("lens.focal", t["focal"]),
+    )
+
+
+def loads_calibration(text: str, *, source: str = "") -> Calibration:
+    """A calibration from TOML text (see the module docstring for the tables)."""
+    where = f"{source}: " if source else ""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CalibrationError(f"{where}not valid TOML: {exc}") from None
+    known = {*_KEYS, "homography", "reprojection_error_px"}
+    extra = sorted(set(data) - known)
+    if extra:
+        raise CalibrationError(f"{where}{extra[0]}: unknown key; known: {', '.join(sorted(known))}")
+    ways = [k for k in ("scale", "points", "body", "homography") if k in data]
+    if len(ways) != 1:
+        raise CalibrationError(
+            f"{where}expected exactly one of [scale], [[points]], [body] or [homography], got "
+            f"{', '.join(ways) or 'none'}"
         )
-    return out
+    try:
+        lens = _lens(data)
+        way = ways[0]
+        if way == "scale":
+            t = _table(data, "scale", {"metres_per_pixel", "origin_pixel"})
+            return Calibration.from_scale(
+                t.get("metres_per_pixel"), t.get("origin_pixel"), lens=lens, source=source
+            )
+        if way == "body":
+            t = _table(data, "body", {"pixels", "metres", "origin_pixel"})
+            return Calibration.from_body_size(
+                t.get("pixels"), t.get("metres"), t.get("origin_pixel"), lens=lens, source=source
+            )
+        if way == "points":
+            pts = data["points"]
+            if not isinstance(pts, list) or not all(isinstance(p, dict) for p in pts):
+                raise CalibrationError("points: expected [[points]] tables with image and scene")
+            image, scene = [], []
+            for i, p in enumerate(pts):
+                bad = sorted(set(p) - {"image", "scene"})
+                if bad:
+                    raise CalibrationError(
+                        f"points[{i}].{bad[0]}: unknown key; known: image, scene"
+                    )
+                image.append(_pair(f"points[{i}].image", p.get("image")))
+                scene.append(_pair(f"points[{i}].scene", p.get("scene")))
+            return Calibration.from_points(image, scene, lens=lens, source=source)
+        t = _table(data, "homography", {"matrix"})
+        h = np.asarray(t.get("matrix"), dtype=float)
+        if h.shape != (3, 3) or not np.isfinite(h).all() or abs(np.linalg.det(h)) < 1e-300:
+            raise CalibrationError("homography.matrix: expected an invertible 3 x 3 matrix")
+        err = _number("reprojection_error_px", data.get("reprojection_error_px", 0.0))
+        return Calibration(h, lens, err, source)
+    except CalibrationError as exc:
+        raise CalibrationError(f"{where}{exc}") from None
 
 
-@dataclass(frozen=True)
-class Coverage:
-    """How often the truth was inside the central ``level`` interval: ``inside`` of ``n``."""
-
-    level: float
-    inside: int
-    n: int
-
-    @property
-    def observed(self) -> float:
-        return self.inside / self.n if self.n else math.nan
-
-    def ci(self, confidence: float = CONFIDENCE) -> tuple[float, float]:
-        """Clopper-Pearson (exact binomial) interval of the coverage; NaNs for no runs."""
-        if not self.n:
-            return math.nan, math.nan
-        from scipy.stats import binomtest
-
-        ci = binomtest(self.inside, self.n).proportion_ci(confidence, method="exact")
-        return float(ci.low), float(ci.high)
-
-
-def coverage(scores: Iterable[Score]) -> list[Coverage]:
-    """The coverage of each of :data:`LEVELS` over ``scores``."""
-    inside = np.array([s.inside for s in scores], dtype=bool).reshape(-1, len(LEVELS))
-    return [Coverage(lv, int(inside[:, i].sum()), inside.shape[0]) for i, lv in enumerate(LEVELS)]
-
-
-def sbc_pvalue(ranks: Sequence[float]) -> float:
-    """p-value of "the ranks are uniform on [0, 1]" (simulation-based calibration).
-
-    A Kolmogorov-Smirnov test rather than a chi-square on a rank histogram: a sweep has tens of
-    ranks per row, too few to fill histogram bins, and KS needs no choice of bins and is exact
-    for small samples. Ranks are multiples of 1/samples, a negligible discreteness at the
-    hundreds of samples a posterior carries. A too-narrow posterior piles ranks at 0 and 1, a
-    biased one to one side, a too-wide one in the middle: all depart from uniform. NaN for no
-    ranks."""
-    r = np.asarray(ranks, dtype=float)
-    if r.size == 0:
-        return math.nan
-    from scipy.stats import kstest
-
-    return float(kstest(r, "uniform").pvalue)
-
-
-def summarize(scores: Sequence[Score]) -> dict[str, float]:
-    """The calibration of many runs: ``coverage50`` ... ``coverage95``, ``sbc_p``, mean
-    ``width90`` and mean ``nld`` (NaN without scores), and ``scored``, their number. Scores of
-    several unknowns of one run are pooled as if independent, which they need not be: the
-    binomial intervals and the p-value are then somewhat optimistic."""
-    cov = coverage(scores)
-    return {
-        **{f"coverage{round(100 * c.level)}": c.observed for c in cov},
-        "sbc_p": sbc_pvalue([s.rank for s in scores]),
-        "width90": float(np.mean([s.width90 for s in scores])) if scores else math.nan,
-        "nld": float(np.mean([s.nld for s in scores])) if scores else math.nan,
-        "scored": len(scores),
-    }
+def load_calibration(path: str | Path) -> Calibration:
+    """Read a calibration TOML file; errors name the file and the key."""
+    p = Path(path)
+    if not p.is_file():
+        raise CalibrationError(f"calibration file {str(p)!r} does not exist")
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CalibrationError(f"{p}: cannot read as UTF-8 text ({exc})") from None
+    return loads_calibration(text, source=str(p))

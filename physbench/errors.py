@@ -77,3 +77,9 @@ class SimulationError(PhysbenchError, RuntimeError):
 
 class PluginError(PhysbenchError):
     """Plugin registration problems (duplicate names, hooks that match no spec)."""
+
+
+class OptionError(PhysbenchError, ValueError):
+    """A component that does not take an option, or refuses its value: names the component, where
+    it comes from, the option and the options it takes (raised by
+    :func:`physbench.components.create`)."""

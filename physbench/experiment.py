@@ -12,25 +12,24 @@ and the engine that made it.
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from physbench.components import create, make_estimator, make_observer, make_renderer
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.estimators.base import DEFAULT_ESTIMATOR
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
-    from physbench.estimators.base import CorrectionEstimator
     from physbench.loop import History, Iteration
     from physbench.observation import Observation
-    from physbench.params import ParamSpace
     from physbench.render.base import Renderer
-    from physbench.render.camera import CameraRenderer
     from physbench.scene import Scene
+    from physbench.simulators.base import Simulator
+    from physbench.unknowns import ParamSpace
 
 #: The scene of a run that names none (and observes no file that carries one).
 DEFAULT_SCENE = "three_circles"
@@ -125,97 +124,6 @@ _LATER = (
 )
 
 
-def _accepted(cls: type) -> str:
-    try:
-        names = [
-            q for q in inspect.signature(cls).parameters if q not in ("self", "args", "kwargs")
-        ]
-    except (TypeError, ValueError):
-        names = []
-    return ", ".join(names) or "none"
-
-
-def _build(kind: str, name: str, options: Mapping[str, Any], **standard: Any) -> Any:
-    """The registered ``kind`` ``name`` built with ``options`` (and the kind's ``standard``
-    keywords); a constructor that refuses them becomes one sentence naming the options."""
-    from physbench.plugins import get_registry
-    from physbench.requirements import require
-
-    cls = get_registry().get(kind, name)
-    require(kind, name, cls)
-    try:
-        return cls(**standard, **dict(options))
-    except PhysbenchError:
-        raise
-    except TypeError as exc:
-        raise PhysbenchError(
-            f"{kind} {name!r} does not take options {dict(options)}: {exc}; "
-            f"its options: {_accepted(cls)}"
-        ) from None
-    except ValueError as exc:  # a plugin's own check, not phrased as a PhysbenchError
-        raise PhysbenchError(f"{kind} {name!r} refused options {dict(options)}: {exc}") from None
-
-
-def make_estimator(name: str, options: Mapping[str, Any]) -> CorrectionEstimator:
-    """Instantiate the registered estimator ``name``; options it does not take are refused with
-    the list of those it does."""
-    return _build("estimator", name, options)
-
-
-def default_render_mode(name: str) -> str:
-    """The channel layout of the registered renderer ``name`` when none is asked for: the first
-    it declares (``mark`` for raster, ``rgb`` for camera)."""
-    from physbench.plugins import get_registry
-
-    try:
-        cls = get_registry().get("renderer", name)
-    except UnknownNameError as exc:
-        raise PhysbenchError(str(exc)) from None
-    return str(cls.modes[0])
-
-
-def make_renderer(
-    name: str,
-    options: Mapping[str, Any],
-    *,
-    resolution: int | tuple[int, int],
-    mode: str | None,
-) -> Renderer:
-    """Instantiate the registered renderer ``name`` with its ``options`` and the standard
-    ``resolution`` and ``mode`` (``None``: :func:`default_render_mode`); options it does not take
-    are refused with the list of those it does."""
-    clash = sorted({"resolution", "mode"} & set(options))
-    if clash:
-        raise PhysbenchError(
-            f"renderer option {clash[0]!r}: set it with --resolution / --render-mode (in a sweep "
-            "spec: the resolution and render_mode axes), not as a renderer option"
-        )
-    if mode is None:
-        mode = default_render_mode(name)
-    return _build("renderer", name, options, resolution=resolution, mode=mode)
-
-
-#: Image width of an observer camera whose options name no ``resolution``.
-OBSERVER_RESOLUTION = 640
-
-
-def make_observer(name: str, options: Mapping[str, Any]) -> CameraRenderer:
-    """The camera renderer ``name`` that films a simulated observation: its ``options`` may hold
-    ``resolution`` (default :data:`OBSERVER_RESOLUTION`); it draws ``rgb`` frames and must be a
-    :class:`~physbench.render.camera.CameraRenderer` (the video path needs its plate)."""
-    from physbench.render.camera import CameraRenderer
-
-    opts = dict(options)
-    resolution = opts.pop("resolution", OBSERVER_RESOLUTION)
-    cam = _build("renderer", name, opts, resolution=resolution, mode="rgb")
-    if not isinstance(cam, CameraRenderer):
-        raise PhysbenchError(
-            f"observer {name!r} is a {type(cam).__name__}; an observer films the observation as "
-            "a video, so it must be a camera renderer (e.g. 'camera')"
-        )
-    return cam
-
-
 def _check_observation(config: RunConfig) -> None:
     given = {"--observation frames": config.observation, "--video": config.video}
     sources = [k for k, v in given.items() if v]
@@ -289,7 +197,7 @@ def model_engine(config: RunConfig, observed: Observation | None = None) -> str:
 
 def config_space(config: RunConfig, scene: Scene | None = None) -> ParamSpace:
     """The unknowns of ``config`` on its scene instance (``scene`` saves regenerating it)."""
-    from physbench.params import ParamSpace
+    from physbench.unknowns import ParamSpace
 
     scene = observed_scene(config) if scene is None else scene
     return ParamSpace.from_scene(
@@ -341,109 +249,82 @@ def check_config(config: RunConfig) -> ParamSpace:
     return config_space(config, scene)
 
 
-def run_config(
+def model_renderer(config: RunConfig) -> Renderer:
+    """The renderer of ``config`` (its options, resolution and channel layout): the model's, and
+    the observation's unless a camera films it."""
+    return make_renderer(
+        config.renderer,
+        config.renderer_options,
+        resolution=config.resolution,
+        mode=config.render_mode,
+    )
+
+
+def make_observation(
     config: RunConfig,
-    *,
-    callback: Callable[[Iteration], None] | None = None,
-    save_observation: str | Path | None = None,
-    probe: bool = True,
-    notice: Callable[[str], None] | None = None,
-) -> History:
-    """Build the scene, observation, engines, renderers and estimator of ``config`` and run
-    :func:`~physbench.loop.refine`. The history's ``meta`` records the observation settings.
-    ``callback`` receives each iteration's record; ``save_observation`` writes the frames used.
-    ``probe``: first check that every unknown changes the rendered frames
-    (:mod:`physbench.identifiability`; the unseen are in ``History.unseen``, and ``notice``
-    receives one sentence about them before the loop starts)."""
-    _check_observation(config)
-    from physbench.loop import draw_problem, refine
-    from physbench.observation import save_observation as save_obs
-    from physbench.observation import simulate_observation
-    from physbench.plugins import create
-    from physbench.render.observe import ObservationModel
+    scene: Scene,
+    truth: Mapping[str, float],
+    marked: tuple[str, ...],
+    renderer: Renderer,
+) -> Observation:
+    """The observation ``config`` asks for, with each ``marked`` body's view: a ``video`` tracked
+    and segmented into ``renderer``'s frames, a simulation of ``truth`` filmed by an ``observer``
+    camera and segmented the same way, or a simulation rendered sharp and degraded by the sensor
+    model (``blur``, ``noise``). (A frames file is loaded by :func:`load_observed` instead.)"""
+    if config.video:
+        from physbench.video.footage import video_observation
 
-    observed = load_observed(config)
-    scene = observed_scene(config, observed)
-    space = config_space(config, scene)
-    check_size(config, scene)
-    estimator = make_estimator(config.estimator, config.options)
-    simulator = create("simulator", model_engine(config, observed))
-
-    def renderer() -> Renderer:
-        return make_renderer(
-            config.renderer,
-            config.renderer_options,
-            resolution=config.resolution,
-            mode=config.render_mode,
-        )
-
-    model_renderer = renderer()
-    per_object = type(estimator).per_object
-    truth, initial = draw_problem(space, config.seed)
-    obs: Observation
-    marked = space.bodies if per_object else ()
-    if observed is not None:
-        obs = observed
-    elif config.video:
-        from physbench.video.observe import video_observation
-
-        obs = video_observation(
+        return video_observation(
             config.video,
             scene,
-            model_renderer,
+            renderer,
             calibration=config.calibration,
             background=config.background,
             start=config.video_start,
             end=config.video_end,
             marked=marked,
         )
-    elif config.observer:
-        from physbench.video.observe import filmed_observation
+    simulator = create("simulator", config.observer_engine)
+    if config.observer:
+        from physbench.video.footage import filmed_observation
 
-        obs = filmed_observation(
-            scene,
-            truth,
-            create("simulator", config.observer_engine),
-            make_observer(config.observer, config.observer_options),
-            model_renderer,
-            marked=marked,
-        )
-    else:
-        obs = simulate_observation(
-            scene,
-            truth,
-            create("simulator", config.observer_engine),
-            renderer(),
-            marked=marked,
-            camera=ObservationModel(blur=config.blur, noise=config.noise, seed=config.seed),
-        )
-    if save_observation:
-        save_obs(save_observation, obs)
-    unseen: tuple[str, ...] = ()
-    if probe:
-        from physbench import identifiability
+        camera = make_observer(config.observer, config.observer_options)
+        return filmed_observation(scene, truth, simulator, camera, renderer, marked=marked)
+    from physbench.observation import simulate_observation
+    from physbench.render.sensor import SensorModel
 
-        probes = identifiability.probe(scene, space, simulator, model_renderer, initial)
-        unseen = identifiability.unseen(probes)
-        sentence = identifiability.describe(probes)
-        if sentence and notice is not None:
-            notice(sentence)
-    history = refine(
-        obs,
-        scene,
-        space,
-        simulator,
-        model_renderer,
-        estimator,
-        iterations=config.iterations,
-        seed=config.seed,
-        initial=initial,
-        callback=callback,
+    sensor = SensorModel(blur=config.blur, noise=config.noise, seed=config.seed)
+    return simulate_observation(
+        scene, truth, simulator, model_renderer(config), marked=marked, sensor=sensor
     )
-    history.unseen = unseen
+
+
+def _probe(
+    scene: Scene,
+    space: ParamSpace,
+    simulator: Simulator,
+    renderer: Renderer,
+    initial: Mapping[str, float],
+    notice: Callable[[str], None] | None,
+) -> tuple[str, ...]:
+    """The unknowns that move no pixel around ``initial`` (one sentence about them to
+    ``notice``)."""
+    from physbench.posterior import identifiability
+
+    probes = identifiability.probe(scene, space, simulator, renderer, dict(initial))
+    sentence = identifiability.describe(probes)
+    if sentence and notice is not None:
+        notice(sentence)
+    return identifiability.unseen(probes)
+
+
+def _record_settings(history: History, config: RunConfig, observed: Observation | None) -> None:
+    """Write the observation's settings into ``history.meta``: the engine that made it (``None``
+    for a video, a file's own maker where it says), the renderer, blur, noise, resolution and
+    layout, and the observer, video or simulated effects where there were some."""
     observe_engine: str | None = config.observer_engine
     if observed is not None:
-        observe_engine = observed.engine or None  # a file's maker, where it says
+        observe_engine = observed.engine or None
     elif config.video:
         observe_engine = None
     history.meta.update(
@@ -463,4 +344,55 @@ def run_config(
         history.meta.update(video=config.video, calibration=config.calibration)
     if observed is not None and observed.effects:
         history.meta.update(observe_effects=list(observed.effects))
+
+
+def run_config(
+    config: RunConfig,
+    *,
+    callback: Callable[[Iteration], None] | None = None,
+    save_observation: str | Path | None = None,
+    probe: bool = True,
+    notice: Callable[[str], None] | None = None,
+) -> History:
+    """Build the scene, observation, engines, renderers and estimator of ``config`` and run
+    :func:`~physbench.loop.refine`. The history's ``meta`` records the observation settings.
+    ``callback`` receives each iteration's record; ``save_observation`` writes the frames used.
+    ``probe``: first check that every unknown changes the rendered frames
+    (:mod:`physbench.posterior.identifiability`; the unseen are in ``History.unseen``, and
+    ``notice`` receives one sentence about them before the loop starts)."""
+    _check_observation(config)
+    from physbench.loop import draw_problem, refine
+    from physbench.observation import save_observation as save_obs
+
+    observed = load_observed(config)
+    scene = observed_scene(config, observed)
+    space = config_space(config, scene)
+    check_size(config, scene)
+    estimator = make_estimator(config.estimator, config.options)
+    simulator = create("simulator", model_engine(config, observed))
+    renderer = model_renderer(config)
+    truth, initial = draw_problem(space, config.seed)
+    marked = space.bodies if type(estimator).per_object else ()
+    obs = (
+        observed
+        if observed is not None
+        else make_observation(config, scene, truth, marked, renderer)
+    )
+    if save_observation:
+        save_obs(save_observation, obs)
+    unseen = _probe(scene, space, simulator, renderer, initial, notice) if probe else ()
+    history = refine(
+        obs,
+        scene,
+        space,
+        simulator,
+        renderer,
+        estimator,
+        iterations=config.iterations,
+        seed=config.seed,
+        initial=initial,
+        callback=callback,
+    )
+    history.unseen = unseen
+    _record_settings(history, config, observed)
     return history

@@ -1,10 +1,13 @@
-"""The only hook definitions. A plugin module implements any of them with ``@hookimpl``.
+"""The only hook definitions, one per component kind of :data:`physbench.kinds.KINDS` (so a new
+kind is one row there). A plugin module implements any of them with ``@hookimpl``:
 
-Every hook returns a list of components; the core builds one name-keyed registry per kind. A name
-that several plugins claim is a conflict that ``physbench plugins`` reports: physbench's own
-component is kept, and between third parties none is used. Components subclass the base class of
-their kind (the contract: what the framework calls, and the defaults of every optional member).
-Register a plugin through the entry-point group ``physbench``::
+``register_simulators``, ``register_renderers``, ``register_estimators``, ``register_scenes``,
+``register_effects``: each returns a list of components and is called once, when the registry is
+first built. The core builds one name-keyed registry per kind. A name that several plugins claim
+is a conflict that ``physbench plugins`` reports: physbench's own component is kept, and between
+third parties none is used. Components subclass the base class of their kind (the contract: what
+the framework calls, and the defaults of every optional member). Register a plugin through the
+entry-point group ``physbench``::
 
     [project.entry-points.physbench]
     myplugin = "my_package.my_module"
@@ -12,41 +15,27 @@ Register a plugin through the entry-point group ``physbench``::
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import pluggy
+
+from physbench.kinds import KINDS, Kind
 
 PROJECT = "physbench"
 hookspec = pluggy.HookspecMarker(PROJECT)
 hookimpl = pluggy.HookimplMarker(PROJECT)
 
 
-@hookspec
-def register_simulators() -> list[type[Any]]:
-    """Return :class:`~physbench.simulators.base.Simulator` subclasses (each with a unique
-    ``name``). Called once when the registry is first built."""
+def _spec(kind: Kind) -> Callable[[], list[Any]]:
+    def hook() -> list[Any]: ...
+
+    hook.__name__ = hook.__qualname__ = kind.hook
+    hook.__module__ = __name__
+    hook.__doc__ = f"{kind.returns} Called once when the registry is first built."
+    return hookspec(hook)  # type: ignore[no-any-return]
 
 
-@hookspec
-def register_renderers() -> list[type[Any]]:
-    """Return :class:`~physbench.render.base.Renderer` subclasses. Called once when the registry is
-    first built."""
-
-
-@hookspec
-def register_estimators() -> list[type[Any]]:
-    """Return :class:`~physbench.estimators.base.CorrectionEstimator` subclasses. Called once when
-    the registry is first built."""
-
-
-@hookspec
-def register_scenes() -> list[Any]:
-    """Return scene generators: callables ``(seed: int) -> Scene`` with a ``name`` attribute
-    (see :func:`physbench.scenes.generator.scene_generator`). Called once when the registry is
-    first built."""
-
-
-@hookspec
-def register_effects() -> list[type[Any]]:
-    """Return :class:`~physbench.effects.base.Effect` subclasses (model extensions). Called once
-    when the registry is first built."""
+for _kind in KINDS:
+    globals()[_kind.hook] = _spec(_kind)
+del _kind

@@ -26,9 +26,9 @@ from physbench.errors import PhysbenchError, SimulationError
 from physbench.estimators.base import Step, Task
 from physbench.metrics import image_mse
 from physbench.observation import Observation, expected_shape, validate
-from physbench.params import Params, ParamSpace
 from physbench.plugins import guard
-from physbench.posterior import Posterior
+from physbench.posterior.samples import Posterior
+from physbench.unknowns import Params, ParamSpace
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -108,10 +108,11 @@ class History:
     options: dict[str, Any] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
     #: Unknowns that moved no pixel when probed before the run
-    #: (:mod:`physbench.identifiability`): their estimates are guesses. Empty when not probed.
+    #: (:mod:`physbench.posterior.identifiability`): their estimates are guesses. Empty when not
+    #: probed.
     unseen: tuple[str, ...] = ()
     #: Unknowns whose best estimate lies at an end of their range
-    #: (:meth:`~physbench.params.ParamSpace.at_bound`): the range, not the data, may hold them.
+    #: (:meth:`~physbench.unknowns.ParamSpace.at_bound`): the range, not the data, may hold them.
     at_bound: tuple[str, ...] = ()
     #: How sure the estimator is (:meth:`CorrectionEstimator.posterior`); ``None`` for an
     #: estimator that gives a point only.
@@ -249,7 +250,7 @@ def _check_posterior(name: str, space: ParamSpace, posterior: object) -> None:
     if not isinstance(posterior, Posterior):
         raise EstimatorError(
             f"estimator {name!r}: posterior() returned {type(posterior).__name__}, expected a "
-            "physbench.posterior.Posterior or None"
+            "physbench.posterior.samples.Posterior or None"
         )
     if posterior.keys != space.keys:
         raise EstimatorError(
@@ -264,6 +265,137 @@ def _space(scene: Scene, unknowns: ParamSpace | Sequence[str] | None) -> ParamSp
     if isinstance(unknowns, str):
         unknowns = [unknowns]
     return ParamSpace.from_scene(scene, unknowns)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """What one simulation of a proposed point gives its estimator: the ``loss`` it minimises,
+    the simulated ``frames`` (and ``marked`` views) and ``trajectory`` it may read, why the
+    simulation ``failed`` (``None`` when it did not), and the seconds it took."""
+
+    loss: float
+    frames: np.ndarray
+    trajectory: Trajectory | None = None
+    marked: Mapping[str, np.ndarray] = field(default_factory=dict)
+    failed: str | None = None
+    t_simulate: float = 0.0
+    t_render: float = 0.0
+
+
+@dataclass(frozen=True)
+class Driven:
+    """What :func:`drive` returns besides what its ``visit`` saw: the seconds ``start`` took and
+    the estimator's posterior (``None`` for a point estimator)."""
+
+    t_start: float
+    posterior: Posterior | None
+
+
+def drive(
+    estimator: CorrectionEstimator,
+    task: Task,
+    evaluate: Callable[[Params], Evaluation],
+    *,
+    seed: int,
+    visit: Callable[[int, Params, Evaluation, float], None],
+) -> Driven:
+    """The one place that calls an estimator: :meth:`~CorrectionEstimator.start` once with
+    ``task``, then for each of ``task.iterations`` iterations ``evaluate`` the current point, show
+    the estimator the :class:`~physbench.estimators.base.Step` and check its proposal (keys,
+    ranges), then :meth:`~CorrectionEstimator.posterior`. Every call is guarded (what a third
+    party's component raises names it). ``visit(k, params, evaluation, t_estimator)`` receives
+    each iteration once its proposal is checked. The image loop (:func:`refine`) and discovery's
+    black-box fits both run through here."""
+    name = type(estimator).name or type(estimator).__name__
+    t = time.perf_counter()
+    with guard("estimator", estimator, "start()"):
+        estimator.start(task, seed=seed)
+    t_start = time.perf_counter() - t
+    params = dict(task.initial)
+    for k in range(task.iterations):
+        ev = evaluate(params)
+        step = Step(k, dict(params), ev.frames, ev.loss, ev.trajectory, marked=dict(ev.marked))
+        t = time.perf_counter()
+        with guard("estimator", estimator, "propose()"):
+            proposal = estimator.propose(step)
+        t_estimator = time.perf_counter() - t
+        nxt = _check_proposal(name, task.space, proposal, k)
+        visit(k, params, ev, t_estimator)
+        params = nxt
+    with guard("estimator", estimator, "posterior()"):
+        posterior = estimator.posterior()
+    _check_posterior(name, task.space, posterior)
+    return Driven(t_start, posterior)
+
+
+def _checked_iterations(iterations: object) -> int:
+    if (
+        isinstance(iterations, bool)
+        or not isinstance(iterations, int | np.integer)
+        or iterations < 1
+    ):
+        raise PhysbenchError(f"iterations = {iterations!r}: expected a whole number >= 1")
+    return int(iterations)
+
+
+def _truth(obs: Observation, space: ParamSpace) -> Params | None:
+    """The observation's true values of the unknowns (``None``: it carries none)."""
+    if obs.truth is None:
+        return None
+    missing = [k for k in space.keys if k not in obs.truth]
+    if missing:
+        raise PhysbenchError(f"the observation's true parameters {dict(obs.truth)} lack {missing}")
+    return {k: float(obs.truth[k]) for k in space.keys}
+
+
+def _first_guess(space: ParamSpace, seed: int, initial: Mapping[str, float] | None) -> Params:
+    """``initial`` checked against the ranges, else a uniform draw from the seed's stream."""
+    if initial is None:
+        return space.sample(derive_seeds(seed).initial)
+    if not set(space.keys) <= set(initial) or not space.contains(initial):
+        ranges = ", ".join(f"{u.key} in [{u.low:g}, {u.high:g}]" for u in space.unknowns)
+        raise PhysbenchError(
+            f"initial guess {dict(initial)}: expected a value for each unknown with {ranges}"
+        )
+    return {k: float(initial[k]) for k in space.keys}
+
+
+def image_objective(
+    obs: Observation,
+    scene: Scene,
+    space: ParamSpace,
+    simulator: Simulator,
+    renderer: Renderer,
+    *,
+    per_object: bool,
+    effects: Sequence[Effect] = (),
+) -> Callable[[Params], Evaluation]:
+    """The loop's objective: simulate a point, render it (and each unknown body marked, for a
+    ``per_object`` estimator) and compare with ``obs`` by image MSE. A simulation that fails
+    gives empty frames and :data:`FAILED_LOSS`."""
+
+    def evaluate(params: Params) -> Evaluation:
+        t0 = time.perf_counter()
+        try:
+            with guard("simulator", simulator, "simulate()"):
+                traj = simulator.simulate(scene, params, effects=effects)
+        except SimulationError as exc:
+            frames = np.zeros_like(obs.frames)
+            marked = dict.fromkeys(space.bodies, frames) if per_object else {}
+            t1 = time.perf_counter()
+            return Evaluation(FAILED_LOSS, frames, None, marked, str(exc), t1 - t0, 0.0)
+        t1 = time.perf_counter()
+        with guard("renderer", renderer, "render()"):
+            frames = renderer.render(scene, traj)
+            marked = (
+                {b: renderer.render(scene, traj, focus=b) for b in space.bodies}
+                if per_object
+                else {}
+            )
+        loss = image_mse(frames, obs.frames)
+        return Evaluation(loss, frames, traj, marked, None, t1 - t0, time.perf_counter() - t1)
+
+    return evaluate
 
 
 def refine(
@@ -288,12 +420,7 @@ def refine(
     (sharp); an observation model (blur, noise) belongs to whoever made ``observation``.
     ``callback`` is called with each :class:`Iteration` as it completes (progress displays).
     """
-    if (
-        isinstance(iterations, bool)
-        or not isinstance(iterations, int | np.integer)
-        or iterations < 1
-    ):
-        raise PhysbenchError(f"iterations = {iterations!r}: expected a whole number >= 1")
+    iterations = _checked_iterations(iterations)
     space = _space(scene, unknowns)
     obs = (
         observation
@@ -303,106 +430,51 @@ def refine(
     name = type(estimator).name or type(estimator).__name__
     per_object = type(estimator).per_object
     obs = validate(obs, expected_shape(renderer, scene), bodies=space.bodies if per_object else ())
-    truth = None
-    if obs.truth is not None:
-        missing = [k for k in space.keys if k not in obs.truth]
-        if missing:
-            raise PhysbenchError(
-                f"the observation's true parameters {dict(obs.truth)} lack {missing}"
-            )
-        truth = {k: float(obs.truth[k]) for k in space.keys}
-
-    seeds = derive_seeds(seed)
-    if initial is None:
-        params = space.sample(seeds.initial)
-    else:
-        if not set(space.keys) <= set(initial) or not space.contains(initial):
-            ranges = ", ".join(f"{u.key} in [{u.low:g}, {u.high:g}]" for u in space.unknowns)
-            raise PhysbenchError(
-                f"initial guess {dict(initial)}: expected a value for each unknown with {ranges}"
-            )
-        params = {k: float(initial[k]) for k in space.keys}
-    first = dict(params)
-
+    truth = _truth(obs, space)
+    first = _first_guess(space, seed, initial)
     task = Task(
         scene=scene,
         space=space,
         observation=obs.frames,
         initial=dict(first),
         renderer=renderer,
-        iterations=int(iterations),
+        iterations=iterations,
         marked_observation=obs.marked,
         noise=obs.noise,
     )
-    t = time.perf_counter()
-    with guard("estimator", estimator, "start()"):
-        estimator.start(task, seed=seeds.estimator)
-    t_start = time.perf_counter() - t
-
     records: list[Iteration] = []
-    best = 0
-    for k in range(int(iterations)):
-        failed: str | None = None
-        traj: Trajectory | None = None
-        t0 = time.perf_counter()
-        try:
-            with guard("simulator", simulator, "simulate()"):
-                traj = simulator.simulate(scene, params, effects=effects)
-        except SimulationError as exc:
-            failed = str(exc)
-        t1 = time.perf_counter()
-        marked: dict[str, np.ndarray] = {}
-        if traj is None:
-            frames = np.zeros_like(obs.frames)
-            marked = dict.fromkeys(space.bodies, frames) if per_object else {}
-            loss = FAILED_LOSS
-        else:
-            with guard("renderer", renderer, "render()"):
-                frames = renderer.render(scene, traj)
-                if per_object:
-                    marked = {b: renderer.render(scene, traj, focus=b) for b in space.bodies}
-            loss = image_mse(frames, obs.frames)
-        t2 = time.perf_counter()
-        step = Step(k, dict(params), frames, loss, traj, marked=marked)
-        with guard("estimator", estimator, "propose()"):
-            proposal = estimator.propose(step)
-        t3 = time.perf_counter()
-        nxt = _check_proposal(name, space, proposal, k)
 
+    def visit(k: int, params: Params, ev: Evaluation, t_estimator: float) -> None:
         nmse = None if truth is None else space.normalized_mse(params, truth)
-        if k == 0 or loss < records[best].loss:  # ties keep the earlier iterate
-            best = k
-        best_loss, best_nmse = (
-            (loss, nmse) if best == k else (records[best].loss, records[best].nmse)
-        )
+        best = k if k == 0 or ev.loss < records[-1].best_loss else records[-1].best_iteration
+        held = records[best] if best < k else None  # ties keep the earlier iterate
         rec = Iteration(
             k,
             dict(params),
-            loss,
+            ev.loss,
             nmse,
             best,
-            best_loss,
-            best_nmse,
-            t1 - t0,
-            t2 - t1,
-            t3 - t2,
-            failed,
+            ev.loss if held is None else held.loss,
+            nmse if held is None else held.nmse,
+            ev.t_simulate,
+            ev.t_render,
+            t_estimator,
+            ev.failed,
         )
         records.append(rec)
         if callback is not None:
             callback(rec)
-        params = nxt
 
-    with guard("estimator", estimator, "posterior()"):
-        posterior = estimator.posterior()
-    _check_posterior(name, space, posterior)
-
+    evaluate = image_objective(
+        obs, scene, space, simulator, renderer, per_object=per_object, effects=effects
+    )
+    driven = drive(estimator, task, evaluate, seed=derive_seeds(seed).estimator, visit=visit)
     return History(
         iterations=records,
-        posterior=posterior,
+        posterior=driven.posterior,
         keys=space.keys,
         estimator=name,
-        at_bound=space.at_bound(records[best].params),
+        at_bound=space.at_bound(records[records[-1].best_iteration].params),
         seed=int(seed),
         initial=first,
         truth=truth,
@@ -412,6 +484,6 @@ def refine(
             "simulator": type(simulator).name,
             "per_object": per_object,
             "observation": obs.source,
-            "t_start": t_start,
+            "t_start": driven.t_start,
         },
     )

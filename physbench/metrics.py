@@ -1,7 +1,7 @@
 """The paper's measures: image-space MSE (the objective) and normalized parameter MSE (the score).
 
 *Normalized MSE*: each parameter divided by the maximum of its range, squared error averaged over
-the unknowns (:meth:`physbench.params.ParamSpace.normalized_mse`). *Minimum after N iterations*:
+the unknowns (:meth:`physbench.unknowns.ParamSpace.normalized_mse`). *Minimum after N iterations*:
 the normalized MSE of the best-so-far iterate, where best means lowest **image** MSE, so the truth
 is never used to pick (the note under the paper's Fig. 3).
 """
@@ -13,7 +13,7 @@ from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
-from physbench.params import ParamSpace
+from physbench.unknowns import ParamSpace
 
 
 def image_mse(a: np.ndarray, b: np.ndarray) -> float:

@@ -36,11 +36,11 @@ from physbench.errors import PhysbenchError
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
-    from physbench.params import Params
     from physbench.render.base import Renderer
-    from physbench.render.observe import ObservationModel
+    from physbench.render.sensor import SensorModel
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
+    from physbench.unknowns import Params
 
 MARK_PREFIX = "marked_"
 #: Keys of an observation file besides the frames: scene, engine, effects.
@@ -151,15 +151,15 @@ def simulate_observation(
     *,
     marked: Iterable[str] = (),
     effects: Sequence[Effect] = (),
-    camera: ObservationModel | None = None,
+    sensor: SensorModel | None = None,
 ) -> Observation:
     """Simulate ``scene`` with the true parameters and render it (and once per ``marked`` body with
-    that body in focus); ``camera`` (blur, noise) degrades every rendered view."""
+    that body in focus); ``sensor`` (blur, noise) degrades every rendered view."""
     traj = simulator.simulate(scene, dict(truth), effects=effects)
     views = {None: renderer.render(scene, traj)}
     views.update({b: renderer.render(scene, traj, focus=b) for b in marked})
-    if camera is not None:
-        views = {b: camera.apply(f) for b, f in views.items()}
+    if sensor is not None:
+        views = {b: sensor.apply(f) for b, f in views.items()}
     frames = views.pop(None)
     name = type(simulator).name
     return Observation(
@@ -170,7 +170,7 @@ def simulate_observation(
         scene=scene.with_params(truth),
         engine=name,
         effects=tuple(repr(e) for e in effects),
-        noise=None if camera is None else float(camera.noise),
+        noise=None if sensor is None else float(sensor.noise),
     )
 
 

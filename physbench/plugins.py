@@ -26,19 +26,11 @@ import pluggy
 
 from physbench import hookspecs
 from physbench.errors import PhysbenchError, PluginError, UnknownNameError
+from physbench.kinds import KINDS
 
 #: The package name of physbench's own components: a conflict keeps them, and what they raise is
 #: physbench's bug, not a plugin's.
 OWN = "physbench"
-
-#: Hook name -> component kind.
-KINDS: dict[str, str] = {
-    "register_simulators": "simulator",
-    "register_renderers": "renderer",
-    "register_estimators": "estimator",
-    "register_scenes": "scene",
-    "register_effects": "effect",
-}
 
 
 @dataclass(frozen=True)
@@ -104,7 +96,7 @@ class ComponentError(PluginError):
 @dataclass
 class Registry:
     components: dict[str, dict[str, Component]] = field(
-        default_factory=lambda: {k: {} for k in KINDS.values()}
+        default_factory=lambda: {k.name: {} for k in KINDS}
     )
     failed: list[FailedPlugin] = field(default_factory=list)
     conflicts: list[Conflict] = field(default_factory=list)
@@ -128,7 +120,7 @@ class Registry:
         return self.components[kind][name]
 
     def all(self) -> list[Component]:
-        return [c for kind in KINDS.values() for _, c in sorted(self.components[kind].items())]
+        return [c for kind in KINDS for _, c in sorted(self.components[kind.name].items())]
 
     def add(self, comp: Component) -> None:
         """Add one component; a name already taken raises :class:`PluginError`
@@ -205,23 +197,8 @@ def _register(
     return True
 
 
-def _bases() -> dict[str, type]:
-    """Kind -> the base class its components subclass (scenes are plain callables)."""
-    from physbench.effects.base import Effect
-    from physbench.estimators.base import CorrectionEstimator
-    from physbench.render.base import Renderer
-    from physbench.simulators.base import Simulator
-
-    return {
-        "simulator": Simulator,
-        "renderer": Renderer,
-        "estimator": CorrectionEstimator,
-        "effect": Effect,
-    }
-
-
-def _contract_breach(kind: str, obj: object, bases: dict[str, type]) -> str | None:
-    base = bases.get(kind)
+def _contract_breach(kind: str, obj: object, bases: dict[str, type | None]) -> str | None:
+    base = bases[kind]
     if base is None:
         return None if callable(obj) else f"returned {obj!r}, which is not callable"
     if not (isinstance(obj, type) and issubclass(obj, base)):
@@ -271,9 +248,10 @@ def build_registry(
         if _register(pm, reg, plugin, name, name, "-"):
             origin[name] = (name, "-")
 
-    bases = _bases()
+    bases = {k.name: k.base_class() for k in KINDS}
     candidates: list[Component] = []
-    for hook, kind in KINDS.items():
+    for k in KINDS:
+        hook, kind = k.hook, k.name
         for impl in getattr(pm.hook, hook).get_hookimpls():
             pkg, ver = origin.get(impl.plugin_name, ("?", "?"))
             try:
@@ -335,14 +313,3 @@ def blame(exc: BaseException) -> tuple[Component, str] | None:
             found = tops[top], f"{tb.tb_frame.f_code.co_name}()"
         tb = tb.tb_next
     return found
-
-
-def create(kind: str, name: str, **options: Any) -> Any:
-    """Instantiate the registered component ``name`` of ``kind`` with keyword options; one that
-    needs a module not installed here raises
-    :class:`~physbench.requirements.MissingDependencyError` naming what to install."""
-    from physbench.requirements import require
-
-    cls = get_registry().get(kind, name)
-    require(kind, name, cls)
-    return cls(**options)

@@ -427,150 +427,8 @@ def parse_recordings(
     text = text.removeprefix("\ufeff")
     accuracy = _declared_accuracy(text, source)
     declared, text = _declared_fields(text, source)
-    reader = csv.reader(io.StringIO(text))
-    header: list[str] | None = None
-    header_line = 0
-    row_no = 0
-    # (run, body) -> {"t": [...], "x": [...], "y": [...], "angle": [...], "lines": [...],
-    #                 "angle_line": int}
-    groups: dict[tuple[str, str], dict[str, list]] = {}
-    seen_times: dict[tuple[str, str], dict[float, int]] = {}
-    angle_state: dict[tuple[str, str], tuple[bool, int]] = {}
-    col: dict[str, int] = {}
-
-    def err(msg: str, column: str | None, line: int, row: int | None) -> RecordingError:
-        return RecordingError(msg, source=source, line=line, row=row, column=column)
-
-    for cells in _csv_rows(reader, source):
-        line = reader.line_num
-        if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
-            continue
-        cells = [c.strip() for c in cells]
-        if header is None:
-            header, header_line = cells, line
-            for i, name in enumerate(header):
-                if name not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS:
-                    raise err(
-                        f"unknown column name {name!r}; columns are {', '.join(REQUIRED_COLUMNS)} "
-                        "and optionally "
-                        f"{', '.join(OPTIONAL_COLUMNS)}",
-                        name or f"#{i + 1}",
-                        line,
-                        None,
-                    )
-                if name in col:
-                    raise err(f"duplicate column (also column {col[name] + 1})", name, line, None)
-                col[name] = i
-            for name in REQUIRED_COLUMNS:
-                if name not in col:
-                    raise err(
-                        f"missing required column; the header has {', '.join(header)} but needs "
-                        f"{', '.join(REQUIRED_COLUMNS)}",
-                        name,
-                        line,
-                        None,
-                    )
-            continue
-        row_no += 1
-        if len(cells) != len(header):
-            column = header[len(cells)] if len(cells) < len(header) else f"#{len(header) + 1}"
-            raise err(
-                f"expected {len(header)} values ({', '.join(header)}), got {len(cells)}",
-                column,
-                line,
-                row_no,
-            )
-
-        def number(
-            name: str, cells: list[str] = cells, line: int = line, row_no: int = row_no
-        ) -> float:
-            raw = cells[col[name]]
-            try:
-                v = float(raw)
-            except ValueError:
-                raise err(f"{raw!r} is not a number", name, line, row_no) from None
-            if not math.isfinite(v):
-                raise err(f"{raw!r}: values must be finite numbers", name, line, row_no)
-            return v
-
-        body = cells[col["body"]]
-        if not body:
-            raise err("empty body name", "body", line, row_no)
-        if known is not None and body not in known:
-            raise err(
-                f"unknown body {body!r}; the scene's bodies are {', '.join(known)}",
-                "body",
-                line,
-                row_no,
-            )
-        run = cells[col["run"]] if "run" in col else ""
-        if "run" in col and not run:
-            raise err("empty run label", "run", line, row_no)
-        t = number("t")
-        if t < 0:
-            raise err(
-                f"t = {t!r}: times must be >= 0 (simulations start at t = 0)", "t", line, row_no
-            )
-        x, y = number("x"), number("y")
-        has_angle = "angle" in col and cells[col["angle"]] != ""
-        a = number("angle") if has_angle else math.nan
-        key = (run, body)
-        if key in angle_state and angle_state[key][0] != has_angle:
-            first_with, first_line = angle_state[key]
-            raise err(
-                f"angle is {'given' if first_with else 'empty'} for body {body!r} in run {run!r} "
-                f"at line {first_line} "
-                f"but {'given' if has_angle else 'empty'} here; give it in all of the body's rows "
-                "or in none",
-                "angle",
-                line,
-                row_no,
-            )
-        angle_state.setdefault(key, (has_angle, line))
-        times = seen_times.setdefault(key, {})
-        if t in times:
-            raise err(
-                f"t = {t!r} repeats for body {body!r} in run {run!r} (also at line {times[t]}); a "
-                "body has one sample per time in a run",
-                "t",
-                line,
-                row_no,
-            )
-        times[t] = line
-        g = groups.setdefault(key, {"t": [], "x": [], "y": [], "angle": []})
-        g["t"].append(t)
-        g["x"].append(x)
-        g["y"].append(y)
-        g["angle"].append(a)
-
-    if header is None:
-        raise err(
-            f"empty file; expected a header with columns {','.join(REQUIRED_COLUMNS)} (optionally "
-            "angle, run)",
-            "t",
-            1,
-            None,
-        )
-    if not groups:
-        raise err("no data rows after the header", "t", header_line + 1, 1)
-
-    runs: dict[str, dict[str, Track]] = {}
-    for (run, body), g in groups.items():
-        t = np.asarray(g["t"])
-        order = np.argsort(t, kind="stable")
-        ang = np.asarray(g["angle"])[order] if angle_state[(run, body)][0] else None
-        runs.setdefault(run, {})[body] = Track(
-            t[order], np.asarray(g["x"])[order], np.asarray(g["y"])[order], ang
-        )
-    for run, (_, line) in declared.items():
-        if run is not None and run not in runs:
-            have = ", ".join(repr(r) for r in runs)
-            raise RecordingError(
-                f"fields of run {run!r}, but no row is of that run; runs: {have}",
-                source=source,
-                line=line,
-                comment=True,
-            )
+    runs = _read_samples(text, source, known).tracks()
+    _check_declared_runs(declared, runs, source)
     every = declared.get(None, (None, 0))[0]
     return [
         Recording(
@@ -582,6 +440,211 @@ def parse_recordings(
         )
         for run, tracks in runs.items()
     ]
+
+
+def _cell_error(
+    msg: str, source: str, column: str | None, line: int, row: int | None
+) -> RecordingError:
+    """An error at ``column`` of ``line`` (the header when ``row`` is None)."""
+    return RecordingError(msg, source=source, line=line, row=row, column=column)
+
+
+def _read_samples(text: str, source: str, known: tuple[str, ...] | None) -> _Samples:
+    """Read the header and every data row of the CSV ``text`` (comment lines blanked)."""
+    reader = csv.reader(io.StringIO(text))
+    samples: _Samples | None = None
+    row_no = 0
+    for cells in _csv_rows(reader, source):
+        line = reader.line_num
+        if not cells or all(not c.strip() for c in cells) or cells[0].lstrip().startswith("#"):
+            continue
+        cells = [c.strip() for c in cells]
+        if samples is None:
+            samples = _Samples(source, known, cells, line, _columns(cells, line, source))
+            continue
+        row_no += 1
+        samples.add(cells, line, row_no)
+    if samples is None:
+        raise _cell_error(
+            f"empty file; expected a header with columns {','.join(REQUIRED_COLUMNS)} (optionally "
+            "angle, run)",
+            source,
+            "t",
+            1,
+            None,
+        )
+    if not samples.groups:
+        raise _cell_error("no data rows after the header", source, "t", samples.header_line + 1, 1)
+    return samples
+
+
+def _columns(header: list[str], line: int, source: str) -> dict[str, int]:
+    """The index of each column the header names; unknown, duplicate and missing columns are
+    errors."""
+    col: dict[str, int] = {}
+    for i, name in enumerate(header):
+        if name not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS:
+            raise _cell_error(
+                f"unknown column name {name!r}; columns are {', '.join(REQUIRED_COLUMNS)} "
+                "and optionally "
+                f"{', '.join(OPTIONAL_COLUMNS)}",
+                source,
+                name or f"#{i + 1}",
+                line,
+                None,
+            )
+        if name in col:
+            msg = f"duplicate column (also column {col[name] + 1})"
+            raise _cell_error(msg, source, name, line, None)
+        col[name] = i
+    for name in REQUIRED_COLUMNS:
+        if name not in col:
+            raise _cell_error(
+                f"missing required column; the header has {', '.join(header)} but needs "
+                f"{', '.join(REQUIRED_COLUMNS)}",
+                source,
+                name,
+                line,
+                None,
+            )
+    return col
+
+
+@dataclass(frozen=True)
+class _Sample:
+    """One data row's values (``angle`` NaN when its cell is empty)."""
+
+    run: str
+    body: str
+    t: float
+    x: float
+    y: float
+    angle: float
+    has_angle: bool
+
+
+@dataclass
+class _Samples:
+    """The data rows read so far, grouped by (run, body), with what the checks across rows need:
+    whether each body's rows give an angle (and the first line that said so) and the line of each
+    of its times."""
+
+    source: str
+    known: tuple[str, ...] | None
+    header: list[str]
+    header_line: int
+    col: dict[str, int]
+    groups: dict[tuple[str, str], dict[str, list[float]]] = field(default_factory=dict)
+    seen_times: dict[tuple[str, str], dict[float, int]] = field(default_factory=dict)
+    angle_state: dict[tuple[str, str], tuple[bool, int]] = field(default_factory=dict)
+
+    def err(self, msg: str, column: str | None, line: int, row: int | None) -> RecordingError:
+        return _cell_error(msg, self.source, column, line, row)
+
+    def add(self, cells: list[str], line: int, row_no: int) -> None:
+        """Check one data row against the header and the rows before it, and keep its sample."""
+        s = self._sample(cells, line, row_no)
+        key = (s.run, s.body)
+        if key in self.angle_state and self.angle_state[key][0] != s.has_angle:
+            first_with, first_line = self.angle_state[key]
+            raise self.err(
+                f"angle is {'given' if first_with else 'empty'} for body {s.body!r} in run "
+                f"{s.run!r} at line {first_line} "
+                f"but {'given' if s.has_angle else 'empty'} here; give it in all of the body's "
+                "rows or in none",
+                "angle",
+                line,
+                row_no,
+            )
+        self.angle_state.setdefault(key, (s.has_angle, line))
+        times = self.seen_times.setdefault(key, {})
+        if s.t in times:
+            raise self.err(
+                f"t = {s.t!r} repeats for body {s.body!r} in run {s.run!r} (also at line "
+                f"{times[s.t]}); a body has one sample per time in a run",
+                "t",
+                line,
+                row_no,
+            )
+        times[s.t] = line
+        g = self.groups.setdefault(key, {"t": [], "x": [], "y": [], "angle": []})
+        g["t"].append(s.t)
+        g["x"].append(s.x)
+        g["y"].append(s.y)
+        g["angle"].append(s.angle)
+
+    def _sample(self, cells: list[str], line: int, row_no: int) -> _Sample:
+        """The values of one data row, each checked on its own."""
+        header, col, known = self.header, self.col, self.known
+        if len(cells) != len(header):
+            column = header[len(cells)] if len(cells) < len(header) else f"#{len(header) + 1}"
+            raise self.err(
+                f"expected {len(header)} values ({', '.join(header)}), got {len(cells)}",
+                column,
+                line,
+                row_no,
+            )
+        body = cells[col["body"]]
+        if not body:
+            raise self.err("empty body name", "body", line, row_no)
+        if known is not None and body not in known:
+            raise self.err(
+                f"unknown body {body!r}; the scene's bodies are {', '.join(known)}",
+                "body",
+                line,
+                row_no,
+            )
+        run = cells[col["run"]] if "run" in col else ""
+        if "run" in col and not run:
+            raise self.err("empty run label", "run", line, row_no)
+        t = self._number(cells, "t", line, row_no)
+        if t < 0:
+            msg = f"t = {t!r}: times must be >= 0 (simulations start at t = 0)"
+            raise self.err(msg, "t", line, row_no)
+        x, y = self._number(cells, "x", line, row_no), self._number(cells, "y", line, row_no)
+        has_angle = "angle" in col and cells[col["angle"]] != ""
+        a = self._number(cells, "angle", line, row_no) if has_angle else math.nan
+        return _Sample(run, body, t, x, y, a, has_angle)
+
+    def _number(self, cells: list[str], name: str, line: int, row_no: int) -> float:
+        """The finite number in column ``name``."""
+        raw = cells[self.col[name]]
+        try:
+            v = float(raw)
+        except ValueError:
+            raise self.err(f"{raw!r} is not a number", name, line, row_no) from None
+        if not math.isfinite(v):
+            raise self.err(f"{raw!r}: values must be finite numbers", name, line, row_no)
+        return v
+
+    def tracks(self) -> dict[str, dict[str, Track]]:
+        """Each body's samples as a track in time order, by run, in order of first appearance."""
+        runs: dict[str, dict[str, Track]] = {}
+        for (run, body), g in self.groups.items():
+            t = np.asarray(g["t"])
+            order = np.argsort(t, kind="stable")
+            ang = np.asarray(g["angle"])[order] if self.angle_state[(run, body)][0] else None
+            runs.setdefault(run, {})[body] = Track(
+                t[order], np.asarray(g["x"])[order], np.asarray(g["y"])[order], ang
+            )
+        return runs
+
+
+def _check_declared_runs(
+    declared: Mapping[str | None, tuple[tuple[str, ...], int]],
+    runs: Mapping[str, object],
+    source: str,
+) -> None:
+    """A ``# fields of run`` line must name a run that has rows."""
+    for run, (_, line) in declared.items():
+        if run is not None and run not in runs:
+            have = ", ".join(repr(r) for r in runs)
+            raise RecordingError(
+                f"fields of run {run!r}, but no row is of that run; runs: {have}",
+                source=source,
+                line=line,
+                comment=True,
+            )
 
 
 def read_recordings(

@@ -9,7 +9,7 @@ by multiplying them, in every engine.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -203,7 +203,7 @@ class Joint:
     kind: Literal["pivot"] = "pivot"
 
 
-#: Unit of each body parameter, for the :class:`~physbench.params.Parameter` of an unknown.
+#: Unit of each body parameter, for the :class:`~physbench.unknowns.Parameter` of an unknown.
 BODY_UNITS: dict[str, str] = {"mass": "kg", "elasticity": "", "friction": "", "moment": "kg·m²"}
 
 
@@ -387,6 +387,20 @@ def _check_param(key: str, param: str, value: float) -> None:
 
 
 def validate_scene(scene: Scene) -> None:
+    """Check every value of ``scene``; raise :class:`SceneError` naming the first bad key."""
+    bounds = _check_world(scene)
+    names = _check_bodies(scene, bounds)
+    _check_statics(scene.statics)
+    _check_forces(scene.forces, names)
+    _check_joints(scene.joints, names)
+    _check_unknowns(scene, names)
+    if scene.test_body is not None:
+        _name("test_body", scene.test_body, names)
+
+
+def _check_world(scene: Scene) -> tuple[float, float, float, float]:
+    """Check the scene's name, bounds, gravity, clock and that it has a body; returns the
+    bounds."""
     if not scene.name or not isinstance(scene.name, str):
         raise SceneError("must be a non-empty string", key="name", value=scene.name)
     if not isinstance(scene.bounds, tuple | list) or len(scene.bounds) != 4:
@@ -406,7 +420,11 @@ def validate_scene(scene: Scene) -> None:
             raise SceneError(f"must be a whole number in [1, {most}]", key=key, value=v)
     if not scene.bodies:
         raise SceneError("a scene needs at least one dynamic body", key="bodies", value=[])
+    return xmin, ymin, xmax, ymax
 
+
+def _check_bodies(scene: Scene, bounds: tuple[float, float, float, float]) -> set[str]:
+    """Check each body (names unique); returns their names."""
     seen: set[str] = set()
     for i, b in enumerate(scene.bodies):
         k = f"bodies[{i}]"
@@ -417,29 +435,38 @@ def validate_scene(scene: Scene) -> None:
         if b.name in seen:
             raise SceneError("duplicate body name", key=f"{k}.name", value=b.name)
         seen.add(b.name)
-        _check_shape(f"{k}.shape", b.shape)
-        x, y = _point(f"{k}.position", b.position)
-        hx, hy = b.shape.half_extents(_finite(f"{k}.angle", b.angle))
-        eps = 1e-9
-        if not (
-            xmin + hx - eps <= x <= xmax - hx + eps and ymin + hy - eps <= y <= ymax - hy + eps
-        ):
-            raise SceneError(
-                f"body (half size {hx:g} x {hy:g} m) must lie inside the world bounds "
-                f"{tuple(scene.bounds)}",
-                key=f"{k}.position",
-                value=b.position,
-            )
-        _finite(f"{k}.angle", b.angle)
-        _bounded_vec(f"{k}.velocity", b.velocity, MAX_SPEED, "m/s")
-        _within(f"{k}.angular_velocity", b.angular_velocity, -MAX_SPIN, MAX_SPIN, "rad/s")
-        _point(f"{k}.com_offset", b.com_offset)
-        for p in ("mass", "elasticity", "friction"):
-            _check_param(f"{k}.{p}", p, getattr(b, p))
-        if b.moment is not None:
-            _check_param(f"{k}.moment", "moment", b.moment)
+        _check_body(k, b, scene, bounds)
+    return seen
 
-    for i, s in enumerate(scene.statics):
+
+def _check_body(k: str, b: Body, scene: Scene, bounds: tuple[float, float, float, float]) -> None:
+    """Check body ``b`` (at key ``k``): its shape, that it lies inside the world (``bounds``: the
+    scene's, as numbers), its motion and its parameters."""
+    xmin, ymin, xmax, ymax = bounds
+    _check_shape(f"{k}.shape", b.shape)
+    x, y = _point(f"{k}.position", b.position)
+    hx, hy = b.shape.half_extents(_finite(f"{k}.angle", b.angle))
+    eps = 1e-9
+    if not (xmin + hx - eps <= x <= xmax - hx + eps and ymin + hy - eps <= y <= ymax - hy + eps):
+        raise SceneError(
+            f"body (half size {hx:g} x {hy:g} m) must lie inside the world bounds "
+            f"{tuple(scene.bounds)}",
+            key=f"{k}.position",
+            value=b.position,
+        )
+    _finite(f"{k}.angle", b.angle)
+    _bounded_vec(f"{k}.velocity", b.velocity, MAX_SPEED, "m/s")
+    _within(f"{k}.angular_velocity", b.angular_velocity, -MAX_SPIN, MAX_SPIN, "rad/s")
+    _point(f"{k}.com_offset", b.com_offset)
+    for p in ("mass", "elasticity", "friction"):
+        _check_param(f"{k}.{p}", p, getattr(b, p))
+    if b.moment is not None:
+        _check_param(f"{k}.moment", "moment", b.moment)
+
+
+def _check_statics(statics: Sequence[Static]) -> None:
+    """Check each static segment or polygon and its contact parameters."""
+    for i, s in enumerate(statics):
         k = f"statics[{i}]"
         if isinstance(s, Segment):
             a, bb = _point(f"{k}.a", s.a), _point(f"{k}.b", s.b)
@@ -456,9 +483,12 @@ def validate_scene(scene: Scene) -> None:
         _check_param(f"{k}.elasticity", "elasticity", s.elasticity)
         _check_param(f"{k}.friction", "friction", s.friction)
 
-    for i, f in enumerate(scene.forces):
+
+def _check_forces(forces: Sequence[Force], names: set[str]) -> None:
+    """Check each applied force or impulse: its body, kind, vector and time window."""
+    for i, f in enumerate(forces):
         k = f"forces[{i}]"
-        _name(f"{k}.body", f.body, seen)
+        _name(f"{k}.body", f.body, names)
         if f.kind not in ("force", "impulse"):
             raise SceneError(
                 "unknown force kind; known: force, impulse", key=f"{k}.kind", value=f.kind
@@ -470,20 +500,27 @@ def validate_scene(scene: Scene) -> None:
         if f.kind == "force" and end <= start:
             raise SceneError("a force window needs end > start", key=f"{k}.end", value=f.end)
 
-    for i, j in enumerate(scene.joints):
+
+def _check_joints(joints: Sequence[Joint], names: set[str]) -> None:
+    """Check each pivot: its kind, two different bodies (or a body and the world), its anchor."""
+    for i, j in enumerate(joints):
         k = f"joints[{i}]"
         if j.kind != "pivot":
             raise SceneError("unknown joint kind; known: pivot", key=f"{k}.kind", value=j.kind)
-        _name(f"{k}.a", j.a, seen)
-        _name(f"{k}.b", j.b, seen, world=True)
+        _name(f"{k}.a", j.a, names)
+        _name(f"{k}.b", j.b, names, world=True)
         if j.a == j.b:
             raise SceneError("a joint needs two different bodies", key=f"{k}.b", value=j.b)
         _point(f"{k}.anchor", j.anchor)
 
+
+def _check_unknowns(scene: Scene, names: set[str]) -> None:
+    """Check each unknown body parameter: its body (not the test body), name and range, each
+    declared once."""
     keys: set[str] = set()
     for i, u in enumerate(scene.unknowns):
         k = f"unknowns[{i}]"
-        _name(f"{k}.body", u.owner, seen)
+        _name(f"{k}.body", u.owner, names)
         if not isinstance(u.name, str) or u.name not in BODY_PARAMS:
             raise SceneError(
                 f"unknown parameter; known: {', '.join(BODY_PARAMS)}",
@@ -504,9 +541,6 @@ def validate_scene(scene: Scene) -> None:
             raise SceneError(
                 "the test body's parameters are fixed by definition", key=f"{k}.body", value=u.owner
             )
-
-    if scene.test_body is not None:
-        _name("test_body", scene.test_body, seen)
 
 
 def _check_shape(key: str, shape: object) -> None:

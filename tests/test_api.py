@@ -113,7 +113,7 @@ def test_simulate_overrides_body_parameters_and_takes_a_scene_name() -> None:
 
 
 def test_render_frames_builds_the_named_renderer_with_its_options() -> None:
-    from physbench.experiment import make_renderer
+    from physbench.components import make_renderer
 
     sc = physbench.make_scene("three_circles")
     traj = physbench.simulate(sc)
@@ -124,7 +124,11 @@ def test_render_frames_builds_the_named_renderer_with_its_options() -> None:
     assert frames.shape[3] == 32 and frames.dtype == np.float32
     mask = physbench.render_frames(sc, traj, "raster", resolution=16, mode="mask")
     assert mask.shape[1] == 1 and mask.shape[3] == 16
-    with pytest.raises(PhysbenchError, match=r"does not take options.*blur_px"):
+    with pytest.raises(
+        PhysbenchError,
+        match=r"renderer 'raster' \(physbench's own\) does not take option 'blur_px'; its "
+        r"options: none",
+    ):
         physbench.render_frames(sc, traj, blur_px=2)
 
 
@@ -164,8 +168,8 @@ def test_run_warns_about_an_unknown_that_moves_no_pixel() -> None:
 
 
 def test_refine_is_the_loop_with_every_part_given() -> None:
+    from physbench.components import create
     from physbench.observation import simulate_observation
-    from physbench.plugins import create
 
     sc = physbench.make_scene("three_circles")
     sim, ren = PymunkSimulator(), create("renderer", "raster", resolution=16)

@@ -1,111 +1,131 @@
-"""Calibration of posteriors against truths: exact posteriors cover at the nominal rates and give
-uniform ranks, over-confident ones are caught, and each per-run score means what it says."""
+"""Calibration: pixels to metres by a scale, a known body size, or a homography through point
+pairs of an oblique view; lens distortion; the TOML file; bad input named."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
-from scipy.stats import gaussian_kde
 
-from physbench.calibration import LEVELS, Coverage, Score, coverage, score, summarize
-from physbench.errors import PhysbenchError
-from physbench.posterior import Posterior
-
-
-def _post(samples: np.ndarray, low: float = -10.0, high: float = 10.0) -> Posterior:
-    return Posterior(("a.mass",), np.asarray(samples).reshape(-1, 1), (low,), (high,), "test")
-
-
-def _gaussian_runs(runs: int, spread: float, seed: int) -> list[Score]:
-    """Runs whose posterior is N(m, spread) while the truth is drawn from N(m, 1): exact for
-    ``spread`` 1."""
-    rng = np.random.default_rng(seed)
-    out = []
-    for _ in range(runs):
-        m = rng.uniform(-3, 3)
-        truth = m + rng.standard_normal()
-        post = _post(m + spread * rng.standard_normal(2000))
-        out.append(score(post, {"a.mass": truth})["a.mass"])
-    return out
+from physbench.calibration import (
+    Calibration,
+    CalibrationError,
+    Lens,
+    load_calibration,
+    loads_calibration,
+)
 
 
-def test_exact_gaussian_posteriors_cover_at_the_nominal_rates() -> None:
-    scores = _gaussian_runs(400, 1.0, seed=0)
-    for c in coverage(scores):
-        lo, hi = c.ci(0.99)  # four levels: 95 % intervals would miss one by chance too often
-        assert c.n == 400 and lo <= c.level <= hi, (c, lo, hi)
-    summary = summarize(scores)
-    assert summary["sbc_p"] > 0.05
-    assert summary["coverage90"] == pytest.approx(0.9, abs=0.04)
-    assert summary["scored"] == 400
-    # a 90 % interval of N(m, 1) is 3.29 wide, of a range 20 wide
-    assert summary["width90"] == pytest.approx(3.29 / 20, rel=0.03)
+def oblique_camera() -> np.ndarray:
+    """An oblique, perspective view of a 4 x 3 m plane in a 640 x 480 image: the homography
+    scene (x, y, 1) -> image (u, v, 1). The plane's rectangle images as a quadrilateral whose far
+    side is shorter (foreshortening) and whose sides converge."""
+    return np.array([[110.0, 25.0, 90.0], [-12.0, -95.0, 420.0], [0.03, 0.04, 1.0]])
 
 
-def test_a_too_narrow_posterior_is_flagged() -> None:
-    summary = summarize(_gaussian_runs(400, 1 / 3, seed=0))
-    assert summary["coverage90"] < 0.5 and summary["coverage50"] < 0.25
-    assert summary["sbc_p"] < 1e-6
-    # its mean negative log density is worse than the exact posterior's
-    assert summary["nld"] > summarize(_gaussian_runs(400, 1.0, seed=0))["nld"] + 0.5
+def project(h: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    q = np.column_stack([xy, np.ones(len(xy))]) @ h.T
+    return q[:, :2] / q[:, 2:]
 
 
-def test_rank_is_the_share_of_samples_below_the_truth() -> None:
-    post = _post(np.arange(100.0) / 10 - 5)  # -5.0 ... 4.9
-    assert score(post, {"a.mass": -6.0})["a.mass"].rank == 0.0
-    assert score(post, {"a.mass": 6.0})["a.mass"].rank == 1.0
-    assert score(post, {"a.mass": -2.45})["a.mass"].rank == pytest.approx(0.26)
-    assert score(post, {"a.mass": -2.5})["a.mass"].rank == pytest.approx(0.255)  # a tie: half
+CORNERS = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]])
 
 
-def test_intervals_contain_the_truth_by_level() -> None:
-    rng = np.random.default_rng(1)
-    post = _post(rng.standard_normal(20_000))
-    # 1.5 sigma: outside the 50 % and 80 % intervals (0.67, 1.28), inside 90 % and 95 %
-    s = score(post, {"a.mass": 1.5})["a.mass"]
-    assert s.inside == (False, False, True, True)
-    assert Score.from_dict(s.to_dict()) == s
-    assert list(s.to_dict())[: len(LEVELS)] == ["in50", "in80", "in90", "in95"]
+def test_four_points_of_an_oblique_view_give_the_exact_homography() -> None:
+    h = oblique_camera()
+    uv = project(h, CORNERS)
+    assert (uv > 0).all() and (uv[:, 0] < 640).all() and (uv[:, 1] < 480).all()
+    cal = Calibration.from_points(uv, CORNERS)
+    assert cal.reprojection_error < 1e-6
+    inside = np.array([[1.0, 0.5], [2.5, 2.0], [3.9, 2.9]])
+    np.testing.assert_allclose(cal.to_scene(project(h, inside)), inside, atol=1e-9)
+    np.testing.assert_allclose(cal.to_image(inside), project(h, inside), atol=1e-6)
 
 
-def test_negative_log_density_is_in_unit_range_units() -> None:
-    rng = np.random.default_rng(2)
-    flat = _post(rng.uniform(0, 10, 4000), 0.0, 10.0)
-    # as likely as under the uniform prior, at the ends too (the estimate is reflected there)
-    for t in (0.1, 5.0, 9.9):
-        assert score(flat, {"a.mass": t})["a.mass"].nld == pytest.approx(0.0, abs=0.15)
-    narrow = _post(rng.normal(5.0, 0.5, 4000), 0.0, 10.0)  # sd 0.05 of the range
-    # far from the ends: scipy's Gaussian KDE of the unit-range samples
-    kde = gaussian_kde(narrow.samples[:, 0] / 10.0)
-    assert score(narrow, {"a.mass": 5.5})["a.mass"].nld == pytest.approx(
-        -kde.logpdf(0.55)[0], rel=1e-9
+def test_marked_points_with_pixel_noise_fit_within_half_a_pixel() -> None:
+    h = oblique_camera()
+    rng = np.random.default_rng(0)
+    xy = np.array([[x, y] for x in (0.0, 1.0, 2.0, 3.0, 4.0) for y in (0.0, 1.5, 3.0)])
+    uv = project(h, xy) + rng.normal(0, 0.3, (len(xy), 2))  # a person clicking to 0.3 px
+    cal = Calibration.from_points(uv, xy)
+    assert cal.reprojection_error <= 0.5
+    truth = np.array([[2.0, 1.0]])
+    assert np.linalg.norm(cal.to_scene(project(h, truth)) - truth) < 0.005  # metres
+
+
+def test_scale_and_body_size_flip_the_image_rows_into_y_up() -> None:
+    cal = Calibration.from_scale(0.01, (320, 400))
+    np.testing.assert_allclose(cal.to_scene([[320, 400], [420, 300]]), [[0, 0], [1.0, 1.0]])
+    np.testing.assert_allclose(cal.to_image([[1.0, 1.0]]), [[420, 300]])
+    assert cal.metres_per_pixel((100, 100)) == pytest.approx(0.01)
+    ball = Calibration.from_body_size(pixels=22.0, metres=0.066, origin_pixel=(0, 480))
+    assert ball.metres_per_pixel((10, 10)) == pytest.approx(0.003)
+
+
+def test_lens_distortion_round_trips_and_is_undone_before_the_homography() -> None:
+    lens = Lens(k1=-0.12, k2=0.02, centre=(320.0, 240.0), focal=800.0)
+    pts = np.array([[10.0, 10.0], [320.0, 240.0], [630.0, 470.0], [500.0, 60.0]])
+    np.testing.assert_allclose(lens.undistort(lens.distort(pts)), pts, atol=1e-8)
+    h = oblique_camera()
+    seen = lens.distort(project(h, CORNERS))
+    cal = Calibration.from_points(seen, CORNERS, lens=lens)
+    inside = np.array([[2.5, 2.0]])
+    np.testing.assert_allclose(cal.to_scene(lens.distort(project(h, inside))), inside, atol=1e-8)
+    plain = Calibration.from_points(seen, CORNERS)  # ignoring the lens costs real accuracy
+    assert np.linalg.norm(plain.to_scene(lens.distort(project(h, inside))) - inside) > 1e-3
+
+
+def test_toml_files_for_each_way_and_the_exact_round_trip(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    h = oblique_camera()
+    uv = project(h, CORNERS)
+    points = "\n".join(
+        f"[[points]]\nimage = [{float(u)!r}, {float(v)!r}]\nscene = [{float(x)!r}, {float(y)!r}]"
+        for (u, v), (x, y) in zip(uv, CORNERS, strict=True)
     )
-    assert score(narrow, {"a.mass": 5.0})["a.mass"].nld == pytest.approx(
-        math.log(0.05 * math.sqrt(2 * math.pi)), abs=0.1
-    )
+    cal = loads_calibration(points + "\n[lens]\nk1 = 0.0\ncentre = [320, 240]\nfocal = 800\n")
+    assert cal.lens is not None and cal.reprojection_error < 1e-6
+    path = tmp_path / "cal.toml"
+    path.write_text(cal.to_toml())
+    back = load_calibration(path)
+    np.testing.assert_array_equal(back.homography, cal.homography)
+    assert back.lens == cal.lens and back.source == str(path)
+    scale = loads_calibration("[scale]\nmetres_per_pixel = 0.002\norigin_pixel = [0, 480]\n")
+    assert scale.metres_per_pixel((1, 1)) == pytest.approx(0.002)
+    body = loads_calibration("[body]\npixels = 40\nmetres = 0.2\norigin_pixel = [0, 0]\n")
+    assert body.metres_per_pixel((1, 1)) == pytest.approx(0.005)
 
 
-def test_equal_samples_give_a_finite_density() -> None:
-    point = _post(np.full(50, 3.0), 0.0, 10.0)
-    s = score(point, {"a.mass": 3.0})["a.mass"]
-    assert s.width90 == 0.0 and s.inside == (True,) * len(LEVELS)
-    assert s.nld == pytest.approx(math.log(1e-3 * math.sqrt(2 * math.pi)))
-    far = score(point, {"a.mass": 4.0})["a.mass"]  # 100 floor widths away
-    assert math.isfinite(far.nld) and far.nld > 1000 and far.inside == (False,) * len(LEVELS)
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("", "exactly one of [scale], [[points]], [body] or [homography], got none"),
+        ("[scale]\nmetres_per_pixel = 0\norigin_pixel = [0, 0]", "metres_per_pixel = 0: expected"),
+        (
+            "[scale]\nmetres_per_pixel = 1\norigin_pixel = [0]",
+            "origin_pixel = [0]: expected a pair",
+        ),
+        ("[scale]\nmetres = 1", "scale.metres: unknown key; known: metres_per_pixel, origin_pixel"),
+        ("[zoom]\nx = 1", "zoom: unknown key"),
+        ("[[points]]\nimage = [0, 0]\nscene = [0, 0]", "1 pairs given; a plane homography needs"),
+        ("[lens]\nk1 = 0.1\n[scale]\nmetres_per_pixel = 1\norigin_pixel = [0, 0]", "lens: missing"),
+        ("[scale", "not valid TOML"),
+    ],
+)
+def test_bad_calibrations_are_named(text: str, message: str) -> None:
+    with pytest.raises(CalibrationError, match=message.replace("[", r"\[").replace("]", r"\]")):
+        loads_calibration(text)
 
 
-def test_a_truth_without_a_key_is_refused() -> None:
-    with pytest.raises(PhysbenchError, match=r"truth lacks a\.mass"):
-        score(_post(np.zeros(3)), {"b.mass": 1.0})
-
-
-def test_coverage_interval_is_clopper_pearson() -> None:
-    c = Coverage(0.9, 9, 10)
-    assert c.observed == 0.9
-    lo, hi = c.ci()
-    assert (lo, hi) == pytest.approx((0.5550, 0.9975), abs=1e-4)
-    assert all(math.isnan(v) for v in (*Coverage(0.9, 0, 0).ci(), Coverage(0.9, 0, 0).observed))
-    empty = summarize([])
-    assert empty["scored"] == 0 and math.isnan(empty["sbc_p"]) and math.isnan(empty["nld"])
+def test_collinear_or_too_few_points_cannot_fix_the_plane(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    line = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [3.0, 3.0]])
+    with pytest.raises(CalibrationError, match=r"scene points .* lie on one line"):
+        Calibration.from_points(project(oblique_camera(), line), line)
+    good = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    with pytest.raises(CalibrationError, match=r"image points .* lie on one line"):
+        Calibration.from_points(line * 10, good)
+    with pytest.raises(CalibrationError, match="pairs of"):
+        Calibration.from_points(good, good[:3])
+    with pytest.raises(CalibrationError, match="does not exist"):
+        load_calibration(tmp_path / "missing.toml")
+    (tmp_path / "latin1.toml").write_bytes(b"# \xe9\n")
+    with pytest.raises(CalibrationError, match="cannot read as UTF-8"):
+        load_calibration(tmp_path / "latin1.toml")

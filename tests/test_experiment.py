@@ -5,14 +5,7 @@ from __future__ import annotations
 import pytest
 
 from physbench.errors import PhysbenchError
-from physbench.experiment import (
-    RunConfig,
-    check_config,
-    config_space,
-    make_estimator,
-    make_renderer,
-    run_config,
-)
+from physbench.experiment import RunConfig, check_config, config_space, run_config
 
 
 def test_settings_round_trip_and_old_settings_take_the_defaults() -> None:
@@ -45,15 +38,6 @@ def test_checks_fail_fast_naming_the_bad_choice() -> None:
     ]:
         with pytest.raises(PhysbenchError, match=message):
             check_config(bad)
-
-
-def test_component_factories_list_the_options_they_take() -> None:
-    with pytest.raises(PhysbenchError, match="its options: startup, design, candidates, gamma"):
-        make_estimator("tpe", {"colour": 1})
-    with pytest.raises(PhysbenchError, match="its options: resolution, mode"):
-        make_renderer("raster", {"colour": 1}, resolution=32, mode="mark")
-    with pytest.raises(PhysbenchError, match="--resolution / --render-mode"):
-        make_renderer("raster", {"mode": "mask"}, resolution=32, mode="mark")
 
 
 def test_a_run_is_a_pure_function_of_its_settings() -> None:

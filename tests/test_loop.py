@@ -26,8 +26,8 @@ from physbench.observation import (
     ObservationError,
     simulate_observation,
 )
-from physbench.params import ParamSpace
 from physbench.testing import ToyRenderer, ToySimulator, toy_task
+from physbench.unknowns import ParamSpace
 
 
 class Scripted(CorrectionEstimator):
@@ -272,7 +272,7 @@ def test_any_number_of_unknown_bodies() -> None:
 
 
 def test_bouncing_balls_end_to_end_with_six_masses_and_marked_objects() -> None:
-    from physbench.plugins import create
+    from physbench.components import create
     from physbench.scenes import bouncing_balls
 
     scene = bouncing_balls.generate(0, n_balls=6)
@@ -291,7 +291,7 @@ def test_bouncing_balls_end_to_end_with_six_masses_and_marked_objects() -> None:
 
 
 def test_an_estimate_at_an_end_of_its_range_is_flagged() -> None:
-    from physbench.plugins import create
+    from physbench.components import create
     from physbench.render.raster import RasterRenderer
     from physbench.scenes.generator import resolve_scene
 

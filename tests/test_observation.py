@@ -37,8 +37,8 @@ def test_observation_files_round_trip_and_bad_files_are_explained(tmp_path) -> N
 
 
 def test_a_simulated_observation_file_carries_its_scene_truth_and_engine(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from physbench.components import create
     from physbench.effects.drag import LinearDrag
-    from physbench.plugins import create
     from physbench.render.raster import RasterRenderer
     from physbench.scenes import resolve_scene
 

@@ -8,8 +8,8 @@ from typing import ClassVar
 
 import pytest
 
+from physbench.components import create
 from physbench.estimators.base import CorrectionEstimator
-from physbench.plugins import create
 from physbench.requirements import MissingDependencyError, Requirements, missing_of, require
 
 

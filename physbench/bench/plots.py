@@ -12,7 +12,7 @@ function).
 - :func:`time_to_accuracy`: the share of seeds whose answer has reached the paper's value, against
   simulations and against wall-clock seconds (:mod:`physbench.bench.time_to_accuracy`).
 - :func:`coverage`: for estimators that return a posterior, how often the truth lies inside
-  its central intervals against how often it should (:mod:`physbench.calibration`).
+  its central intervals against how often it should (:mod:`physbench.posterior.scoring`).
 
 Axes carry units (:mod:`physbench.plotting.units`), legends sit outside the axes, titles name the
 engine and blur, and iterations are numbered as in the long table (0: the initial guess).
@@ -270,9 +270,8 @@ def landscape_data(
     ``body.param`` moved across its range, per key: ``{"x": Δp grid (points,), key: (seeds,
     points)}``, Δp relative to the nominal value (the range's middle); frames from ``renderer``
     with ``renderer_options``."""
-    from physbench.experiment import make_renderer
+    from physbench.components import create, make_renderer
     from physbench.metrics import image_mse
-    from physbench.plugins import create
     from physbench.scenes import resolve_scene
 
     sim = create("simulator", engine)
@@ -413,8 +412,8 @@ def coverage(df: pd.DataFrame, out: Path) -> list[Path]:
     coverage of the central intervals, a line per estimator and unknown set (pooled over seeds
     and unknowns) with Clopper-Pearson bars, and the diagonal a calibrated posterior follows.
     Nothing for a table without posteriors."""
-    from physbench.calibration import CONFIDENCE, LEVELS
-    from physbench.calibration import coverage as observed_coverage
+    from physbench.posterior.scoring import CONFIDENCE, LEVELS
+    from physbench.posterior.scoring import coverage as observed_coverage
 
     fin = final_rows(df)
     if not has_posteriors(fin):

@@ -260,7 +260,7 @@ def _import_tables() -> None:
     import scipy.stats  # noqa: F401
 
     import physbench.bench.summary
-    import physbench.calibration  # noqa: F401
+    import physbench.posterior.scoring  # noqa: F401
 
     versions()  # for run.json
 

@@ -48,13 +48,12 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from physbench.commands.arguments import MAX_RESOLUTION, MAX_SEED
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
-from physbench.params import split_params
+from physbench.limits import MAX_NOISE, MAX_RESOLUTION, MAX_SEED
 from physbench.render.base import DEFAULT_RENDERER
-from physbench.render.observe import MAX_NOISE
 from physbench.simulators.base import DEFAULT_SIMULATOR
+from physbench.unknowns import split_params
 
 #: The most seeds a spec may list: each is a cell per scene x estimator x axis value, so more is
 #: a typo (``seeds = 2**62`` would build the list before anything runs).
@@ -480,9 +479,10 @@ def load_spec(path: str | Path) -> Spec:
 def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
     """Build every estimator and renderer once and look up every name, so a bad spec fails
     before anything runs; errors name the spec file and the key."""
-    from physbench.experiment import config_space, make_estimator, make_observer, make_renderer
+    from physbench.components import make_estimator, make_observer, make_renderer
+    from physbench.experiment import config_space
     from physbench.plugins import get_registry
-    from physbench.render.observe import ObservationModel
+    from physbench.render.sensor import SensorModel
     from physbench.scenes import resolve_scene
 
     reg = get_registry()
@@ -518,7 +518,7 @@ def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
                     "segmented into masks (mark, instance or mask)"
                 )
         for blur, noise in itertools.product(spec.axes["blur"], spec.axes["noise"]):
-            ObservationModel(blur=blur, noise=noise)
+            SensorModel(blur=blur, noise=noise)
         for sc in spec.scenes:
             scene = resolve_scene(sc.path, spec.seeds[0])
             for unknowns in sc.unknowns:

@@ -77,7 +77,7 @@ class Stamper:
         defaults included)."""
         key = (name, json.dumps(dict(options), sort_keys=True, default=repr))
         if key not in self._estimators:
-            from physbench.experiment import make_estimator
+            from physbench.components import make_estimator
 
             try:
                 resolved: Any = _canonical(dict(make_estimator(name, options).options))

@@ -10,9 +10,9 @@ exactly, and :func:`param_frame` spreads it into columns when needed. Columns st
 are wall-clock timings; everything else is identical between runs of the same spec.
 
 A sweep where some estimator returned a posterior also has a ``calibration`` column
-(:data:`OPTIONAL`): per unknown, the :mod:`physbench.calibration` scores of the cell's posterior
-against its truth (a JSON object like ``params``), null for cells without one. A sweep without
-posteriors lacks the column, so its tables are those written before calibration existed.
+(:data:`OPTIONAL`): per unknown, the :mod:`physbench.posterior.scoring` scores of the cell's
+posterior against its truth (a JSON object like ``params``), null for cells without one. A sweep
+without posteriors lacks the column, so its tables are those written before calibration existed.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from physbench.render.base import DEFAULT_RENDERER
 if TYPE_CHECKING:
     import pandas as pd
 
-    from physbench.calibration import Score
+    from physbench.posterior.scoring import Score
 
 #: Column -> pandas dtype of the long table.
 SCHEMA: dict[str, str] = {
@@ -226,8 +226,8 @@ def cell_rows(cell: Mapping[str, Any], data: Mapping[str, Any]) -> list[dict[str
 
 def _calibration(posterior: Mapping[str, Any], truth: Mapping[str, float]) -> str:
     """The ``calibration`` cell: the scores of a stored posterior against the truth."""
-    from physbench.calibration import score
-    from physbench.posterior import Posterior
+    from physbench.posterior.samples import Posterior
+    from physbench.posterior.scoring import score
 
     scores = score(Posterior.from_dict(posterior), truth)
     return dumps({k: s.to_dict() for k, s in scores.items()})
@@ -379,7 +379,7 @@ def _ordered_groups(df: pd.DataFrame, cols: Sequence[str]) -> list[tuple[Any, ..
 def calibration_scores(rows: pd.DataFrame) -> list[Score]:
     """The posterior scores in the ``calibration`` column of finished ``rows``, one per cell and
     unknown (none for a table without the column)."""
-    from physbench.calibration import Score
+    from physbench.posterior.scoring import Score
 
     if "calibration" not in rows.columns:
         return []
@@ -397,12 +397,12 @@ def stats(df: pd.DataFrame) -> pd.DataFrame:
     bootstrap interval (of the mean) of the normalized min MSE after the configuration's
     iterations, plus the initial guess's mean error and the paper's values where it has the cell.
     When some cell has a posterior, also the calibration of the configuration's posteriors
-    (:func:`physbench.calibration.summarize`: ``coverage50`` ... ``coverage95``, ``sbc_p``,
+    (:func:`physbench.posterior.scoring.summarize`: ``coverage50`` ... ``coverage95``, ``sbc_p``,
     ``width90``, ``nld``, ``scored``; NaN and 0 scored for a configuration without
     posteriors)."""
     import pandas as pd
 
-    from physbench.calibration import summarize
+    from physbench.posterior.scoring import summarize
 
     df = upgrade(df)
     fin = final_rows(df)
@@ -564,7 +564,7 @@ def calibration(st: pd.DataFrame) -> pd.DataFrame:
     Empty when no configuration has posteriors."""
     import pandas as pd
 
-    from physbench.calibration import LEVELS
+    from physbench.posterior.scoring import LEVELS
 
     if "scored" not in st.columns:
         return pd.DataFrame()

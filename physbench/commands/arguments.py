@@ -15,7 +15,7 @@ The vocabulary (tests/commands/test_vocabulary.py walks every parser against it)
   :data:`DEFAULT_SCENE` where the command makes its own data (run, simulate, train) and is
   required where it must describe given data (track, discover).
 - ``--params`` takes one set of unknowns spelled ``mass+elasticity``, ``mass,elasticity`` or
-  ``mass elasticity`` (:func:`physbench.params.split_params`).
+  ``mass elasticity`` (:func:`physbench.unknowns.split_params`).
 - ``-q/--quiet`` on every command that prints more than its result or shows progress; progress
   goes to stderr and only on a terminal (:mod:`physbench.commands.console`).
 """
@@ -28,16 +28,12 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from physbench.limits import MAX_RESOLUTION, MAX_SCENE_ARGUMENT, MAX_SEED
+
 #: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
 RENDER_MODES = ("mark", "instance", "mask", "rgb")
 #: physbench.experiment.DEFAULT_SCENE, for the same reason.
 DEFAULT_SCENE = "three_circles"
-#: The widest frame in pixels: a (T, C, H, W) float32 sequence at 4096 px already takes GiBs.
-MAX_RESOLUTION = 4096
-#: Seeds go to numpy, random, torch and optuna; this is the range all of them accept.
-MAX_SEED = 2**32 - 1
-#: The widest ``--noise``: physbench.render.observe.MAX_NOISE, kept here for the same reason.
-MAX_NOISE = 1.0
 #: The epilog of the commands that refuse a job too big for this machine (physbench.cost; kept
 #: here so that building a parser imports nothing else).
 SIZE_CHECK_HELP = (
@@ -46,8 +42,6 @@ SIZE_CHECK_HELP = (
     "is available or more than 24 h of compute is refused, naming the estimate. Set the "
     "environment variable PHYSBENCH_NO_SIZE_CHECK=1 to run it anyway (docs/architecture.md)."
 )
-#: The longest ``--scene``: Linux's PATH_MAX (a longer path cannot name a file).
-MAX_SCENE_ARGUMENT = 4096
 
 
 def bounded_int(low: int, high: int | None = None) -> Callable[[str], int]:
@@ -125,7 +119,7 @@ def add_scene_argument(p: argparse.ArgumentParser, *, required: bool, help: str 
 
 def add_params_argument(p: argparse.ArgumentParser, *, help: str = "") -> None:
     """``--params``: one set of unknowns, as words, or joined by ``+`` or ``,``; read it with
-    :func:`physbench.params.split_params`."""
+    :func:`physbench.unknowns.split_params`."""
     p.add_argument(
         "--params",
         nargs="+",
@@ -232,7 +226,7 @@ def renderer_choice(args: argparse.Namespace) -> tuple[str, dict[str, Any]]:
 
 def make_renderer_from(args: argparse.Namespace) -> Any:
     """The renderer the parsed ``args`` choose, built with their resolution and render mode."""
-    from physbench.experiment import make_renderer
+    from physbench.components import make_renderer
 
     name, options = renderer_choice(args)
     return make_renderer(name, options, resolution=args.resolution, mode=args.render_mode)

@@ -152,10 +152,10 @@ def main(args: argparse.Namespace) -> int:
 
     from physbench.commands.arguments import renderer_choice
     from physbench.commands.console import show_progress, stages, wrote
+    from physbench.components import create
     from physbench.discover import Settings, discover, load_runs, renderer_for
     from physbench.discover.verdict import text, to_dict
     from physbench.errors import PhysbenchError
-    from physbench.plugins import create
     from physbench.scenes import resolve_scene
 
     out, to_stdout = args.out, args.json == "-"

@@ -14,8 +14,6 @@ import sys
 from typing import Any
 
 from physbench.commands.arguments import (
-    MAX_NOISE,
-    MAX_RESOLUTION,
     SIZE_CHECK_HELP,
     add_json_argument,
     add_params_argument,
@@ -27,10 +25,20 @@ from physbench.commands.arguments import (
     positive_int,
     seed_int,
 )
+from physbench.limits import MAX_NOISE, MAX_RESOLUTION
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.epilog = SIZE_CHECK_HELP
+    _add_estimator_arguments(p)
+    _add_problem_arguments(p)
+    _add_simulation_arguments(p)
+    _add_observation_arguments(p)
+    _add_output_arguments(p)
+
+
+def _add_estimator_arguments(p: argparse.ArgumentParser) -> None:
+    """The estimator and its options."""
     p.add_argument(
         "--estimator",
         default="tpe",
@@ -46,6 +54,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="estimator option, repeatable, e.g. -o startup=5 or -o sampler=cmaes (values parse as "
         "JSON, else text)",
     )
+
+
+def _add_problem_arguments(p: argparse.ArgumentParser) -> None:
+    """The scene, its unknowns, the iteration budget and the seed."""
     add_scene_argument(
         p,
         required=False,
@@ -74,6 +86,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="scene instance, truth, initial guess and estimator seed (default: 0); with an "
         "--observation file that carries its scene, only the initial guess and estimator seed",
     )
+
+
+def _add_simulation_arguments(p: argparse.ArgumentParser) -> None:
+    """The engines, the renderer and what degrades the simulated observation."""
     p.add_argument(
         "--engine",
         default=None,
@@ -105,6 +121,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help=f"Gaussian pixel noise (standard deviation, at most {MAX_NOISE:g}) of the "
         "observation only",
     )
+
+
+def _add_observation_arguments(p: argparse.ArgumentParser) -> None:
+    """A given observation: an observation file, a camera's video or a filmed simulation."""
     p.add_argument(
         "--observation",
         default=None,
@@ -135,6 +155,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="KEY=VALUE",
         help="an option of --observer, repeatable (e.g. tilt=15, bitrate=2000000, resolution=640)",
     )
+
+
+def _add_output_arguments(p: argparse.ArgumentParser) -> None:
+    """What is written: the observation, the history, a plot, and how much is printed."""
     p.add_argument(
         "--save-observation",
         default=None,
@@ -214,9 +238,24 @@ def describe_observation(history: Any) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
-    from pathlib import Path
+    _check_arguments(args)
+    config = _build_config(args)
+    history = _run_with_progress(args, config)
+    _save_outputs(args, history)
+    _warn_about_result(history)
+    if args.json:
+        print(history.to_json(indent=1))
+        return 0
+    if not args.quiet:
+        _print_details(args, history)
+    _print_posterior(history)
+    _print_final_line(args, history)
+    return 0
 
-    from physbench.errors import PhysbenchError, counted
+
+def _check_arguments(args: argparse.Namespace) -> None:
+    """Refuse an iteration count below 1 and a blur wider than the frame."""
+    from physbench.errors import PhysbenchError
 
     if args.iterations < 1:
         raise PhysbenchError(f"--iterations {args.iterations}: expected a whole number >= 1")
@@ -226,16 +265,13 @@ def main(args: argparse.Namespace) -> int:
             f"{args.resolution} pixels (a wider blur leaves flat frames)"
         )
 
+
+def _build_config(args: argparse.Namespace) -> Any:
+    """The checked :class:`~physbench.experiment.RunConfig` the flags describe."""
     from physbench.commands.arguments import parse_key_values, renderer_choice
-    from physbench.commands.console import progress_bar, wrote
-    from physbench.experiment import (
-        DEFAULT_SCENE,
-        RunConfig,
-        check_config,
-        default_render_mode,
-        run_config,
-    )
-    from physbench.params import split_params
+    from physbench.components import default_render_mode
+    from physbench.experiment import RunConfig, check_config
+    from physbench.unknowns import split_params
 
     params = split_params(args.params)
     bodies = (
@@ -270,6 +306,13 @@ def main(args: argparse.Namespace) -> int:
         video_end=args.end,
     )
     check_config(config)  # a bad name or option: fail before the progress bar appears
+    return config
+
+
+def _run_with_progress(args: argparse.Namespace, config: Any) -> Any:
+    """Run ``config`` behind a progress bar showing the best errors so far; the history."""
+    from physbench.commands.console import progress_bar
+    from physbench.experiment import DEFAULT_SCENE, run_config
 
     bar = progress_bar(
         args,
@@ -287,7 +330,7 @@ def main(args: argparse.Namespace) -> int:
         bar.update(1)
 
     try:
-        history = run_config(
+        return run_config(
             config,
             callback=progress,
             save_observation=args.save_observation,
@@ -295,11 +338,18 @@ def main(args: argparse.Namespace) -> int:
         )
     finally:
         bar.close()
+
+
+def _save_outputs(args: argparse.Namespace, history: Any) -> None:
+    """Report the saved observation; write the plots and the history JSON asked for."""
+    from pathlib import Path
+
+    from physbench.commands.console import wrote
+
     if args.save_observation:
         # numpy adds .npz to a name without it
         saved = str(args.save_observation)
         wrote(saved if saved.endswith(".npz") else saved + ".npz")
-
     if args.plot:
         from physbench.plotting.convergence import plot_convergence, run_title
 
@@ -315,6 +365,9 @@ def main(args: argparse.Namespace) -> int:
         Path(args.out).write_text(history.to_json(indent=1) + "\n", encoding="utf-8")
         wrote(args.out)
 
+
+def _warn_about_result(history: Any) -> None:
+    """Warn on stderr of estimates at a range's end and of incomplete or uninformed posteriors."""
     if history.at_bound:
         print(
             f"physbench run: warning: {', '.join(history.at_bound)} ended at an end of "
@@ -331,40 +384,50 @@ def main(args: argparse.Namespace) -> int:
             "the posterior is about as wide as the range",
             file=sys.stderr,
         )
-    if args.json:
-        print(history.to_json(indent=1))
-        return 0
-    n = len(history)
-    if not args.quiet:
-        if args.observation:
-            print(describe_observation(history))
-        print_table(history)
-        t = history.timings()
-        print(
-            f"per iteration: simulate {1e3 * t['simulate']:.2f} ms, render "
-            f"{1e3 * t['render']:.2f} ms, "
-            f"estimator {1e3 * t['estimator']:.2f} ms"
-        )
-        best = history.best
-        if history.truth is not None:
-            print("truth:   " + "  ".join(f"{k}={v:.4g}" for k, v in history.truth.items()))
-        print(
-            f"best (iteration {best.iteration}, by image MSE): "
-            + "  ".join(
-                f"{k}={v:.4g}"
-                + (" (unseen: a guess)" if k in history.unseen else "")
-                + (
-                    " (at its range's end: the true value may lie beyond)"
-                    if k in history.at_bound
-                    else ""
-                )
-                for k, v in best.params.items()
+
+
+def _print_details(args: argparse.Namespace, history: Any) -> None:
+    """The observation, the per-iteration table, mean timings, the truth and the best iterate."""
+    if args.observation:
+        print(describe_observation(history))
+    print_table(history)
+    t = history.timings()
+    print(
+        f"per iteration: simulate {1e3 * t['simulate']:.2f} ms, render "
+        f"{1e3 * t['render']:.2f} ms, "
+        f"estimator {1e3 * t['estimator']:.2f} ms"
+    )
+    best = history.best
+    if history.truth is not None:
+        print("truth:   " + "  ".join(f"{k}={v:.4g}" for k, v in history.truth.items()))
+    print(
+        f"best (iteration {best.iteration}, by image MSE): "
+        + "  ".join(
+            f"{k}={v:.4g}"
+            + (" (unseen: a guess)" if k in history.unseen else "")
+            + (
+                " (at its range's end: the true value may lie beyond)"
+                if k in history.at_bound
+                else ""
             )
+            for k, v in best.params.items()
         )
+    )
+
+
+def _print_posterior(history: Any) -> None:
+    """The posterior's summary, when the estimator returned one."""
     if history.posterior is not None:
         print(f"posterior ({history.posterior.method}, {len(history.posterior)} samples):")
         for line in history.posterior.describe(history.truth):
             print("  " + line)
+
+
+def _print_final_line(args: argparse.Namespace, history: Any) -> None:
+    """The final line: the normalized min MSE, or without a truth the min image MSE."""
+    from physbench.errors import counted
+
+    n = len(history)
     if history.best_nmse is not None:
         print(
             f"normalized min MSE after {counted(n, 'iteration')}: {history.best_nmse:.3e} "
@@ -375,4 +438,3 @@ def main(args: argparse.Namespace) -> int:
             f"min image MSE after {counted(n, 'iteration')}: {history.min_loss:.3e} (no truth: "
             f"observation from {args.observation or args.video})"
         )
-    return 0

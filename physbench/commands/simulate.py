@@ -4,6 +4,7 @@ camera renderer, a video file, and a preview."""
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from physbench.commands.arguments import (
     DEFAULT_SCENE,
@@ -79,8 +80,8 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
 
 def make_effects(items: list[str]) -> list:
     """Effect instances from ``--effect NAME[:KEY=VALUE,...]`` items."""
+    from physbench.components import create
     from physbench.errors import PhysbenchError
-    from physbench.plugins import create
 
     out = []
     for item in items:
@@ -96,20 +97,37 @@ def make_effects(items: list[str]) -> list:
                 raise PhysbenchError(
                     f"--effect {item!r}: expected NAME[:KEY=NUMBER,...], e.g. linear_drag:c=0.3"
                 ) from None
-        out.append(create("effect", name.strip(), **values))
+        out.append(create("effect", name.strip(), values))
     return out
 
 
 def main(args: argparse.Namespace) -> int:
+    from physbench.scenes import resolve_scene
+
+    video = _check_paths(args)
+    scene = resolve_scene(args.scene or DEFAULT_SCENE, args.seed)
+    scene = scene.with_params(parse_overrides(args.set)).validate()
+    renderer = make_renderer_from(args)  # a bad renderer or option fails before simulating
+    camera = _camera(renderer, args, video)
+    _check_size(scene, renderer, args.resolution)
+    effects = make_effects(args.effect)
+    traj = _simulate(args.engine, scene, effects)
+    # A video is filmed as it is written (_write_out): no separate render of the frames.
+    frames_shape = renderer.shape(scene, traj.frames) if video else None
+    frames = None if video else renderer.render(scene, traj)
+    if not args.quiet:
+        _print_trajectory(args, scene, traj, frames_shape if frames is None else frames.shape)
+    _write_out(args, scene, traj, frames, effects, camera, video)
+    _write_pictures(args, scene, traj, camera)
+    return 0
+
+
+def _check_paths(args: argparse.Namespace) -> bool:
+    """Refuse --out, --plate and --preview names of a kind not written; whether --out is a
+    video."""
     from pathlib import Path
 
-    import numpy as np
-
-    from physbench.commands.console import wrote
     from physbench.errors import PhysbenchError
-    from physbench.plugins import create
-    from physbench.render.camera import CameraRenderer
-    from physbench.scenes import resolve_scene
 
     suffix = Path(args.out).suffix.lower() if args.out else ""
     video = suffix in VIDEO_SUFFIXES
@@ -130,10 +148,15 @@ def main(args: argparse.Namespace) -> int:
                 f"--preview {args.preview!r}: expected {' or '.join(PREVIEW_SUFFIXES)} "
                 "(an animation or a trail picture)"
             )
-    scene = resolve_scene(args.scene or DEFAULT_SCENE, args.seed)
-    scene = scene.with_params(parse_overrides(args.set)).validate()
-    renderer = make_renderer_from(args)  # a bad renderer or option fails before simulating
-    camera = renderer if isinstance(renderer, CameraRenderer) else None
+    return video
+
+
+def _camera(renderer: Any, args: argparse.Namespace, video: bool) -> Any:
+    """``renderer`` if it is a camera, else None; refuse a video or plate without one."""
+    from physbench.errors import PhysbenchError
+    from physbench.render.base import Camera
+
+    camera = renderer if isinstance(renderer, Camera) else None
     for flag, value, wants in (
         ("--out", args.out if video else None, "a video"),
         ("--plate", args.plate, "a plate"),
@@ -144,40 +167,71 @@ def main(args: argparse.Namespace) -> int:
                 f"{renderer.name!r} makes {renderer.mode!r} channels, not a colour image "
                 "(write its frames to an .npz file)"
             )
+    return camera
+
+
+def _check_size(scene: Any, renderer: Any, resolution: int) -> None:
+    """Refuse a simulation this machine cannot hold (:mod:`physbench.cost`)."""
     from physbench import cost
 
     # Rendered frames are held twice: as rendered and while --out compresses them.
-    one = cost.of_scene(scene, resolution=args.resolution, mode=renderer.mode, held=2)
+    one = cost.of_scene(scene, resolution=resolution, mode=renderer.mode, held=2)
     cost.check(
         one,
-        f"this simulation ({cost.simulations(1, scene, args.resolution)})",
+        f"this simulation ({cost.simulations(1, scene, resolution)})",
         "--resolution or the scene's frames, substeps or bodies",
     )
-    effects = make_effects(args.effect)
-    traj = create("simulator", args.engine).simulate(scene, effects=effects)
+
+
+def _simulate(engine: str, scene: Any, effects: list) -> Any:
+    """The trajectory of ``scene`` on ``engine`` with ``effects`` and their measurements."""
+    from physbench.components import create
+
+    traj = create("simulator", engine).simulate(scene, effects=effects)
     if effects:
         from physbench.effects import apply_measurements
 
         traj = apply_measurements(traj, effects)
-    # A video is filmed by write() below: no separate render of the frames.
-    frames_shape = renderer.shape(scene, traj.frames) if video else None
-    frames = None if video else renderer.render(scene, traj)
-    if not args.quiet:
-        print(
-            f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies "
-            f"{', '.join(traj.bodies)}, "
-            f"frames {frames_shape if frames is None else frames.shape}"
-        )
-        for i, name in enumerate(traj.bodies):
-            (x0, y0), (x1, y1) = traj.states[0, i, :2], traj.states[-1, i, :2]
-            print(f"  {name:>8}: ({x0:6.3f}, {y0:6.3f}) -> ({x1:6.3f}, {y1:6.3f}) m")
-    if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    if args.out and video:
+    return traj
+
+
+def _print_trajectory(args: argparse.Namespace, scene: Any, traj: Any, shape: Any) -> None:
+    """One line on the run, then each body's start and end position."""
+    print(
+        f"{scene.name} seed {args.seed} on {args.engine}: {traj.frames} frames, bodies "
+        f"{', '.join(traj.bodies)}, "
+        f"frames {shape}"
+    )
+    for i, name in enumerate(traj.bodies):
+        (x0, y0), (x1, y1) = traj.states[0, i, :2], traj.states[-1, i, :2]
+        print(f"  {name:>8}: ({x0:6.3f}, {y0:6.3f}) -> ({x1:6.3f}, {y1:6.3f}) m")
+
+
+def _write_out(
+    args: argparse.Namespace,
+    scene: Any,
+    traj: Any,
+    frames: Any,
+    effects: list,
+    camera: Any,
+    video: bool,
+) -> None:
+    """Write --out: the camera's clip as a video file, or trajectory and frames as .npz."""
+    if not args.out:
+        return
+    from pathlib import Path
+
+    from physbench.commands.console import wrote
+
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    if video:
+        from physbench.video.writer import write_clip
+
         assert camera is not None
-        camera.write(args.out, scene, traj)
-        wrote(args.out)
-    elif args.out:
+        write_clip(camera, args.out, scene, traj)
+    else:
+        import numpy as np
+
         from physbench.scene_toml import dumps_scene
 
         np.savez_compressed(
@@ -187,7 +241,15 @@ def main(args: argparse.Namespace) -> int:
             effects=np.array([repr(e) for e in effects], dtype=str),
             **traj.to_npz_dict(),
         )
-        wrote(args.out)
+    wrote(args.out)
+
+
+def _write_pictures(args: argparse.Namespace, scene: Any, traj: Any, camera: Any) -> None:
+    """Write the --plate image and the --preview picture."""
+    from pathlib import Path
+
+    from physbench.commands.console import wrote
+
     if args.plate:
         from PIL import Image
 
@@ -200,4 +262,3 @@ def main(args: argparse.Namespace) -> int:
 
         save_preview(scene, traj, args.preview)
         wrote(args.preview)
-    return 0

@@ -34,11 +34,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from physbench.calibration import load_calibration
     from physbench.commands.console import show_progress, wrote
     from physbench.errors import PhysbenchError
     from physbench.recording import write_recordings
     from physbench.scenes import resolve_scene
-    from physbench.video.calibration import load_calibration
     from physbench.video.overlay import OVERLAY_SUFFIXES, write_overlay
     from physbench.video.track import track_video
 

@@ -28,6 +28,15 @@ FRAMES = (2, 64)
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.epilog = SIZE_CHECK_HELP
+    _add_target_arguments(p)
+    _add_training_arguments(p)
+    _add_data_arguments(p)
+    _add_validation_arguments(p)
+    _add_mode_arguments(p)
+
+
+def _add_target_arguments(p: argparse.ArgumentParser) -> None:
+    """What is trained (scene and unknowns) and where it is written."""
     add_scene_argument(
         p,
         required=False,
@@ -36,6 +45,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     add_params_argument(p)
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/train/SCENE__PARAMS)")
+
+
+def _add_training_arguments(p: argparse.ArgumentParser) -> None:
+    """The budget, the network's shape, the device, augmentation and the starting weights."""
     p.add_argument(
         "--samples",
         type=bounded_int(1, MAX_SAMPLES),
@@ -90,6 +103,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "their --widths must match, --resolution and --frames may differ (a bigger input from "
         "the same tensors); training draws scene instances after the ones they were trained on",
     )
+
+
+def _add_data_arguments(p: argparse.ArgumentParser) -> None:
+    """How the training data are made: engine, renderer, processes and threads."""
     p.add_argument("--engine", default="pymunk", help="simulator generating the training data")
     add_renderer_choice(p)
     p.add_argument(
@@ -101,6 +118,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--threads", type=nonnegative_int, default=0, help="torch threads (default: torch's choice)"
     )
+
+
+def _add_validation_arguments(p: argparse.ArgumentParser) -> None:
+    """Validation during training and the held-out evaluation after it."""
     p.add_argument(
         "--val-groups",
         type=positive_int,
@@ -119,6 +140,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=5,
         help="held-out runs of the final evaluation (0 to skip)",
     )
+
+
+def _add_mode_arguments(p: argparse.ArgumentParser) -> None:
+    """Resuming, the npe posterior instead of resnet3d, and how much is printed."""
     p.add_argument(
         "--no-resume", action="store_true", help="start over even if a checkpoint exists"
     )
@@ -149,41 +174,81 @@ def check_size(spec: Any, samples: int, scene: Any, minutes: float = 0.0) -> Non
 
 
 def main(args: argparse.Namespace) -> int:
-    import sys
-    from pathlib import Path
-
-    from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
-    from physbench.commands.console import show_progress, wrote
-    from physbench.errors import PhysbenchError
-    from physbench.estimators.resnet3d import sidecar
-    from physbench.estimators.resnet3d.data import DataSpec
-    from physbench.estimators.resnet3d.model import NetConfig
-    from physbench.estimators.resnet3d.train import TrainConfig, train, weights_name
-    from physbench.experiment import make_renderer
-    from physbench.params import ParamSpace, split_params
-    from physbench.plugins import get_registry
-    from physbench.requirements import require
-    from physbench.scenes.generator import resolve_scene
+    from physbench.commands.arguments import DEFAULT_SCENE
+    from physbench.estimators.resnet3d.training_data import DataSpec
 
     if args.posterior:
         return _posterior(args)
+    _fill_defaults(args)
+    scene_name = args.scene or DEFAULT_SCENE  # a registered generator or a scene TOML file
+    params, scene, renderer, renderer_options = _check_problem(args, scene_name)
+    widths = _parse_widths(args.widths)
+    _check_settings(args)
+    spec = DataSpec(
+        scene_name,
+        params,
+        engine=args.engine,
+        renderer=renderer,
+        renderer_options=renderer_options,
+        resolution=args.resolution,
+        frames=args.frames,
+        blur_max=args.blur_max,
+    )
+    check_size(spec, args.samples, scene, args.minutes)
+    path, meta = _train(args, spec, widths)
+    _print_trained(path, meta)
+    if args.eval_seeds:
+        _print_held_out(path, args.eval_seeds)
+    return 0
+
+
+def _fill_defaults(args: argparse.Namespace) -> None:
+    """The resnet3d defaults of the flags whose default depends on --posterior."""
     args.samples = 40_000 if args.samples is None else args.samples
     args.batch = 16 if args.batch is None else args.batch
     args.frames = 15 if args.frames is None else args.frames
+
+
+def _check_problem(
+    args: argparse.Namespace, scene_name: str
+) -> tuple[tuple[str, ...], Any, str, dict[str, Any]]:
+    """Check resnet3d is installed, the unknowns and the renderer; the unknowns, the scene
+    instance of seed 0 and the renderer's name and options."""
+    from physbench.commands.arguments import renderer_choice
+    from physbench.components import make_renderer
+    from physbench.plugins import get_registry
+    from physbench.requirements import require
+    from physbench.scenes.generator import resolve_scene
+    from physbench.unknowns import ParamSpace, split_params
+
     require("estimator", "resnet3d", get_registry().get("estimator", "resnet3d"))
     params = split_params(args.params)
-    scene_name = args.scene or DEFAULT_SCENE  # a registered generator or a scene TOML file
     scene = resolve_scene(scene_name, 0)
     ParamSpace.from_scene(scene, params)  # unknown parameter names fail here, listing the known
     renderer, renderer_options = renderer_choice(args)
     make_renderer(renderer, renderer_options, resolution=64, mode="mark")  # fail before training
+    return params, scene, renderer, renderer_options
+
+
+def _parse_widths(text: str) -> tuple[int, ...]:
+    """The 4 stage widths of ``--widths``."""
+    from physbench.errors import PhysbenchError
+
     try:
-        widths = tuple(int(w) for w in args.widths.split(","))
+        widths = tuple(int(w) for w in text.split(","))
         assert len(widths) == 4 and all(w > 0 for w in widths)
     except (ValueError, AssertionError):
         raise PhysbenchError(
-            f"--widths {args.widths!r}: expected 4 positive integers, e.g. 16,32,64,128"
+            f"--widths {text!r}: expected 4 positive integers, e.g. 16,32,64,128"
         ) from None
+    return widths
+
+
+def _check_settings(args: argparse.Namespace) -> None:
+    """Refuse sizes, budgets and a device the training cannot use."""
+    from physbench.errors import PhysbenchError
+    from physbench.estimators.resnet3d import sidecar
+
     for name in ("samples", "batch"):
         if getattr(args, name) < 1:
             raise PhysbenchError(f"--{name} {getattr(args, name)}: must be >= 1")
@@ -204,18 +269,19 @@ def main(args: argparse.Namespace) -> int:
                 f"--device {args.device!r} is not usable here ({exc}); use cpu or an available "
                 "GPU, e.g. cuda"
             ) from None
-    spec = DataSpec(
-        scene_name,
-        params,
-        engine=args.engine,
-        renderer=renderer,
-        renderer_options=renderer_options,
-        resolution=args.resolution,
-        frames=args.frames,
-        blur_max=args.blur_max,
-    )
-    check_size(spec, args.samples, scene, args.minutes)
-    n_out = len(params)
+
+
+def _train(
+    args: argparse.Namespace, spec: Any, widths: tuple[int, ...]
+) -> tuple[Any, dict[str, Any]]:
+    """Train (resuming from a checkpoint unless --no-resume); the weights' path and metadata."""
+    from pathlib import Path
+
+    from physbench.commands.console import show_progress
+    from physbench.estimators.resnet3d.network import NetConfig
+    from physbench.estimators.resnet3d.train import TrainConfig, train, weights_name
+
+    n_out = len(spec.params)
     net = NetConfig(n_outputs=n_out, widths=widths, resolution=args.resolution, frames=args.frames)  # type: ignore[arg-type]
     cfg = TrainConfig(
         samples=args.samples,
@@ -232,18 +298,30 @@ def main(args: argparse.Namespace) -> int:
     out = Path(args.out or f"runs/train/{weights_name(spec)}")
     checkpoint = out / "checkpoint.safetensors"
     if not args.no_resume and checkpoint.is_file():
-        import json
+        _say_resuming(checkpoint, args.samples)
+    return train(spec, net, cfg, out, resume=not args.no_resume, progress=show_progress(args))
 
-        try:
-            done = json.loads(checkpoint.with_suffix(".json").read_text())["samples"]
-            at = f"at {done} of {args.samples} samples"
-        except (OSError, ValueError, KeyError, TypeError):
-            at = "(its sample count unreadable)"
-        print(
-            f"resuming from {checkpoint} {at} (--no-resume starts over)",
-            file=sys.stderr,
-        )
-    path, meta = train(spec, net, cfg, out, resume=not args.no_resume, progress=show_progress(args))
+
+def _say_resuming(checkpoint: Any, samples: int) -> None:
+    """Say on stderr where training resumes from ``checkpoint``."""
+    import json
+    import sys
+
+    try:
+        done = json.loads(checkpoint.with_suffix(".json").read_text())["samples"]
+        at = f"at {done} of {samples} samples"
+    except (OSError, ValueError, KeyError, TypeError):
+        at = "(its sample count unreadable)"
+    print(
+        f"resuming from {checkpoint} {at} (--no-resume starts over)",
+        file=sys.stderr,
+    )
+
+
+def _print_trained(path: Any, meta: dict[str, Any]) -> None:
+    """The files written and the training's result line."""
+    from physbench.commands.console import wrote
+
     wrote(path)
     wrote(path.with_suffix(".json"))
     print(
@@ -251,18 +329,20 @@ def main(args: argparse.Namespace) -> int:
         f"{meta['val_mse']:.3g}; "
         f"{meta['training']['samples_seen']} samples in {meta['training']['wall_s']:.0f} s"
     )
-    if args.eval_seeds:
-        from physbench.estimators.resnet3d.evaluate import evaluate_weights
 
-        rows = evaluate_weights(path, seeds=range(args.eval_seeds), iterations=11)
-        for it in (1, 2, 11):
-            vals = [r[it] for r in rows]
-            print(
-                f"held-out seeds 0..{args.eval_seeds - 1}: normalized min MSE after {it:2d} "
-                "iterations: "
-                f"{sum(vals) / len(vals):.3g}"
-            )
-    return 0
+
+def _print_held_out(path: Any, seeds: int) -> None:
+    """The mean normalized min MSE of the weights on held-out seeds after 1, 2 and 11 iterations."""
+    from physbench.bench.held_out import evaluate_weights
+
+    rows = evaluate_weights(path, seeds=range(seeds), iterations=11)
+    for it in (1, 2, 11):
+        vals = [r[it] for r in rows]
+        print(
+            f"held-out seeds 0..{seeds - 1}: normalized min MSE after {it:2d} "
+            "iterations: "
+            f"{sum(vals) / len(vals):.3g}"
+        )
 
 
 def _posterior(args: argparse.Namespace) -> int:
@@ -271,14 +351,14 @@ def _posterior(args: argparse.Namespace) -> int:
 
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
     from physbench.commands.console import wrote
+    from physbench.components import make_renderer
     from physbench.errors import PhysbenchError
-    from physbench.estimators.npe.data import NPEDataSpec
     from physbench.estimators.npe.estimator import NPEEstimator
     from physbench.estimators.npe.train import NPETrainConfig, train, weights_name
-    from physbench.experiment import make_renderer
-    from physbench.params import ParamSpace, split_params
+    from physbench.estimators.npe.training_data import NPEDataSpec
     from physbench.requirements import require
     from physbench.scenes.generator import is_scene_file, resolve_scene
+    from physbench.unknowns import ParamSpace, split_params
 
     require("estimator", "npe", NPEEstimator)
     params = split_params(args.params)

@@ -1,16 +1,16 @@
 """Loaders that turn the real measured data sets into recordings plus matching scenes.
 
-Each loader returns a list of :class:`~physbench.datasets.run.DatasetRun`: one recorded run and a
-scene that reproduces its setup (geometry, masses and initial state from the data; the plain
-rigid-body model otherwise), so that simulating ``run.scene`` and calling
+Each loader returns a list of :class:`~physbench.datasets.recorded_run.DatasetRun`: one recorded
+run and a scene that reproduces its setup (geometry, masses and initial state from the data; the
+plain rigid-body model otherwise), so that simulating ``run.scene`` and calling
 ``run.recording.residuals(traj)`` measures what the plain model misses. The data ship inside the
 package, ``physbench/datasets/data/<dataset>/``, each folder with its PROVENANCE.md;
 ``PHYSBENCH_DATA`` or a loader's ``root`` argument points elsewhere
 (:mod:`~physbench.datasets.files`).
 
 One module per data set (``NAME`` and ``load``); the shared concepts have their own modules:
-:mod:`~physbench.datasets.run` (the run), :mod:`~physbench.datasets.files` (finding the data) and
-:mod:`~physbench.datasets.oscillation` (measuring swings).
+:mod:`~physbench.datasets.recorded_run` (the run), :mod:`~physbench.datasets.files` (finding the
+data) and :mod:`~physbench.datasets.oscillation` (measuring swings).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from collections.abc import Callable
 
 from physbench.datasets.files import DATA_ENV, DatasetError, data_dir
 from physbench.datasets.oscillation import oscillation_centre, oscillation_periods, swing_peaks
-from physbench.datasets.run import DatasetRun
+from physbench.datasets.recorded_run import DatasetRun
 from physbench.errors import UnknownNameError
 
 

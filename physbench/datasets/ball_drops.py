@@ -1,10 +1,10 @@
 """Ball drops from ≈47 m (de Silva et al. 2020): 11 balls × 2 drops, height at 15 fps.
 
-Each drop becomes a :class:`~physbench.datasets.run.DatasetRun` whose scene is the ball falling
-under g = 9.81 m/s² without air (the plain model); the provenance says the model misses quadratic
-drag. The recording tracks ``y`` only (``x`` is written as 0 and ``fields = ("y",)``). Each drop is
-clipped as the authors do: at the last sample whose time step differs from the median step by
-> 5 ms. The initial height and speed come from a least-squares fit of the first
+Each drop becomes a :class:`~physbench.datasets.recorded_run.DatasetRun` whose scene is the ball
+falling under g = 9.81 m/s² without air (the plain model); the provenance says the model misses
+quadratic drag. The recording tracks ``y`` only (``x`` is written as 0 and ``fields = ("y",)``).
+Each drop is clipped as the authors do: at the last sample whose time step differs from the median
+step by > 5 ms. The initial height and speed come from a least-squares fit of the first
 :data:`FIT_SAMPLES` heights to free fall (g fixed), since single samples are noisy (rms 0.05-0.3 m).
 
 :func:`check_drag_laws` tests the drag law without physbench's simulation or fitter: ODE fits of
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from physbench.datasets.files import DatasetError, data_dir
-from physbench.datasets.run import DatasetRun
+from physbench.datasets.recorded_run import DatasetRun
 from physbench.errors import UnknownNameError
 from physbench.recording import Recording, Track
 from physbench.scene import Body, Circle, Scene

@@ -1,10 +1,10 @@
 """A real three-cushion billiards match (Dogan, 2022-12-25): 182 shots, tracked ball centres.
 
-Each shot becomes a :class:`~physbench.datasets.run.DatasetRun`: a top-down scene (gravity 0) of
-the 2.84 × 1.42 m table, its four cushions as thick segments whose inner surface is the table edge,
-and the three balls (``white``, ``yellow``, ``red``) at rest at their first tracked positions. The
-cue strike is an impulse on the cue ball (see :func:`cue_strike`); tracking starts slightly before
-it. The recording has ``x, y``; balls are only sampled while they move.
+Each shot becomes a :class:`~physbench.datasets.recorded_run.DatasetRun`: a top-down scene (gravity
+0) of the 2.84 × 1.42 m table, its four cushions as thick segments whose inner surface is the table
+edge, and the three balls (``white``, ``yellow``, ``red``) at rest at their first tracked
+positions. The cue strike is an impulse on the cue ball (see :func:`cue_strike`); tracking starts
+slightly before it. The recording has ``x, y``; balls are only sampled while they move.
 
 The plain model misses rolling resistance, cushion losses and spin (see PROVENANCE.md);
 :func:`rolling_decelerations` measures the first from the tracks. :func:`rolling_segments` cuts
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from physbench.datasets.files import DatasetError, data_dir, data_file
-from physbench.datasets.run import DatasetRun
+from physbench.datasets.recorded_run import DatasetRun
 from physbench.recording import Recording, Track
 from physbench.scene import Body, Circle, Force, Scene, Segment, body_unknown
 

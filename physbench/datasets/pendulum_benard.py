@@ -1,8 +1,8 @@
 """A small rod pendulum on a hobby rig (jensen-benard 2025): three free swings, encoder angle at
 a nominal 1 kHz.
 
-Each file becomes a :class:`~physbench.datasets.run.DatasetRun` from the first extreme of the
-swing (before it the hand still moves the rod; the rate there is 0). The scene is a uniform
+Each file becomes a :class:`~physbench.datasets.recorded_run.DatasetRun` from the first extreme of
+the swing (before it the hand still moves the rod; the rate there is 0). The scene is a uniform
 0.13 m, 0.1 kg rod on a frictionless pivot (the plain model); the recording tracks the angle
 (``fields = ("angle",)``, converted to rad; ``x, y`` are the rod centre it implies). Times are the
 nominal sample index / 1000 s: the logger's real interval is >= 1 ms and jitters. For one pendulum
@@ -21,7 +21,7 @@ import numpy as np
 
 from physbench.datasets.arms import Arm, chain, chain_tracks
 from physbench.datasets.files import DatasetError, data_dir
-from physbench.datasets.run import DatasetRun
+from physbench.datasets.recorded_run import DatasetRun
 from physbench.recording import Recording
 from physbench.scene import Scene
 

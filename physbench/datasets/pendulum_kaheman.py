@@ -1,11 +1,11 @@
 """Single and double compound pendulum, encoder angles (Kaheman et al. 2022), free swing.
 
-A :class:`~physbench.datasets.run.DatasetRun` is a window of the record: the arms' geometry and
-inertia are the authors' fitted values (:data:`SINGLE`, :data:`DOUBLE`), the initial angles and
-rates the data's at the window start, and the scene the plain, lossless model. The recording
-tracks the arm angles (``fields = ("angle",)``); its ``x, y`` are the shape centres the angles
-imply. Data angles θ (from upright, clockwise-positive as seen in the scene) map to scene angles
-φ = π - θ; rates to -dθ/dt.
+A :class:`~physbench.datasets.recorded_run.DatasetRun` is a window of the record: the arms'
+geometry and inertia are the authors' fitted values (:data:`SINGLE`, :data:`DOUBLE`), the initial
+angles and rates the data's at the window start, and the scene the plain, lossless model. The
+recording tracks the arm angles (``fields = ("angle",)``); its ``x, y`` are the shape centres the
+angles imply. Data angles θ (from upright, clockwise-positive as seen in the scene) map to scene
+angles φ = π - θ; rates to -dθ/dt.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 
 from physbench.datasets.arms import Arm, chain, chain_tracks
 from physbench.datasets.files import DatasetError, data_dir, data_file
-from physbench.datasets.run import DatasetRun
+from physbench.datasets.recorded_run import DatasetRun
 from physbench.recording import Recording
 from physbench.scene import Scene
 

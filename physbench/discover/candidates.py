@@ -42,9 +42,9 @@ class CandidateSpec:
     options: tuple[tuple[str, Any], ...] = ()
 
     def make(self) -> Effect:
-        from physbench.plugins import get_registry
+        from physbench.components import create
 
-        return get_registry().get("effect", self.name)(**dict(self.options))
+        return create("effect", self.name, dict(self.options))  # type: ignore[no-any-return]
 
     @property
     def label(self) -> str:
@@ -71,6 +71,7 @@ def candidates_for(
 ) -> tuple[list[CandidateSpec], list[tuple[str, str]]]:
     """Candidates for ``scene`` from the registered effects (or ``names``), and the ones left out
     with the reason. Raises :class:`UnknownNameError` for a name that is not registered."""
+    from physbench.components import create
     from physbench.plugins import get_registry
 
     registry = get_registry()
@@ -125,7 +126,8 @@ def candidates_for(
             continue
         spec = CandidateSpec(name, tuple(sorted(options.items())))
         try:
-            eff = (factories or {}).get(name, registry.get("effect", name))(**options)
+            factory = (factories or {}).get(name)
+            eff = factory(**options) if factory else create("effect", name, options)
             eff.setup(scene, {})
         except Exception as exc:  # an effect that cannot describe this scene is not a candidate
             skipped.append((name, f"{type(exc).__name__}: {exc}"))

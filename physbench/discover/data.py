@@ -20,9 +20,9 @@ from physbench.errors import PhysbenchError, counted
 from physbench.recording import Recording, Track
 
 if TYPE_CHECKING:
-    from physbench.datasets.run import DatasetRun
+    from physbench.calibration import Calibration
+    from physbench.datasets.recorded_run import DatasetRun
     from physbench.scene import Scene
-    from physbench.video.calibration import Calibration
 
 #: Fewest samples (recordings) or frames (frames) a run needs in its fitted and held-out parts.
 MIN_FIT_SAMPLES = 6
@@ -171,8 +171,8 @@ def _video_run(
     """Track the scene's bodies through a video into one run; the summary goes to stderr."""
     import sys
 
+    from physbench.calibration import load_calibration
     from physbench.recording import write_recordings
-    from physbench.video.calibration import load_calibration
     from physbench.video.track import track_video
 
     cal = load_calibration(calibration) if isinstance(calibration, str | Path) else calibration

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -133,9 +133,68 @@ def _lsq(
     *,
     covariance_needed: bool = True,
 ) -> FitResult:
-    from scipy.optimize import least_squares as lsq
-
+    """One bounded least-squares fit of ``free`` over the first ``horizon`` of time: the best point
+    seen is kept (also when ``budget`` runs out), set on the model and, if ``covariance_needed``,
+    given its uncertainty."""
     sims0 = model.problem.simulations
+    start = _start(model, free, role, runs, horizon)
+    if not free or start.r0.size == 0:
+        return FitResult(
+            dict(model.values),
+            list(free),
+            {},
+            float(start.r0 @ start.r0),
+            start.r0.size,
+            1,
+            model.problem.simulations - sims0,
+            "nothing to fit",
+        )
+    limit = math.inf if budget is None else sims0 + budget
+    objective = _Objective(model, free, role, runs, horizon, start, diff_step, limit)
+    status, nfev, j = _minimize(objective, max_nfev, tol, budget)
+    ssr, z = objective.best
+    x = start.point(z)
+    values = dict(model.values)
+    values.update(zip(free, x.tolist(), strict=True))
+    model.values = values
+    u = _uncertainty(objective, z, x, ssr, j) if covariance_needed else _Uncertainty()
+    return FitResult(
+        values,
+        list(free),
+        u.stderr,
+        ssr,
+        objective.n,
+        nfev,
+        model.problem.simulations - sims0,
+        status,
+        u.corr,
+        intervals=u.intervals,
+        interval_method=METHOD if u.intervals else "",
+        half_widths=u.half_widths,
+    )
+
+
+@dataclass(frozen=True)
+class _Start:
+    """Where a fit starts: the free parameters, their values clipped to their ranges, and the
+    residuals there."""
+
+    params: list[FitParameter]
+    x0: np.ndarray
+    scale: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    r0: np.ndarray
+
+    def point(self, z: np.ndarray) -> np.ndarray:
+        """The parameter values ``z`` scales away from the start, clipped to their ranges."""
+        return np.clip(self.x0 + z * self.scale, self.low, self.high)
+
+
+def _start(
+    model: Model, free: Sequence[str], role: str, runs: Sequence[int] | None, horizon: float
+) -> _Start:
+    """Clip the model's values of ``free`` to their ranges and simulate the residuals there."""
     x0, ps = _vector(model, free)
     scale = np.array([p.scale for p in ps])
     low = np.array([p.low for p in ps])
@@ -145,61 +204,83 @@ def _lsq(
         r0 = model.residuals(role, dict(zip(free, x0, strict=True)), runs, horizon)
     except SimulationError as exc:
         raise DiscoverError(f"the model's starting point does not simulate: {exc}") from exc
-    n = r0.size
-    if not free or n == 0:
-        return FitResult(
-            dict(model.values),
-            list(free),
-            {},
-            float(r0 @ r0),
-            n,
-            1,
-            model.problem.simulations - sims0,
-            "nothing to fit",
-        )
-    bad = FAILED_RESIDUAL * max(float(np.sqrt(np.mean(r0 * r0))), 1e-9)
-    best: list[tuple[float, np.ndarray]] = [(float(r0 @ r0), np.zeros(len(free)))]
-    limit = math.inf if budget is None else sims0 + budget
+    return _Start(ps, x0, scale, low, high, r0)
 
-    def fun(z: np.ndarray) -> np.ndarray:
-        if model.problem.simulations >= limit:
+
+@dataclass
+class _Objective:
+    """The residuals as a function of the step ``z`` from the start, in units of each parameter's
+    scale, remembering the best point seen. A simulation that fails or changes the number of
+    residuals scores :data:`FAILED_RESIDUAL`; reaching ``limit`` simulations stops the fit."""
+
+    model: Model
+    free: Sequence[str]
+    role: str
+    runs: Sequence[int] | None
+    horizon: float
+    start: _Start
+    diff_step: float
+    limit: float
+    n: int = field(init=False)
+    bad: float = field(init=False)
+    best: tuple[float, np.ndarray] = field(init=False)  # (SSR, z)
+    lo_z: np.ndarray = field(init=False)
+    hi_z: np.ndarray = field(init=False)
+
+    def __post_init__(self) -> None:
+        s, r0 = self.start, self.start.r0
+        self.n = r0.size
+        self.bad = FAILED_RESIDUAL * max(float(np.sqrt(np.mean(r0 * r0))), 1e-9)
+        self.best = (float(r0 @ r0), np.zeros(len(self.free)))
+        lo_z, hi_z = (s.low - s.x0) / s.scale, (s.high - s.x0) / s.scale
+        # least_squares needs a start strictly inside the bounds it is given.
+        self.lo_z = np.where(lo_z >= 0, -1e-12, lo_z)
+        self.hi_z = np.where(hi_z <= 0, 1e-12, hi_z)
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        if self.model.problem.simulations >= self.limit:
             raise _OutOfBudget
-        x = np.clip(x0 + z * scale, low, high)
+        x = self.start.point(z)
         try:
-            r = model.residuals(role, dict(zip(free, x, strict=True)), runs, horizon)
+            r = self.model.residuals(
+                self.role, dict(zip(self.free, x, strict=True)), self.runs, self.horizon
+            )
         except SimulationError:
-            return np.full(n, bad)
-        if r.size != n:
-            return np.full(n, bad)
+            return np.full(self.n, self.bad)
+        if r.size != self.n:
+            return np.full(self.n, self.bad)
         s = float(r @ r)
-        if s < best[0][0]:
-            best[0] = (s, z.copy())
+        if s < self.best[0]:
+            self.best = (s, z.copy())
         return r
 
-    lo_z, hi_z = (low - x0) / scale, (high - x0) / scale
-    # least_squares needs a start strictly inside the bounds it is given.
-    lo_z = np.where(lo_z >= 0, -1e-12, lo_z)
-    hi_z = np.where(hi_z <= 0, 1e-12, hi_z)
-
-    def jac(z: np.ndarray) -> np.ndarray:
-        # Forward differences with a fixed step in scaled units (scipy's relative step vanishes at
-        # z = 0, where every fit starts), stepping backwards at an upper bound.
-        f0 = fun(z)
-        out = np.empty((n, z.size))
+    def jac(self, z: np.ndarray) -> np.ndarray:
+        """Forward differences with a fixed step in scaled units (scipy's relative step vanishes
+        at z = 0, where every fit starts), stepping backwards at an upper bound."""
+        f0 = self(z)
+        out = np.empty((self.n, z.size))
         for i in range(z.size):
-            h = diff_step if z[i] + diff_step <= hi_z[i] else -diff_step
+            h = self.diff_step if z[i] + self.diff_step <= self.hi_z[i] else -self.diff_step
             zi = z.copy()
             zi[i] += h
-            out[:, i] = (fun(zi) - f0) / h
+            out[:, i] = (self(zi) - f0) / h
         return out
+
+
+def _minimize(
+    objective: _Objective, max_nfev: int, tol: float, budget: int | None
+) -> tuple[str, int, np.ndarray | None]:
+    """Run scipy's bounded least squares from z = 0; returns its status, its evaluations and its
+    Jacobian at the optimum (None when the best point is not scipy's own)."""
+    from scipy.optimize import least_squares as lsq
 
     status, nfev, j = "", 0, None
     try:
         res = lsq(
-            fun,
-            np.zeros(len(free)),
-            jac=jac,
-            bounds=(lo_z, hi_z),
+            objective,
+            np.zeros(len(objective.free)),
+            jac=objective.jac,
+            bounds=(objective.lo_z, objective.hi_z),
             method="dogbox",
             x_scale=1.0,
             max_nfev=max_nfev,
@@ -208,43 +289,45 @@ def _lsq(
             gtol=tol,
         )
         status, nfev = str(res.message), int(res.nfev)
-        if float(res.fun @ res.fun) <= best[0][0]:
-            best[0], j = (float(res.fun @ res.fun), res.x), res.jac
+        if float(res.fun @ res.fun) <= objective.best[0]:
+            objective.best, j = (float(res.fun @ res.fun), res.x), res.jac
     except _OutOfBudget:
         status = f"stopped after {budget} simulations (best point kept)"
-    ssr, z = best[0]
-    x = np.clip(x0 + z * scale, low, high)
-    values = dict(model.values)
-    values.update(zip(free, x.tolist(), strict=True))
-    model.values = values
-    stderr: dict[str, float] = {}
-    corr: dict[str, dict[str, float]] = {}
-    intervals: dict[str, tuple[float, float]] = {}
-    half_widths: dict[str, float] = {}
-    if covariance_needed:
-        limit = math.inf
-        if j is None:
-            j = jac(z)
-        stderr, corr = covariance(j, ssr, n, scale, free)
-        hw = ar1_covariance(j, fun(z), model.problem.series(role, runs)).half_width() * scale
-        half_widths = {k: float(hw[i]) for i, k in enumerate(free)}
-        intervals = {
+    return status, nfev, j
+
+
+@dataclass
+class _Uncertainty:
+    """Standard errors, correlations and 90 % intervals (with their unclipped half widths) of the
+    fitted parameters; empty when not asked for."""
+
+    stderr: dict[str, float] = field(default_factory=dict)
+    corr: dict[str, dict[str, float]] = field(default_factory=dict)
+    intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
+    half_widths: dict[str, float] = field(default_factory=dict)
+
+
+def _uncertainty(
+    objective: _Objective, z: np.ndarray, x: np.ndarray, ssr: float, j: np.ndarray | None
+) -> _Uncertainty:
+    """The uncertainty at the optimum ``z`` (values ``x``) from the fit's Jacobian ``j``, or a
+    fresh one; these simulations are not held to the fit's budget."""
+    objective.limit = math.inf
+    if j is None:
+        j = objective.jac(z)
+    free, scale, ps = objective.free, objective.start.scale, objective.start.params
+    stderr, corr = covariance(j, ssr, objective.n, scale, free)
+    r = objective(z)
+    ar1 = ar1_covariance(j, r, objective.model.problem.series(objective.role, objective.runs))
+    hw = ar1.half_width() * scale
+    return _Uncertainty(
+        stderr,
+        corr,
+        intervals={
             k: (max(float(x[i] - hw[i]), ps[i].low), min(float(x[i] + hw[i]), ps[i].high))
             for i, k in enumerate(free)
-        }
-    return FitResult(
-        values,
-        list(free),
-        stderr,
-        ssr,
-        n,
-        nfev,
-        model.problem.simulations - sims0,
-        status,
-        corr,
-        intervals=intervals,
-        interval_method=METHOD if intervals else "",
-        half_widths=half_widths,
+        },
+        half_widths={k: float(hw[i]) for i, k in enumerate(free)},
     )
 
 
@@ -329,11 +412,12 @@ def estimator_fit(
     """Search ``free`` with a registered black-box estimator (``tpe``, ``cmaes``, ``optuna``,
     ``random``, ...), one simulation per iteration, on the mean squared residual of the fit part;
     returns the best values found (the model's values are set to them)."""
-    from physbench.estimators.base import Step, Task
-    from physbench.params import ParamSpace
-    from physbench.plugins import create
+    from physbench.components import create
+    from physbench.estimators.base import Task
+    from physbench.loop import Evaluation, drive
+    from physbench.unknowns import ParamSpace
 
-    est = create("estimator", estimator, **(options or {}))
+    est = create("estimator", estimator, options)
     if type(est).per_object:
         raise DiscoverError(
             f"estimator {estimator!r} corrects marked objects in images; discovery needs a "
@@ -346,28 +430,31 @@ def estimator_fit(
     current = {k: min(max(model.values[k], p.low), p.high) for k, p in zip(free, ps, strict=True)}
     r0 = model.residuals("fit", current)
     worst = FAILED_RESIDUAL**2 * max(float(np.mean(r0 * r0)), 1e-18)
-    est.start(
-        Task(
-            scene=model.problem.runs[0].scene,
-            space=space,
-            observation=np.zeros((0, 1, 1, 1), np.float32),
-            initial=current,
-            renderer=None,
-            iterations=iterations,
-        ),
-        seed=seed,
-    )
-    best, best_loss = dict(current), float(np.mean(r0 * r0))
-    params = dict(current)
-    for k in range(iterations):
+    none = np.zeros((0, 1, 1, 1), np.float32)  # no frames: the loss is on trajectories
+
+    def evaluate(params: dict[str, float]) -> Evaluation:
         try:
             r = model.residuals("fit", params)
-            loss = float(np.mean(r * r))
-        except SimulationError:
-            loss = worst
-        if loss < best_loss:
-            best, best_loss = dict(params), loss
-        params = dict(est.propose(Step(k, dict(params), np.zeros((0, 1, 1, 1), np.float32), loss)))
+            return Evaluation(float(np.mean(r * r)), none)
+        except SimulationError as exc:
+            return Evaluation(worst, none, failed=str(exc))
+
+    best, best_loss = dict(current), float(np.mean(r0 * r0))
+
+    def visit(k: int, params: dict[str, float], ev: Evaluation, t_estimator: float) -> None:
+        nonlocal best, best_loss
+        if ev.loss < best_loss:
+            best, best_loss = dict(params), ev.loss
+
+    task = Task(
+        scene=model.problem.runs[0].scene,
+        space=space,
+        observation=none,
+        initial=current,
+        renderer=None,
+        iterations=iterations,
+    )
+    drive(est, task, evaluate, seed=seed, visit=visit)
     model.values.update(best)
     return best
 

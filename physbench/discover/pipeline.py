@@ -78,7 +78,7 @@ def problem_for(
 ) -> Problem:
     """The data side of every model: ``runs`` split by ``settings``, the simulator (an instance
     or a registered name) and, for frames, the renderer (default :func:`renderer_for`)."""
-    from physbench.plugins import create
+    from physbench.components import create
 
     sim = create("simulator", simulator) if isinstance(simulator, str) else simulator
     runs = list(runs)
@@ -204,7 +204,7 @@ def renderer_for(
     runs' frames ``(T, C, H, W)``: width ``resolution`` (default ``W``; the height follows the
     world); ``mode`` by default from the channels, ``mask`` for one, ``mark`` for two,
     ``instance`` for one per body."""
-    from physbench.experiment import make_renderer
+    from physbench.components import make_renderer
     from physbench.render.base import DEFAULT_RENDERER
 
     f = runs[0].frames

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import html
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -48,10 +49,48 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from physbench.discover.diagnostics import views
-
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
+    report = _report(disc, plt, out, dpi)
+    drawn = (
+        _trajectories(report),
+        _frame_residuals(report),
+        _event_residuals(report),
+        _candidates(report),
+    )
+    figures = [f for f in drawn if f is not None]
+    page = out / "index.html"
+    page.write_text(_html(disc, [(out / f, cap) for f, cap in figures]), encoding="utf-8")
+    return page
+
+
+@dataclass(frozen=True)
+class _Report:
+    """What the figures of one report draw from: the discovery, both models' views of its runs,
+    where each run's fitted part ends, the runs shown and the extended model's label."""
+
+    disc: Discovery
+    plt: Any  # matplotlib.pyplot, imported by write_report only
+    out: Path
+    dpi: int
+    base_v: list[RunView]
+    final_v: list[RunView]
+    cut: dict[int, float]
+    shown: list[int]
+    ext: str
+
+    def save(self, fig: Any, name: str, caption: str) -> tuple[str, str]:
+        """Lay out, write and close ``fig``; returns its file name and caption."""
+        fig.tight_layout()
+        fig.savefig(self.out / name, dpi=self.dpi)
+        self.plt.close(fig)
+        return name, caption
+
+
+def _report(disc: Discovery, plt: Any, out: Path, dpi: int) -> _Report:
+    """Simulate both models on every run and pick the runs the figures show."""
+    from physbench.discover.diagnostics import views
+
     base_v = views(disc.base.model)
     final_v = views(disc.final.model) if disc.causes else base_v
     split = disc.split
@@ -60,153 +99,155 @@ def write_report(disc: Discovery, folder: str | Path, *, dpi: int = DPI) -> Path
         if split.kind == "time"
         else {p.run: p.t_end for p in split.lead}
     )
-    figures: list[tuple[str, str]] = []
     # held-out runs first: they show how the models predict data they were not fitted on
     order = list(split.test_runs) + [i for i in range(len(disc.runs)) if i not in split.test_runs]
     shown = order[:MAX_RUNS] if split.kind == "runs" else list(range(min(len(disc.runs), MAX_RUNS)))
     ext = " + ".join(disc.causes) or "base"
+    return _Report(disc, plt, out, dpi, base_v, final_v, cut, shown, ext)
 
-    # ------------------------------------------------------------------ trajectories and residuals
-    rec_runs = [i for i in shown if disc.runs[i].recording is not None]
-    if rec_runs:
-        rows = []
-        for i in rec_runs:
-            rec = disc.runs[i].recording
-            assert rec is not None
-            for body in rec.bodies[:MAX_BODIES]:
-                for f in ("x", "y", "angle"):
-                    if _field_series(base_v[i], body, f) is not None:
-                        rows.append((i, body, f))
-        rows = rows[:9]
-        fig, axes = plt.subplots(len(rows), 2, figsize=(11, 2.2 * len(rows)), squeeze=False)
-        for (i, body, f), (ax, axr) in zip(rows, axes, strict=True):
-            s_b = _field_series(base_v[i], body, f)
-            s_f = _field_series(final_v[i], body, f)
-            assert s_b is not None and s_f is not None
-            t, obs, sim_b = s_b
-            ax.plot(t, obs, ".", ms=2.5, color="k", label="observed")
-            ax.plot(base_v[i].measured.times, sim_b, "-", lw=1.0, color="tab:blue", label="base")
-            if disc.causes:
-                ax.plot(final_v[i].measured.times, s_f[2], "-", lw=1.0, color="tab:red", label=ext)
-            ax.set_ylabel(f"{body} {f} ({'rad' if f == 'angle' else 'm'})", fontsize=8)
-            held = " (held out)" if split.kind == "runs" and i in split.test_runs else ""
-            ax.set_title(f"run {disc.runs[i].name}{held}", fontsize=8)
-            ax.set_xlim(t[0], t[-1])
-            assert base_v[i].simulated is not None and final_v[i].simulated is not None
-            rb = base_v[i].simulated.track(body).values(f) - obs
-            rf = final_v[i].simulated.track(body).values(f) - obs
-            if f == "angle":
-                rb, rf = (
-                    (rb + math.pi) % (2 * math.pi) - math.pi,
-                    (rf + math.pi) % (2 * math.pi) - math.pi,
-                )
-            axr.plot(t, rb, "-", lw=0.8, color="tab:blue", label="base")
-            if disc.causes:
-                axr.plot(t, rf, "-", lw=0.8, color="tab:red", label=ext)
-            axr.axhline(0, color="0.6", lw=0.5)
-            axr.set_ylabel(f"simulated − observed ({'rad' if f == 'angle' else 'm'})", fontsize=8)
-            for a in (ax, axr):
-                if i in cut:
-                    a.axvline(cut[i], color="0.5", ls="--", lw=0.8)
-                a.tick_params(labelsize=7)
-        axes[0, 0].legend(fontsize=7, loc="best")
-        axes[0, 1].legend(fontsize=7, loc="best")
-        axes[-1, 0].set_xlabel("t (s); dashed: end of the fitted part", fontsize=8)
-        axes[-1, 1].set_xlabel("t (s)", fontsize=8)
-        fig.suptitle(f"engine {disc.engine}: {disc.split.describe(disc.runs)}", fontsize=9)
-        fig.tight_layout()
-        fig.savefig(out / "trajectories.png", dpi=dpi)
-        plt.close(fig)
-        figures.append(
-            (
-                "trajectories.png",
-                "Observed vs simulated (left) and residuals (right), base and extended model.",
-            )
+
+def _trajectories(r: _Report) -> tuple[str, str] | None:
+    """Observed vs simulated and the residuals of the recorded fields of the runs shown."""
+    disc = r.disc
+    rec_runs = [i for i in r.shown if disc.runs[i].recording is not None]
+    if not rec_runs:
+        return None
+    rows = []
+    for i in rec_runs:
+        rec = disc.runs[i].recording
+        assert rec is not None
+        for body in rec.bodies[:MAX_BODIES]:
+            for f in ("x", "y", "angle"):
+                if _field_series(r.base_v[i], body, f) is not None:
+                    rows.append((i, body, f))
+    rows = rows[:9]
+    fig, axes = r.plt.subplots(len(rows), 2, figsize=(11, 2.2 * len(rows)), squeeze=False)
+    for (i, body, f), (ax, axr) in zip(rows, axes, strict=True):
+        _trajectory_row(r, ax, axr, i, body, f)
+    axes[0, 0].legend(fontsize=7, loc="best")
+    axes[0, 1].legend(fontsize=7, loc="best")
+    axes[-1, 0].set_xlabel("t (s); dashed: end of the fitted part", fontsize=8)
+    axes[-1, 1].set_xlabel("t (s)", fontsize=8)
+    fig.suptitle(f"engine {disc.engine}: {disc.split.describe(disc.runs)}", fontsize=9)
+    return r.save(
+        fig,
+        "trajectories.png",
+        "Observed vs simulated (left) and residuals (right), base and extended model.",
+    )
+
+
+def _trajectory_row(r: _Report, ax: Any, axr: Any, i: int, body: str, f: str) -> None:
+    """Draw field ``f`` of ``body`` in run ``i``: the data and both models on ``ax``, their
+    residuals on ``axr``."""
+    disc, split, base_v, final_v = r.disc, r.disc.split, r.base_v, r.final_v
+    s_b = _field_series(base_v[i], body, f)
+    s_f = _field_series(final_v[i], body, f)
+    assert s_b is not None and s_f is not None
+    t, obs, sim_b = s_b
+    ax.plot(t, obs, ".", ms=2.5, color="k", label="observed")
+    ax.plot(base_v[i].measured.times, sim_b, "-", lw=1.0, color="tab:blue", label="base")
+    if disc.causes:
+        ax.plot(final_v[i].measured.times, s_f[2], "-", lw=1.0, color="tab:red", label=r.ext)
+    ax.set_ylabel(f"{body} {f} ({'rad' if f == 'angle' else 'm'})", fontsize=8)
+    held = " (held out)" if split.kind == "runs" and i in split.test_runs else ""
+    ax.set_title(f"run {disc.runs[i].name}{held}", fontsize=8)
+    ax.set_xlim(t[0], t[-1])
+    assert base_v[i].simulated is not None and final_v[i].simulated is not None
+    rb = base_v[i].simulated.track(body).values(f) - obs
+    rf = final_v[i].simulated.track(body).values(f) - obs
+    if f == "angle":
+        rb, rf = (
+            (rb + math.pi) % (2 * math.pi) - math.pi,
+            (rf + math.pi) % (2 * math.pi) - math.pi,
         )
+    axr.plot(t, rb, "-", lw=0.8, color="tab:blue", label="base")
+    if disc.causes:
+        axr.plot(t, rf, "-", lw=0.8, color="tab:red", label=r.ext)
+    axr.axhline(0, color="0.6", lw=0.5)
+    axr.set_ylabel(f"simulated − observed ({'rad' if f == 'angle' else 'm'})", fontsize=8)
+    for a in (ax, axr):
+        if i in r.cut:
+            a.axvline(r.cut[i], color="0.5", ls="--", lw=0.8)
+        a.tick_params(labelsize=7)
 
-    # ------------------------------------------------------------------ frames: residual per frame
-    frame_runs = [i for i in shown if disc.runs[i].frames is not None]
-    if frame_runs:
-        fig, ax = plt.subplots(figsize=(7, 3))
-        for label, scored, color in (("base", disc.base, "tab:blue"), (ext, disc.final, "tab:red")):
-            if label != "base" and not disc.causes:
-                continue
-            for n, i in enumerate(frame_runs):
-                r = scored.model.residuals("fit" if split.kind == "time" else "held", runs=[i])
-                f = disc.runs[i].frames
-                assert f is not None
-                per = int(np.prod(f.shape[1:]))
-                k = r.size // per
-                ax.plot(
-                    np.arange(k) / disc.runs[i].scene.fps,
-                    np.sqrt(np.mean(r[: k * per].reshape(k, per) ** 2, axis=1)),
-                    color=color,
-                    label=label if n == 0 else None,  # one legend entry per model, not per run
-                )
-        ax.set_xlabel("t (s), fitted part")
-        ax.set_ylabel("RMS residual (pixel value, in [0, 1])")
-        ax.set_title(f"engine {disc.engine}", fontsize=8)
-        ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(out / "frames.png", dpi=dpi)
-        plt.close(fig)
-        figures.append(("frames.png", "Image residual per frame, base and extended model."))
 
-    # ------------------------------------------------------------------ per event
+def _frame_residuals(r: _Report) -> tuple[str, str] | None:
+    """The RMS image residual per frame of the filmed runs shown, base and extended model."""
+    disc = r.disc
+    frame_runs = [i for i in r.shown if disc.runs[i].frames is not None]
+    if not frame_runs:
+        return None
+    fig, ax = r.plt.subplots(figsize=(7, 3))
+    for label, scored, color in (("base", disc.base, "tab:blue"), (r.ext, disc.final, "tab:red")):
+        if label != "base" and not disc.causes:
+            continue
+        for n, i in enumerate(frame_runs):
+            res = scored.model.residuals("fit" if disc.split.kind == "time" else "held", runs=[i])
+            f = disc.runs[i].frames
+            assert f is not None
+            per = int(np.prod(f.shape[1:]))
+            k = res.size // per
+            ax.plot(
+                np.arange(k) / disc.runs[i].scene.fps,
+                np.sqrt(np.mean(res[: k * per].reshape(k, per) ** 2, axis=1)),
+                color=color,
+                label=label if n == 0 else None,  # one legend entry per model, not per run
+            )
+    ax.set_xlabel("t (s), fitted part")
+    ax.set_ylabel("RMS residual (pixel value, in [0, 1])")
+    ax.set_title(f"engine {disc.engine}", fontsize=8)
+    ax.legend(fontsize=7)
+    return r.save(fig, "frames.png", "Image residual per frame, base and extended model.")
+
+
+def _event_residuals(r: _Report) -> tuple[str, str] | None:
+    """Bars of the residual RMS per body and event, base and extended model."""
+    disc = r.disc
     bb, bf = disc.breakdowns.get("base"), disc.breakdowns.get("final")
-    if bb is not None and bb.per_event:
-        bodies = list(bb.per_event)[:6]
-        labels = [(b, e) for b in bodies for e in EVENTS if e in bb.per_event[b]]
-        if labels:
-            fig, ax = plt.subplots(figsize=(max(5, 0.8 * len(labels)), 3))
-            x = np.arange(len(labels))
-            ax.bar(
-                x - 0.2,
-                [bb.per_event[b][e] for b, e in labels],
-                0.4,
-                label="base",
-                color="tab:blue",
-            )
-            if disc.causes and bf is not None:
-                ax.bar(
-                    x + 0.2,
-                    [bf.per_event.get(b, {}).get(e, np.nan) for b, e in labels],
-                    0.4,
-                    label=ext,
-                    color="tab:red",
-                )
-            ax.set_xticks(x, [f"{b}\n{e}" for b, e in labels], fontsize=7)
-            ax.set_xlabel("body, event", fontsize=8)
-            ax.set_ylabel(f"RMS residual ({disc.unit})", fontsize=8)
-            ax.legend(fontsize=7)
-            fig.tight_layout()
-            fig.savefig(out / "events.png", dpi=dpi)
-            plt.close(fig)
-            figures.append(("events.png", "Residual RMS per body and event (whole runs)."))
-
-    # ------------------------------------------------------------------ candidates
-    if disc.candidates:
-        first = [c for c in disc.candidates if c.round == 1]
-        fig, ax = plt.subplots(figsize=(7, 0.35 * len(first) + 1.2))
-        y = np.arange(len(first))
-        ax.barh(
-            y,
-            [c.heldout_error for c in first],
-            color=["tab:red" if c.chosen else "tab:gray" for c in first],
+    if bb is None or not bb.per_event:
+        return None
+    bodies = list(bb.per_event)[:6]
+    labels = [(b, e) for b in bodies for e in EVENTS if e in bb.per_event[b]]
+    if not labels:
+        return None
+    fig, ax = r.plt.subplots(figsize=(max(5, 0.8 * len(labels)), 3))
+    x = np.arange(len(labels))
+    ax.bar(x - 0.2, [bb.per_event[b][e] for b, e in labels], 0.4, label="base", color="tab:blue")
+    if disc.causes and bf is not None:
+        ax.bar(
+            x + 0.2,
+            [bf.per_event.get(b, {}).get(e, np.nan) for b, e in labels],
+            0.4,
+            label=r.ext,
+            color="tab:red",
         )
-        ax.axvline(disc.base.heldout, color="tab:blue", ls="--", lw=1, label="base")
-        ax.set_yticks(y, [c.effect for c in first], fontsize=7)
-        ax.set_ylabel("candidate effect added to the base model", fontsize=8)
-        ax.set_xlabel(f"held-out error ({disc.unit}), round 1", fontsize=8)
-        ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(out / "candidates.png", dpi=dpi)
-        plt.close(fig)
-        figures.append(("candidates.png", "Held-out error of base + each candidate (red: chosen)."))
+    ax.set_xticks(x, [f"{b}\n{e}" for b, e in labels], fontsize=7)
+    ax.set_xlabel("body, event", fontsize=8)
+    ax.set_ylabel(f"RMS residual ({disc.unit})", fontsize=8)
+    ax.legend(fontsize=7)
+    return r.save(fig, "events.png", "Residual RMS per body and event (whole runs).")
 
-    page = out / "index.html"
-    page.write_text(_html(disc, [(out / f, cap) for f, cap in figures]), encoding="utf-8")
-    return page
+
+def _candidates(r: _Report) -> tuple[str, str] | None:
+    """Bars of the first round's held-out errors, the chosen candidate in red, the base's as a
+    line."""
+    disc = r.disc
+    if not disc.candidates:
+        return None
+    first = [c for c in disc.candidates if c.round == 1]
+    fig, ax = r.plt.subplots(figsize=(7, 0.35 * len(first) + 1.2))
+    y = np.arange(len(first))
+    ax.barh(
+        y,
+        [c.heldout_error for c in first],
+        color=["tab:red" if c.chosen else "tab:gray" for c in first],
+    )
+    ax.axvline(disc.base.heldout, color="tab:blue", ls="--", lw=1, label="base")
+    ax.set_yticks(y, [c.effect for c in first], fontsize=7)
+    ax.set_ylabel("candidate effect added to the base model", fontsize=8)
+    ax.set_xlabel(f"held-out error ({disc.unit}), round 1", fontsize=8)
+    ax.legend(fontsize=7)
+    return r.save(fig, "candidates.png", "Held-out error of base + each candidate (red: chosen).")
 
 
 def _html(disc: Discovery, figures: list[tuple[Path, str]]) -> str:

@@ -440,8 +440,8 @@ def make_case(
     scene and the noise do not change). ``body_params``: body parameters (``{"ball.mass": 80}``)
     applied to the drawn scene, for magnitudes that need a heavier or larger body to stay
     visible without swamping the motion."""
+    from physbench.components import create
     from physbench.effects import apply_measurements
-    from physbench.plugins import get_registry
 
     rng = _rng(seed, 1 + sorted(SCENES).index(scene_kind))
     scene = SCENES[scene_kind](rng).with_params(body_params or {}).validate()
@@ -449,7 +449,7 @@ def make_case(
     effects = []
     if effect is not None:
         values = {**hidden_values(effect, scene, rng), **(truth or {})}
-        eff = get_registry().get("effect", effect)()
+        eff = create("effect", effect)
         for p in eff.parameters():
             wide = p
             while not wide.contains(values.get(p.name, 0.0)) and wide.extensible:
@@ -520,9 +520,9 @@ def filmed_run(case: SyntheticRun, seed: int = 0, **camera: Any) -> Run:
     true motion: filmed by the ``camera`` renderer (options :data:`FILM`, overridden by
     ``camera``; the view frames where the bodies go), encoded, tracked with a four-point
     calibration, keeping the recording's fields
-    (:func:`~physbench.video.observe.filmed_recording`)."""
+    (:func:`~physbench.video.footage.filmed_recording`)."""
     from physbench.render.camera import CameraRenderer
-    from physbench.video.observe import filmed_recording, frame_trajectory, motion_view
+    from physbench.video.footage import filmed_recording, frame_trajectory, motion_view
 
     run, rec = case.run, case.run.recording
     if case.trajectory is None or rec is None:

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +34,9 @@ from physbench.discover.settings import Settings
 from physbench.discover.significance import judge
 from physbench.errors import SimulationError
 
+if TYPE_CHECKING:
+    from physbench.effects.base import Effect
+
 
 def try_effect(
     current: Scored,
@@ -51,6 +55,37 @@ def try_effect(
     settings = settings or Settings()
     spec = effect if isinstance(effect, CandidateSpec) else CandidateSpec(effect)
     base = current if base is None else base
+    trial = _extend(current, spec)
+    if isinstance(trial, Skipped):
+        return trial
+    earlier = _rescale_steps(trial, current)
+    _off_the_bounds(trial.model, trial.seen)
+    if quick:
+        fr = _quick_fit(trial, settings)
+    else:
+        fr = _full_fit(trial.model, current, settings, trial.free, trial.seen, earlier)
+    fr = _no_worse_than_current(trial, current, fr)
+    return judge(_candidate(trial, current, fr, round, quick), current, base, settings)
+
+
+@dataclass(frozen=True)
+class _Trial:
+    """The current model extended by one effect (``key`` in the model): ``own`` are the effect's
+    parameter keys, ``seen`` those the data can see (fitted, with the current free ones:
+    ``free``), ``fixed`` the values of the others by short name."""
+
+    effect: Effect
+    key: str
+    model: Model
+    own: list[str]
+    seen: list[str]
+    fixed: dict[str, float]
+    free: list[str]
+
+
+def _extend(current: Scored, spec: CandidateSpec) -> _Trial | Skipped:
+    """Extend ``current``'s model by the effect, started from values sized for the fitted scene,
+    and find which of its parameters change the fitted data."""
     eff = spec.make()
     scene = current.model.problem.runs[0].scene
     fitted = scene.with_params(
@@ -66,7 +101,13 @@ def try_effect(
     if not seen:
         return Skipped(spec.label, "none of its parameters changes the fitted data")
     fixed = {k.rpartition(".")[2]: model.values[k] for k in own if k not in seen}
-    free = [*current.fit.free, *seen]
+    return _Trial(eff, key, model, own, seen, fixed, [*current.fit.free, *seen])
+
+
+def _rescale_steps(trial: _Trial, current: Scored) -> list[str]:
+    """Size the steps of the effect's seen parameters, and of the causes already in the model
+    outside contact scenes, to the current misfit; returns those earlier causes."""
+    model = trial.model
     rough = is_rough(current.model.problem.runs)
     # The causes already in the model were scaled against the misfit of the model they extended;
     # near the current, better optimum those steps are far too large for finite differences (the
@@ -78,58 +119,78 @@ def try_effect(
         else [
             p.key
             for p in model.params
-            if p.kind == "effect" and p.owner != key and p.key in current.fit.free
+            if p.kind == "effect" and p.owner != trial.key and p.key in current.fit.free
         ]
     )
     rescale(
         model,
-        {k: unit_sensitivity(model, k, rough) for k in [*seen, *earlier]},
+        {k: unit_sensitivity(model, k, rough) for k in [*trial.seen, *earlier]},
         current.fit.rms,
     )
-    for k in seen:  # off the bound: a bounded least-squares step from a bound can stall there
+    return earlier
+
+
+def _off_the_bounds(model: Model, keys: list[str]) -> None:
+    """Move each of ``keys`` at an end of its range one step inside: a bounded least-squares step
+    from a bound can stall there."""
+    for k in keys:
         p = model.param(k)
         v = model.values[k]
         if v <= p.low:
             model.values[k] = min(p.low + p.scale, p.high)
         elif v >= p.high:
             model.values[k] = max(p.high - p.scale, p.low)
-    if quick:
-        probe_start(model, seen)
-        fr = least_squares(
-            model,
-            free,
-            max_nfev=settings.max_nfev,
-            budget=max(settings.quick_budget, 3 * (len(free) + 1)),
-            diff_step=settings.diff_step,
-        )
-    else:
-        fr = _full_fit(model, current, settings, free, seen, earlier)
-    if fr.ssr > current.fit.ssr:
-        # Worse than the model it extends (the fit stalled away from the effect's neutral start):
-        # the extended model can always do at least as well with the effect switched off.
-        model.values = {**current.model.values, **{k: model.param(k).default for k in own}}
-        fr = FitResult(
-            dict(model.values),
-            list(free),
-            {k: current.fit.stderr.get(k, math.nan) for k in free},
-            current.fit.ssr,
-            current.fit.n,
-            fr.nfev,
-            fr.simulations,
-            "no better than the current model",
-            intervals={k: v for k, v in current.fit.intervals.items() if k in free},
-            interval_method=current.fit.interval_method,
-        )
+
+
+def _quick_fit(trial: _Trial, settings: Settings) -> FitResult:
+    """The screening fit: probe the new parameters, then one horizon on a small budget."""
+    probe_start(trial.model, trial.seen)
+    return least_squares(
+        trial.model,
+        trial.free,
+        max_nfev=settings.max_nfev,
+        budget=max(settings.quick_budget, 3 * (len(trial.free) + 1)),
+        diff_step=settings.diff_step,
+    )
+
+
+def _no_worse_than_current(trial: _Trial, current: Scored, fr: FitResult) -> FitResult:
+    """``fr``, or, when it is worse than the model it extends (the fit stalled away from the
+    effect's neutral start), the current optimum with the effect switched off: the extended
+    model can always do at least as well."""
+    if fr.ssr <= current.fit.ssr:
+        return fr
+    model, free = trial.model, trial.free
+    model.values = {**current.model.values, **{k: model.param(k).default for k in trial.own}}
+    return FitResult(
+        dict(model.values),
+        list(free),
+        {k: current.fit.stderr.get(k, math.nan) for k in free},
+        current.fit.ssr,
+        current.fit.n,
+        fr.nfev,
+        fr.simulations,
+        "no better than the current model",
+        intervals={k: v for k, v in current.fit.intervals.items() if k in free},
+        interval_method=current.fit.interval_method,
+    )
+
+
+def _candidate(
+    trial: _Trial, current: Scored, fr: FitResult, round: int, quick: bool
+) -> CandidateResult:
+    """Score the fitted extension on the held-out data; the result is not judged yet."""
+    key, model, seen = trial.key, trial.model, trial.seen
     scored = score(f"{current.label} + {key}", (*current.causes, key), model, fr)
-    c = CandidateResult(
+    return CandidateResult(
         round=round,
         effect=key,
-        name=eff.name,
+        name=trial.effect.name,
         params={k.rpartition(".")[2]: model.values[k] for k in seen},
         stderr={k.rpartition(".")[2]: fr.stderr.get(k, math.nan) for k in seen},
         intervals={k.rpartition(".")[2]: fr.intervals[k] for k in seen if k in fr.intervals},
         interval_method=fr.interval_method,
-        fixed=fixed,
+        fixed=trial.fixed,
         heldout_error=scored.heldout,
         gain=0.0,
         gain_vs_base=0.0,
@@ -140,7 +201,6 @@ def try_effect(
         quick=quick,
         at_bound=tuple(k.rpartition(".")[2] for k in fr.at_bound if k in seen),
     )
-    return judge(c, current, base, settings)
 
 
 def _full_fit(

@@ -72,7 +72,7 @@ class Effect(Requirements):
     """Base class of every effect (plugin contract).
 
     Subclasses set the class attributes :attr:`name` and :attr:`params` (each
-    :class:`~physbench.params.Parameter` with a ``default`` inside its range) and the traits they
+    :class:`~physbench.unknowns.Parameter` with a ``default`` inside its range) and the traits they
     need, and override :meth:`forces`, :meth:`restitution` or :meth:`measure` accordingly;
     :meth:`configure` is the place to precompute from the scene. Constructor keywords:
     ``bodies`` (names of the bodies it acts on; default all), ``label`` (the key prefix of its
@@ -137,6 +137,12 @@ class Effect(Requirements):
         return {f"{self.key}.{k}": v for k, v in self.values.items()}
 
     # ----------------------------------------------------------------- configuration
+
+    @classmethod
+    def option_names(cls) -> tuple[str, ...]:
+        """Called by the component factory when a user's options are refused: the options this
+        effect takes, ``bodies``, ``label`` and its parameters (each also as ``<key>.<param>``)."""
+        return ("bodies", "label", *(p.name for p in cls.params))
 
     @classmethod
     def neutral(cls) -> dict[str, float] | None:

@@ -2,7 +2,7 @@
 just simulated, then *ask* for the next point.
 
 Every built-in black-box optimiser works on the unit cube (each unknown's range mapped to [0, 1]
-by :meth:`~physbench.params.ParamSpace.to_unit`); the first point told is the initial guess.
+by :meth:`~physbench.unknowns.ParamSpace.to_unit`); the first point told is the initial guess.
 Importing an estimator module is cheap: the optimiser library is imported in :meth:`start`.
 """
 
@@ -17,7 +17,7 @@ from physbench.estimators.base import CorrectionEstimator
 
 if TYPE_CHECKING:
     from physbench.estimators.base import Step, Task
-    from physbench.params import Params, ParamSpace
+    from physbench.unknowns import Params, ParamSpace
 
 
 class AskTellEstimator(CorrectionEstimator):

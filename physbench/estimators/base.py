@@ -18,11 +18,11 @@ from physbench.requirements import Requirements
 if TYPE_CHECKING:
     import numpy as np
 
-    from physbench.params import Params, ParamSpace
-    from physbench.posterior import Posterior
+    from physbench.posterior.samples import Posterior
     from physbench.render.base import Renderer
     from physbench.scene import Scene
     from physbench.trajectory import Trajectory
+    from physbench.unknowns import Params, ParamSpace
 
 #: The estimator a run uses unless told otherwise.
 DEFAULT_ESTIMATOR = "tpe"
@@ -97,6 +97,6 @@ class CorrectionEstimator(Requirements):
 
     def posterior(self) -> Posterior | None:
         """Called once after the last :meth:`propose`: how sure the estimator is, as a
-        :class:`~physbench.posterior.Posterior` over ``task.space``. Default ``None``: the
+        :class:`~physbench.posterior.samples.Posterior` over ``task.space``. Default ``None``: the
         estimator gives a point estimate only."""
         return None

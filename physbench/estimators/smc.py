@@ -1,5 +1,5 @@
 """``smc``: a posterior for any scene without training, by sequential Monte Carlo on the image
-likelihood (:mod:`physbench.likelihood`).
+likelihood (:mod:`physbench.posterior.likelihood`).
 
 A population of particles starts as draws from the prior (each unknown uniform on its range).
 The likelihood is switched on gradually, ``L**beta`` with ``beta`` rising from 0 to 1 as fast as
@@ -31,8 +31,8 @@ from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
     from physbench.estimators.base import Step, Task
-    from physbench.params import Params, ParamSpace
-    from physbench.posterior import Posterior
+    from physbench.posterior.samples import Posterior
+    from physbench.unknowns import Params, ParamSpace
 
 #: Effective sample size kept per tempering step, as a share of the population.
 ESS_SHARE = 0.5
@@ -92,7 +92,7 @@ class SMCEstimator(CorrectionEstimator):
 
     def start(self, task: Task, *, seed: int) -> None:
         """Called once per run: set up the likelihood and a fresh population."""
-        from physbench.likelihood import PixelLikelihood, estimate_noise
+        from physbench.posterior.likelihood import PixelLikelihood, estimate_noise
 
         self.space = task.space
         if task.noise is not None and task.noise > 0:
@@ -182,7 +182,7 @@ class SMCEstimator(CorrectionEstimator):
     def posterior(self) -> Posterior | None:
         """Called once after the run: the particles of every sweep since the likelihood was fully
         on (or the current ones, marked incomplete, when the budget ran out before)."""
-        from physbench.posterior import Posterior
+        from physbench.posterior.samples import Posterior
 
         if self.space is None:
             return None

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from physbench.posterior import Posterior
+    from physbench.posterior.samples import Posterior
 
 
 def posterior_path(plot: str | Path) -> Path:

@@ -4,7 +4,7 @@
 :class:`~physbench.render.raster.RasterRenderer` is the default built-in renderer (registered as
 ``raster``), :class:`~physbench.render.camera.CameraRenderer` films scenes like a real camera
 (``camera``: ``rgb`` frames with perspective, lens, motion blur, light, noise and encoding);
-:mod:`physbench.render.observe` holds the observation model (:class:`ObservationModel`: blur and
+:mod:`physbench.render.sensor` holds the observation model (:class:`SensorModel`: blur and
 noise of observed frames) and its image filters, and
 :func:`physbench.render.preview.save_preview` writes a GIF or PNG for people to look at.
 """
@@ -13,15 +13,15 @@ from __future__ import annotations
 
 from physbench.render.base import DEFAULT_RENDERER, MODES, Renderer, RenderError
 from physbench.render.camera import CameraRenderer
-from physbench.render.observe import ObservationModel
 from physbench.render.raster import RasterRenderer
+from physbench.render.sensor import SensorModel
 
 __all__ = [
     "DEFAULT_RENDERER",
     "MODES",
     "CameraRenderer",
-    "ObservationModel",
     "RasterRenderer",
     "RenderError",
     "Renderer",
+    "SensorModel",
 ]

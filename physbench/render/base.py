@@ -7,12 +7,13 @@ pose, a background, ...) is its own keyword option, given on the command line wi
 ``--renderer-option KEY=VALUE`` and in a sweep spec as ``renderer = {name = ..., options = {...}}``.
 
 An observation model (camera blur, pixel noise) is not part of a renderer: the framework applies
-:class:`~physbench.render.observe.ObservationModel` to the observed frames only, whatever renderer
+:class:`~physbench.render.sensor.SensorModel` to the observed frames only, whatever renderer
 made them.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
@@ -21,6 +22,7 @@ from physbench.errors import PhysbenchError
 from physbench.requirements import Requirements
 
 if TYPE_CHECKING:
+    from physbench.calibration import Calibration
     from physbench.scene import Scene
     from physbench.trajectory import Trajectory
 
@@ -101,3 +103,66 @@ class Renderer(Requirements):
             states[0, i, :3] = (*b.position, b.angle)
         frame = self.render(scene, Trajectory(scene.body_names, np.zeros(1), states))
         return (scene.frames if frames is None else frames, *frame.shape[1:])  # type: ignore[return-value]
+
+
+class Camera(Renderer):
+    """Base class of renderers that film the scene as a real camera would (plugin contract of
+    observer cameras, ``run --observer``, and of ``simulate --out clip.mp4``): 8-bit ``rgb``
+    footage, the empty scene's plate, and the camera's own true calibration. The video package
+    encodes the footage (:func:`physbench.video.writer.write_clip`) and tracks it.
+
+    Subclasses implement :meth:`exposure`, :meth:`plate` and :meth:`calibration`; :meth:`film`,
+    :meth:`image_points` and :meth:`render` have defaults built on them.
+    """
+
+    modes: ClassVar[tuple[str, ...]] = ("rgb",)
+    #: Encoding of the footage: bit rate in bits/s (0: none) or H.264 quality ``crf`` (0-51,
+    #: ``None``: none). Set by the subclass from its options; the writer reads them.
+    bitrate: float = 0.0
+    crf: int | None = None
+
+    def exposure(self, scene: Scene, traj: Trajectory) -> np.ndarray:
+        """Called to film ``traj``: the frames the sensor records, before any encoding, ``(T, H,
+        W, 3)`` uint8."""
+        raise NotImplementedError(f"{type(self).__name__} must implement exposure()")
+
+    def plate(self, scene: Scene) -> np.ndarray:
+        """Called before tracking the camera's footage: the empty scene (background and static
+        geometry) as this camera films it, ``(H, W, 3)`` uint8."""
+        raise NotImplementedError(f"{type(self).__name__} must implement plate()")
+
+    def calibration(self, scene: Scene) -> Calibration:
+        """Called before tracking the camera's footage: the true map from this camera's pixels to
+        ``scene``'s metres."""
+        raise NotImplementedError(f"{type(self).__name__} must implement calibration()")
+
+    def film(self, scene: Scene, traj: Trajectory) -> np.ndarray:
+        """The frames as a video file would hold them, ``(T, H, W, 3)`` uint8. Default:
+        :meth:`exposure` (no codec)."""
+        return self.exposure(scene, traj)
+
+    def image_points(self, scene: Scene, xy: Sequence[Sequence[float]] | np.ndarray) -> np.ndarray:
+        """Where scene points ``(N, 2)`` (metres) land in the image (pixels). Default: through
+        :meth:`calibration`."""
+        return np.asarray(self.calibration(scene).to_image(np.asarray(xy, dtype=float)))
+
+    def render(
+        self,
+        scene: Scene,
+        traj: Trajectory,
+        *,
+        focus: str | None = None,
+        out: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Called after every simulation: :meth:`film` as ``(T, 3, H, W)`` float32 in [0, 1]
+        (``focus`` is ignored: a camera marks no body)."""
+        frames = self.film(scene, traj)
+        shape = (frames.shape[0], 3, frames.shape[1], frames.shape[2])
+        if out is not None and (out.shape != shape or out.dtype != np.float32):
+            raise RenderError(
+                f"out has shape {out.shape} and dtype {out.dtype}; expected {shape} float32"
+            )
+        if out is None:
+            out = np.empty(shape, np.float32)
+        np.divide(frames.transpose(0, 3, 1, 2), np.float32(255), out=out)
+        return out

@@ -11,7 +11,7 @@ Model, in the order light goes through it:
   maps to the undistorted image by the homography ``K [r1 r2 t]``. A steep view may see past
   the plane's horizon: those pixels are dark (and textures alias near it, as they would).
 - **Lens**: Brown's radial distortion ``k1``, ``k2`` about the image centre, normalised by the
-  focal length in pixels (:class:`physbench.video.calibration.Lens`).
+  focal length in pixels (:class:`physbench.calibration.Lens`).
 - **Exposure**: the shutter is open for ``shutter`` of the frame interval, centred on the frame
   time; ``subframes`` poses (from each body's pose and velocity) are averaged: motion blur that
   keeps the blob's centroid at the frame-time position.
@@ -20,7 +20,7 @@ Model, in the order light goes through it:
 - **Sensor**: Gaussian noise of std ``noise``, quantised to 8 bits; optionally a real H.264
   encode and decode (``bitrate`` or ``crf``), so the frames are what a video file would hold.
 
-Pixel convention (that of :mod:`physbench.video.calibration`): ``u`` right, ``v`` down, pixel
+Pixel convention (that of :mod:`physbench.calibration`): ``u`` right, ``v`` down, pixel
 centres at integer coordinates. :meth:`CameraRenderer.calibration` is the true map.
 
 Every pixel's scene coordinates, the background and the light field are computed once per scene
@@ -33,16 +33,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from fractions import Fraction
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from physbench.calibration import Calibration, Lens
+from physbench.codec import h264_round_trip
 from physbench.hookspecs import hookimpl
-from physbench.render.base import Renderer, RenderError
+from physbench.render.base import Camera, RenderError
 from physbench.scene import Circle, Segment
-from physbench.video.calibration import Calibration, Lens
 
 if TYPE_CHECKING:
     from physbench.scene import Scene
@@ -72,10 +71,6 @@ _CACHE_SIZE = 4
 #: The view must not look along the plane: largest angle between the optical axis and the
 #: plane's normal (degrees).
 MAX_OBLIQUE = 85.0
-#: CRF of :meth:`CameraRenderer.write` when neither ``bitrate`` nor ``crf`` is set.
-WRITE_CRF = 20
-#: Codec of :meth:`CameraRenderer.write` by file suffix (others: H.264).
-VIDEO_CODECS = {".webm": "libvpx-vp9"}
 
 
 def _number(name: str, value: object, low: float, high: float, *, open_: bool = False) -> float:
@@ -441,7 +436,7 @@ def _region(view: object) -> tuple[float, float, float, float]:
     return vals  # type: ignore[return-value]
 
 
-class CameraRenderer(Renderer):
+class CameraRenderer(Camera):
     """A camera filming the scene: ``rgb`` frames with perspective, lens distortion, motion blur,
     a textured background, shaded bodies, uneven and flickering light, sensor noise and
     (optionally) lossy H.264 encoding. ``focus`` is ignored: a camera does not mark bodies.
@@ -577,52 +572,10 @@ class CameraRenderer(Renderer):
     def film(self, scene: Scene, traj: Trajectory) -> np.ndarray:
         """The frames as they go into a video file: ``(T, H, W, 3)`` uint8, after the H.264
         round trip when ``bitrate`` or ``crf`` is set."""
-        frames = self._expose(scene, traj)
+        frames = self.exposure(scene, traj)
         if self.bitrate > 0 or self.crf is not None:
-            frames = _h264_round_trip(frames, scene.fps, self.bitrate, self.crf)
+            frames = h264_round_trip(frames, scene.fps, self.bitrate, self.crf)
         return frames
-
-    def write(self, path: str | Path, scene: Scene, traj: Trajectory) -> None:
-        """Film the clip and encode it to the video file ``path``, each frame at its trajectory
-        time: H.264 (VP9 for ``.webm``) at ``bitrate`` or ``crf``, else CRF :data:`WRITE_CRF`;
-        ``.gif`` is an animated GIF (256 colours, times rounded to 10 ms)."""
-        frames = self._expose(scene, traj)
-        times = np.asarray(traj.times, dtype=float)
-        if Path(path).suffix.lower() == ".gif":
-            _write_gif(Path(path), frames, times, scene.dt)
-            return
-        from physbench.video.writer import write_video
-
-        crf = self.crf if self.crf is not None or self.bitrate > 0 else WRITE_CRF
-        write_video(
-            path,
-            _even(frames),
-            fps=scene.fps,
-            times=times,
-            codec=VIDEO_CODECS.get(Path(path).suffix.lower(), "libx264"),
-            bitrate=int(self.bitrate) if self.bitrate > 0 else None,
-            crf=crf,
-        )
-
-    def render(
-        self,
-        scene: Scene,
-        traj: Trajectory,
-        *,
-        focus: str | None = None,
-        out: np.ndarray | None = None,
-    ) -> np.ndarray:
-        """Called after every simulation: :meth:`film` as ``(T, 3, H, W)`` float32 in [0, 1]."""
-        frames = self.film(scene, traj)
-        shape = self.shape(scene, frames.shape[0])
-        if out is not None and (out.shape != shape or out.dtype != np.float32):
-            raise RenderError(
-                f"out has shape {out.shape} and dtype {out.dtype}; expected {shape} float32"
-            )
-        if out is None:
-            out = np.empty(shape, np.float32)
-        np.divide(frames.transpose(0, 3, 1, 2), np.float32(255), out=out)
-        return out
 
     # ------------------------------------------------------------------ the exposure
 
@@ -635,7 +588,8 @@ class CameraRenderer(Renderer):
         w = 0.7 * np.sin(2 * math.pi * f1 * t + p1) + 0.3 * np.sin(2 * math.pi * f2 * t + p2)
         return 1 + self.flicker * w
 
-    def _expose(self, scene: Scene, traj: Trajectory) -> np.ndarray:
+    def exposure(self, scene: Scene, traj: Trajectory) -> np.ndarray:
+        """The frames the sensor records, before any encoding: ``(T, H, W, 3)`` uint8."""
         states = np.asarray(traj.states, dtype=float)
         n = len(scene.bodies)
         if (
@@ -729,64 +683,8 @@ def _draw_body(
     part += premult
 
 
-def _write_gif(path: Path, frames: np.ndarray, times: np.ndarray, dt: float) -> None:
-    from PIL import Image
-
-    ends = np.append(times[1:], times[-1] + (times[-1] - times[-2] if len(times) > 1 else dt))
-    ms = [max(10, round(d * 100) * 10) for d in ends - times]
-    images = [Image.fromarray(f) for f in frames]
-    images[0].save(path, save_all=True, append_images=images[1:], duration=ms, loop=0)
-
-
 def _quantise(img: np.ndarray) -> np.ndarray:
     return np.rint(np.clip(img, 0.0, 1.0) * np.float32(255)).astype(np.uint8)
-
-
-def _even(frames: np.ndarray) -> np.ndarray:
-    """Frames padded (edge pixels repeated) to an even height and width, as H.264 needs."""
-    _, h, w, _ = frames.shape
-    if h % 2 == 0 and w % 2 == 0:
-        return frames
-    return np.pad(frames, ((0, 0), (0, h % 2), (0, w % 2), (0, 0)), mode="edge")
-
-
-def _h264_round_trip(frames: np.ndarray, fps: float, bitrate: float, crf: int | None) -> np.ndarray:
-    """``frames`` (T, H, W, 3) uint8 encoded with H.264 (yuv420p) and decoded again in memory."""
-    from physbench.video.reader import _av
-
-    av = _av()
-    t, h, w, _ = frames.shape
-    padded = _even(frames)
-    enc = av.CodecContext.create("libx264", "w")
-    enc.width, enc.height = padded.shape[2], padded.shape[1]
-    enc.pix_fmt = "yuv420p"
-    rate = Fraction(fps).limit_denominator(1001)
-    enc.framerate = rate
-    enc.time_base = 1 / rate
-    if bitrate > 0:
-        enc.bit_rate = int(bitrate)
-    opts = {"preset": "veryfast", "tune": "zerolatency"}
-    if crf is not None:
-        opts["crf"] = str(crf)
-    enc.options = opts
-    dec = av.CodecContext.create("h264", "r")
-    got: list[np.ndarray] = []
-
-    def decode(packets: Any) -> None:
-        for packet in packets:
-            for frame in dec.decode(packet):
-                got.append(frame.to_ndarray(format="rgb24"))
-
-    for i in range(t):
-        frame = av.VideoFrame.from_ndarray(np.ascontiguousarray(padded[i]), format="rgb24")
-        frame.pts = i
-        decode(enc.encode(frame))
-    decode(enc.encode(None))
-    for frame in dec.decode(None):
-        got.append(frame.to_ndarray(format="rgb24"))
-    if len(got) != t:
-        raise RenderError(f"H.264 round trip returned {len(got)} frames for {t}")
-    return np.stack(got)[:, :h, :w]
 
 
 @hookimpl

@@ -123,7 +123,7 @@ def save_preview(
     xmin, ymin, xmax, ymax = scene.bounds
     mx, my = MARGIN * (xmax - xmin), MARGIN * (ymax - ymin)
     view = dataclasses.replace(scene, bounds=(xmin - mx, ymin - my, xmax + mx, ymax + my))
-    from physbench.plugins import create
+    from physbench.components import create
 
     # the default renderer draws each body's coverage, one channel per body, for the colours
     renderer = create("renderer", DEFAULT_RENDERER, resolution=size, mode="instance")

@@ -115,24 +115,15 @@ class Check:
 
 
 def kind_of(cls: type) -> str:
-    """``simulator``, ``renderer``, ``effect`` or ``estimator``: the base class ``cls``
-    subclasses."""
-    from physbench.effects.base import Effect
-    from physbench.estimators.base import CorrectionEstimator
-    from physbench.render.base import Renderer
-    from physbench.simulators.base import Simulator
+    """``simulator``, ``renderer``, ``effect`` or ``estimator``: the kind (of
+    :data:`physbench.kinds.KINDS`) whose base class ``cls`` subclasses."""
+    from physbench.kinds import KINDS, kind_of_class
 
-    bases = {
-        "simulator": Simulator,
-        "renderer": Renderer,
-        "effect": Effect,
-        "estimator": CorrectionEstimator,
-    }
-    for kind, base in bases.items():
-        if isinstance(cls, type) and issubclass(cls, base):
-            return kind
-    names = ", ".join(f"{b.__module__}.{b.__qualname__}" for b in bases.values())
-    raise ConformanceError(f"{cls!r} subclasses none of the component base classes ({names})")
+    found = kind_of_class(cls)
+    if found is None:
+        names = ", ".join(k.base.replace(":", ".") for k in KINDS if k.base)
+        raise ConformanceError(f"{cls!r} subclasses none of the component base classes ({names})")
+    return found.name
 
 
 def _module(kind: str) -> Any:

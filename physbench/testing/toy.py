@@ -12,11 +12,11 @@ import numpy as np
 from physbench.effects.base import Effect
 from physbench.loop import History, draw_problem, refine
 from physbench.observation import Observation, simulate_observation
-from physbench.params import ParamSpace
 from physbench.render.base import Renderer, RenderError
 from physbench.scene import Body, Circle, Scene, body_unknown
 from physbench.simulators.base import Simulator
 from physbench.trajectory import Trajectory
+from physbench.unknowns import ParamSpace
 
 
 def toy_scene(frames: int = 12) -> Scene:

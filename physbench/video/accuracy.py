@@ -9,13 +9,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from physbench.render.camera import CameraRenderer
+    from physbench.render.base import Camera
     from physbench.scene import Scene
     from physbench.trajectory import Trajectory
 
 
 def true_pixels(
-    scene: Scene, traj: Trajectory, camera: CameraRenderer, body: str, times: np.ndarray
+    scene: Scene, traj: Trajectory, camera: Camera, body: str, times: np.ndarray
 ) -> np.ndarray:
     """``(len(times), 2)`` image positions (px) of ``body`` at the trajectory frames of ``times``
     (s), as ``camera`` films ``scene``."""
@@ -25,7 +25,7 @@ def true_pixels(
 
 
 def pixel_errors(
-    scene: Scene, traj: Trajectory, camera: CameraRenderer, pixels: dict[str, np.ndarray]
+    scene: Scene, traj: Trajectory, camera: Camera, pixels: dict[str, np.ndarray]
 ) -> tuple[np.ndarray, int]:
     """Centre errors (px) over all bodies and tracked frames of ``pixels`` (body -> rows ``(t, u,
     v)``, as in :attr:`~physbench.video.track.TrackResult.pixels`), and the identity swaps: tracked

@@ -1,7 +1,7 @@
 """The background a tracker subtracts: a plate of the empty scene, or the median of the video.
 
-A plate (an image filmed before the bodies came in, or :meth:`CameraRenderer.plate
-<physbench.render.camera.CameraRenderer.plate>`) is the better choice: the median of a clip holds a
+A plate (an image filmed before the bodies came in, or a camera renderer's
+:meth:`~physbench.render.base.Camera.plate`) is the better choice: the median of a clip holds a
 body that never moves as background. :func:`median_background` streams the video and keeps about
 ``samples`` frames spread over the whole clip (it never holds the video in memory).
 """

@@ -26,7 +26,7 @@ import numpy as np
 from scipy import ndimage
 
 if TYPE_CHECKING:
-    from physbench.video.calibration import Calibration
+    from physbench.calibration import Calibration
 
 
 @dataclass(frozen=True)

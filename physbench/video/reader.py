@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from physbench.codec import load_av
 from physbench.errors import PhysbenchError
 
 #: Image files a folder may hold, as frames.
@@ -60,16 +61,6 @@ class VideoInfo:
     frames: int | None
     duration: float | None
     codec: str
-
-
-def _av() -> Any:
-    try:
-        import av
-    except ImportError:
-        raise VideoError(
-            "reading video needs PyAV: pip install 'physbench[video]' (or pip install av)"
-        ) from None
-    return av
 
 
 def _number(name: str, value: float | None, *, low: float = 0.0) -> float | None:
@@ -187,7 +178,7 @@ class VideoReader:
             raise VideoError(f"image {str(p)!r} cannot be read: {exc}") from None
 
     def _open(self) -> Any:
-        av = _av()
+        av = load_av()
         try:
             return av.open(str(self.path))
         except av.error.FFmpegError as exc:
@@ -204,7 +195,7 @@ class VideoReader:
         return stream
 
     def _decode(self) -> Iterator[Frame]:
-        av = _av()
+        av = load_av()
         with self._open() as container:
             stream = self._stream(container)
             stream.thread_type = "AUTO"

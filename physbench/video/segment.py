@@ -30,8 +30,8 @@ from physbench.render.raster import image_size
 from physbench.scene import Circle
 
 if TYPE_CHECKING:
+    from physbench.calibration import Calibration
     from physbench.scene import Scene
-    from physbench.video.calibration import Calibration
 
 #: Channel layouts a segmenter can produce (those of a mask renderer).
 SEGMENT_MODES = ("mark", "instance", "mask")

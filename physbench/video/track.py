@@ -47,9 +47,9 @@ from physbench.video.detect import (
 from physbench.video.segment import difference, noise_threshold
 
 if TYPE_CHECKING:
+    from physbench.calibration import Calibration
     from physbench.recording import Recording
     from physbench.scene import Body, Scene
-    from physbench.video.calibration import Calibration
     from physbench.video.reader import Frame
 
 #: Ratio of a body's principal second moments above which its long axis gives its angle.
@@ -75,7 +75,7 @@ def bounds_calibration(scene: Scene, image_shape: tuple[int, int]) -> Calibratio
     """The calibration of a camera square-on to the plane with ``scene.bounds`` filling an image
     of ``image_shape = (H, W)`` px: the scene's aspect is kept, so the bounds touch two opposite
     edges and are centred between the other two; ``y`` up."""
-    from physbench.video.calibration import Calibration
+    from physbench.calibration import Calibration
 
     h, w = image_shape
     xmin, ymin, xmax, ymax = scene.bounds

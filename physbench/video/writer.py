@@ -1,5 +1,6 @@
 """Writing video files with real lossy encoding (H.264 through PyAV's FFmpeg), with each frame's
-time kept as its container timestamp."""
+time kept as its container timestamp: frames (:func:`write_video`), or a camera filming a
+trajectory (:func:`write_clip`)."""
 
 from __future__ import annotations
 
@@ -7,10 +8,17 @@ import math
 from collections.abc import Iterable, Sequence
 from fractions import Fraction
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.video.reader import VideoError, _av
+from physbench.codec import even, load_av
+from physbench.video.reader import VideoError
+
+if TYPE_CHECKING:
+    from physbench.render.base import Camera
+    from physbench.scene import Scene
+    from physbench.trajectory import Trajectory
 
 #: Timestamps are written in these units (ticks per second): fine enough for any camera's clock.
 TIME_BASE = Fraction(1, 90_000)
@@ -32,7 +40,7 @@ def write_video(
     timestamps, so a variable frame rate or dropped frames are recorded as such. ``bitrate``
     (bits/s) or ``crf`` (H.264 quality, 0-51) sets the compression. Returns the path.
     """
-    av = _av()
+    av = load_av()
     if not (isinstance(fps, int | float) and math.isfinite(fps) and fps > 0):
         raise VideoError(f"fps = {fps!r}: expected a number > 0")
     if times is not None and (np.diff(np.asarray(times, dtype=float)) <= 0).any():
@@ -69,3 +77,41 @@ def write_video(
     finally:
         container.close()
     return path
+
+
+#: H.264 quality of a clip written with neither a bitrate nor a CRF.
+WRITE_CRF = 20
+#: Container suffix -> codec; others get H.264.
+VIDEO_CODECS = {".webm": "libvpx-vp9"}
+
+
+def write_clip(camera: Camera, path: str | Path, scene: Scene, traj: Trajectory) -> Path:
+    """Film ``traj`` with ``camera`` and encode the clip to ``path``, each frame at its trajectory
+    time: H.264 (VP9 for ``.webm``) at the camera's ``bitrate`` or ``crf``, else CRF
+    :data:`WRITE_CRF`; ``.gif`` is an animated GIF (256 colours, times rounded to 10 ms). Returns
+    the path."""
+    frames = camera.exposure(scene, traj)
+    times = np.asarray(traj.times, dtype=float)
+    path = Path(path)
+    if path.suffix.lower() == ".gif":
+        _write_gif(path, frames, times, scene.dt)
+        return path
+    crf = camera.crf if camera.crf is not None or camera.bitrate > 0 else WRITE_CRF
+    return write_video(
+        path,
+        even(frames),
+        fps=scene.fps,
+        times=times,
+        codec=VIDEO_CODECS.get(path.suffix.lower(), "libx264"),
+        bitrate=int(camera.bitrate) if camera.bitrate > 0 else None,
+        crf=crf,
+    )
+
+
+def _write_gif(path: Path, frames: np.ndarray, times: np.ndarray, dt: float) -> None:
+    from PIL import Image
+
+    ends = np.append(times[1:], times[-1] + (times[-1] - times[-2] if len(times) > 1 else dt))
+    ms = [max(10, round(d * 100) * 10) for d in ends - times]
+    images = [Image.fromarray(f) for f in frames]
+    images[0].save(path, save_all=True, append_images=images[1:], duration=ms, loop=0)

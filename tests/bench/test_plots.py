@@ -208,7 +208,7 @@ def test_the_coverage_figure_draws_posteriors_against_the_diagonal(
     calibrated_sweep, tmp_path: Path
 ) -> None:
     from physbench.bench import plots
-    from physbench.calibration import LEVELS
+    from physbench.posterior.scoring import LEVELS
 
     from .conftest import SMC
 

@@ -287,7 +287,7 @@ def test_building_the_tables_imports_no_library_after_the_cells(tmp_path: Path) 
         [sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, check=True
     ).stdout.split()
     libraries = {"pandas", "pyarrow.parquet", "pyarrow.pandas_compat", "scipy.stats"}
-    assert not set(late) & {*libraries, "physbench.calibration"}
+    assert not set(late) & {*libraries, "physbench.posterior.scoring"}
 
 
 def test_the_tables_libraries_are_imported_while_the_cells_run(

@@ -62,7 +62,8 @@ def test_seed_forms(seeds: object, expected: tuple[int, ...]) -> None:
         ({"estimators": ["random", "nope"]}, "unknown estimator 'nope'; known estimators: "),
         (
             {"estimators": [{"name": "optuna", "options": {"temperature": 1}}]},
-            "estimator 'optuna' does not take options",
+            "estimator 'optuna' (physbench's own) does not take option 'temperature'; "
+            "its options: sampler,",
         ),
         ({"scenes": ["no_such_scene"]}, "unknown scene 'no_such_scene'"),
         (
@@ -186,7 +187,8 @@ def test_renderer_axis_forms_and_product() -> None:
         ),
         (
             {"name": "blocks", "options": {"colour": "red"}},
-            "s.toml: renderer = 'blocks': renderer 'blocks' does not take options",
+            "s.toml: renderer = 'blocks': renderer 'blocks' (plugin 'toy_blocks', registered by "
+            "PHYSBENCH_PLUGINS) does not take option 'colour'",
         ),
         (
             {"name": "blocks", "options": {"resolution": 8}},

@@ -142,8 +142,8 @@ CALIBRATION_STATS = [
 
 def test_cells_with_a_posterior_record_its_scores_against_the_truth(calibrated_sweep) -> None:
     from physbench.bench.store import CellStore
-    from physbench.calibration import score
-    from physbench.posterior import Posterior
+    from physbench.posterior.samples import Posterior
+    from physbench.posterior.scoring import score
 
     from .conftest import SMC
 

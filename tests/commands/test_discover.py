@@ -187,7 +187,11 @@ def test_bad_frames_give_a_named_error(tmp_path, capsys, arrays, message):
 
 RENDERER_CASES = [
     ("unknown renderer", ["--renderer", "nope"], r"unknown renderer 'nope'.*raster"),
-    ("option it does not take", ["-R", "nope=1"], r"renderer 'raster' does not take options"),
+    (
+        "option it does not take",
+        ["-R", "nope=1"],
+        r"renderer 'raster' \(physbench's own\) does not take option 'nope'; its options: none",
+    ),
     (
         "mode against the channels",
         ["--render-mode", "mark"],

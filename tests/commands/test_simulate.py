@@ -84,7 +84,10 @@ def test_the_renderer_is_a_choice(tmp_path: Path, capsys, squares_renderer) -> N
     frames = np.load(out)["frames"]
     assert frames.shape[1:] == (1, 20, 20) and set(np.unique(frames)) <= {0.0, 1.0}
     assert main([*argv, "-R", "size=0.5.1"]) == 2  # not a number: the plugin's own ValueError
-    assert "renderer 'squares' refused options {'size': '0.5.1'}" in capsys.readouterr().err
+    assert (
+        "renderer 'squares' (plugin 'pb_squares', registered by PHYSBENCH_PLUGINS) refused "
+        "options {'size': '0.5.1'}" in capsys.readouterr().err
+    )
     assert main(["simulate", "--scene", "three_circles", "--renderer", "nope"]) == 2
     assert "unknown renderer 'nope'" in capsys.readouterr().err
 
@@ -132,7 +135,7 @@ def test_effects_change_the_simulated_motion(tmp_path: Path, capsys) -> None:  #
     capsys.readouterr()
     for bad, message in (
         ("linear_drag:c", "expected NAME[:KEY=NUMBER,...]"),
-        ("linear_drag:q=1", "known parameters of effect 'linear_drag': c"),
+        ("linear_drag:q=1", "does not take option 'q'; its options: bodies, label, c"),
         ("nope", "unknown effect 'nope'; known effects: clock_scale"),
     ):
         assert main(["simulate", "--scene", "ball_drop", "--effect", bad]) == 2

@@ -10,10 +10,11 @@ import pytest
 from PIL import Image
 
 from physbench.cli import main
-from physbench.plugins import create
+from physbench.components import create
 from physbench.recording import read_recording
 from physbench.render.camera import CameraRenderer
 from physbench.scenes import resolve_scene
+from physbench.video.writer import write_clip
 
 
 @pytest.fixture(scope="module")
@@ -22,7 +23,7 @@ def clip(tmp_path_factory):
     scene = resolve_scene("bouncing_balls", 4)
     traj = create("simulator", "pymunk").simulate(scene)
     cam = CameraRenderer(640, bitrate=1_500_000, seed=4)
-    cam.write(tmp / "clip.mp4", scene, traj)
+    write_clip(cam, tmp / "clip.mp4", scene, traj)
     Image.fromarray(cam.plate(scene)).save(tmp / "plate.png")
     cal = cam.calibration(scene).homography
     rows = "\n".join(f"[{', '.join(repr(float(x)) for x in r)}]," for r in cal)

@@ -14,7 +14,10 @@ from physbench.cli import main
     [
         (["--params", "volume"], "unknown parameter 'volume'"),
         (["--params", "mass", "--renderer", "nope"], "unknown renderer 'nope'"),
-        (["--params", "mass", "-R", "colour=red"], "renderer 'raster' does not take options"),
+        (
+            ["--params", "mass", "-R", "colour=red"],
+            "renderer 'raster' (physbench's own) does not take option 'colour'; its options: none",
+        ),
         (["--params", "mass", "--widths", "1,2"], "--widths '1,2': expected 4 positive integers"),
         (["--params", "mass", "--resolution", "4096"], "--resolution 4096: expected 8..512"),
         (

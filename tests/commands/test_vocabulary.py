@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from physbench.cli import COMMANDS, build_parser, main
-from physbench.params import split_params
+from physbench.unknowns import split_params
 
 #: commands that write files: all take --out for their result
 WRITERS = {"run", "simulate", "track", "train", "bench", "plot", "discover"}

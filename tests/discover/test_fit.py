@@ -57,3 +57,39 @@ def test_budgets_and_horizons_follow_the_settings_and_the_scene(slide, noisy):
     assert fit_horizons(model, Settings(horizons=(0.3, 2.0))) == (0.3, 1.0)
     walls = start_model(problem_for([Run("r", floor, recording=track)], "pymunk", s), s)
     assert fit_horizons(walls, s) == (0.5, 1.0)
+
+
+WILD = """
+from typing import ClassVar
+
+from physbench.estimators.base import CorrectionEstimator
+from physbench.hookspecs import hookimpl
+
+
+class Wild(CorrectionEstimator):
+    name: ClassVar[str] = "wild"
+
+    def start(self, task, *, seed):
+        self.space = task.space
+
+    def propose(self, step):
+        return {k: 1e9 for k in self.space.keys}  # far outside every range
+
+
+@hookimpl
+def register_estimators():
+    return [Wild]
+"""
+
+
+def test_discovery_fits_run_through_the_loops_guarded_driver(plugin, slide, noisy):  # type: ignore[no-untyped-def]
+    """A black-box fit gets the same proposal checks as the image loop: one driver."""
+    from physbench.loop import EstimatorError
+
+    plugin("pb_wild", WILD)
+    scene = slide()
+    settings = Settings()
+    runs = [Run("r", scene, recording=noisy(PymunkSimulator().simulate(scene)))]
+    model = start_model(problem_for(runs, "pymunk", settings), settings)
+    with pytest.raises(EstimatorError, match=r"estimator 'wild' proposed .* = 1000000000\.0 in"):
+        estimator_fit(model, model.free_keys()[:1], "wild", iterations=3)

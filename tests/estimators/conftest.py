@@ -8,11 +8,11 @@ from typing import Any
 
 import pytest
 
+from physbench.components import create
 from physbench.loop import History, draw_problem, refine
 from physbench.observation import simulate_observation
-from physbench.params import ParamSpace
-from physbench.plugins import create
 from physbench.scenes import resolve_scene
+from physbench.unknowns import ParamSpace
 
 
 def run_three_circles(name: str, seed: int, params: list[str], **options: Any) -> History:

@@ -7,15 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from physbench.components import create
 from physbench.estimators.options import EstimatorOptionError
 from physbench.estimators.smc import SMCEstimator, next_beta, systematic_resample
 from physbench.loop import History, draw_problem, refine
 from physbench.observation import simulate_observation
-from physbench.params import ParamSpace
-from physbench.plugins import create
-from physbench.render.observe import ObservationModel
+from physbench.render.sensor import SensorModel
 from physbench.scenes import resolve_scene
 from physbench.testing.toy import ToyRenderer, ToySimulator, toy_scene
+from physbench.unknowns import ParamSpace
 
 
 def _toy(
@@ -25,8 +25,8 @@ def _toy(
     space = ParamSpace.from_scene(scene, ["mass", "elasticity"], ["a"])
     truth, _ = draw_problem(space, seed)
     sim, ren = ToySimulator(), ToyRenderer()
-    camera = ObservationModel(noise=0.2, seed=seed)
-    obs = simulate_observation(scene, truth, sim, ren, camera=camera)
+    camera = SensorModel(noise=0.2, seed=seed)
+    obs = simulate_observation(scene, truth, sim, ren, sensor=camera)
     if not stated:  # as if the frames came from a file: the noise level is not stated
         obs.noise = None
     h = refine(
@@ -83,7 +83,7 @@ def test_ball_drop_mass_without_drag_is_not_determined() -> None:
     space = ParamSpace.from_scene(scene, ["mass"])
     truth, _ = draw_problem(space, 0)
     sim, ren = create("simulator", "pymunk"), create("renderer", "raster", resolution=32)
-    obs = simulate_observation(scene, truth, sim, ren, camera=ObservationModel(noise=0.05, seed=0))
+    obs = simulate_observation(scene, truth, sim, ren, sensor=SensorModel(noise=0.05, seed=0))
     h = refine(obs, scene, space, sim, ren, SMCEstimator(), iterations=400, seed=0)
     p = h.posterior
     assert p is not None and p.complete

@@ -7,13 +7,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from physbench.calibration import Calibration
 from physbench.render.base import RenderError
 from physbench.render.camera import CameraRenderer
 from physbench.scene import Body, Box, Circle, Scene
 from physbench.testing import Check, Subject, parametrize_with_checks
 from physbench.testing.renderers import probe_scene, probe_trajectory
 from physbench.trajectory import Trajectory
-from physbench.video.calibration import Calibration
+from physbench.video.writer import write_clip
 
 #: A clean picture: no noise, no uneven or changing light, a uniform background.
 CLEAN = {"noise": 0.0, "light": 0.0, "flicker": 0.0, "background": "plain"}
@@ -236,7 +237,7 @@ def test_write_encodes_the_clip_at_the_trajectory_times(tmp_path) -> None:  # ty
     scene = probe_scene()
     traj = probe_trajectory(scene)
     cam = CameraRenderer(96)
-    cam.write(tmp_path / "clip.mkv", scene, traj)
+    write_clip(cam, tmp_path / "clip.mkv", scene, traj)
     frames = list(VideoReader(tmp_path / "clip.mkv").frames())
     assert len(frames) == scene.frames
     np.testing.assert_allclose([f.time for f in frames], traj.times, atol=2e-3)

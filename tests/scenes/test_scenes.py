@@ -26,7 +26,6 @@ import numpy as np
 import pytest
 
 from physbench.errors import SimulationError
-from physbench.params import ParamSpace
 from physbench.render.raster import RasterRenderer
 from physbench.scene import BODY_PARAMS, Scene
 from physbench.scene_toml import dumps_scene, loads_scene
@@ -40,6 +39,7 @@ from physbench.scenes import (
 )
 from physbench.simulators.box2d_sim import Box2DSimulator
 from physbench.simulators.pymunk_sim import PymunkSimulator
+from physbench.unknowns import ParamSpace
 
 SEEDS = range(10)
 MIN_DISPLACEMENT = 0.3  # m

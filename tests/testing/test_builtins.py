@@ -7,11 +7,13 @@ from typing import Any
 
 from physbench.effects import BUILTIN_EFFECTS
 from physbench.estimators.resnet3d.weights import SHIPPED
+from physbench.kinds import KINDS as ALL_KINDS
 from physbench.plugins import build_registry
 from physbench.testing import Check, Subject, parametrize_with_checks
 from physbench.testing.kit import kind_of
 
-KINDS = ("simulator", "renderer", "effect", "estimator")
+#: The kinds with a contract class (scenes are plain callables, without a kit).
+KINDS = tuple(k.name for k in ALL_KINDS if k.base)
 
 #: Kit settings, options and optional modules of the built-ins that need them (by registered name).
 SETTINGS: dict[str, dict[str, Any]] = {

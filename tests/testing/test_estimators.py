@@ -12,7 +12,6 @@ import pytest
 from physbench.errors import PhysbenchError
 from physbench.estimators.base import CorrectionEstimator, Step, Task
 from physbench.estimators.random_search import RandomSearch
-from physbench.params import Params
 from physbench.testing import (
     Check,
     ConformanceError,
@@ -28,6 +27,7 @@ from physbench.testing import (
     parametrize_with_checks,
 )
 from physbench.testing.estimators import check_marked_views
+from physbench.unknowns import Params
 
 
 class Base(CorrectionEstimator):

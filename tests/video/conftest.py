@@ -9,11 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from physbench.plugins import create
+from physbench.components import create
 from physbench.render.camera import CameraRenderer
 from physbench.scene import Scene
 from physbench.trajectory import Trajectory
 from physbench.video.accuracy import pixel_errors
+from physbench.video.writer import write_clip
 
 #: A realistic camera: motion blur, sensor noise, uneven flickering light, lossy H.264.
 REAL = {"shutter": 0.5, "subframes": 8, "noise": 0.02, "bitrate": 1_500_000}
@@ -40,7 +41,7 @@ def film(tmp_path: Path) -> Callable[..., Clip]:
         traj = create("simulator", engine).simulate(scene)
         camera = CameraRenderer(640, **{**REAL, **opts})  # type: ignore[arg-type]
         path = tmp_path / name
-        camera.write(path, scene, traj)
+        write_clip(camera, path, scene, traj)
         return Clip(path, scene, traj, camera)
 
     return make

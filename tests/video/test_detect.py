@@ -58,7 +58,7 @@ def test_moments_give_the_long_axis_and_a_squares_sides() -> None:
 
 
 def test_a_long_body_seen_obliquely_is_measured_on_the_plane() -> None:
-    from physbench.video.calibration import Calibration
+    from physbench.calibration import Calibration
     from physbench.video.detect import blob_from_pixels, plane_pose
 
     # A steep view: the far side of the plane is squeezed (points of a 4 m x 3 m board).

@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physbench.plugins import create
+from physbench.calibration import Calibration
+from physbench.components import create
 from physbench.render.camera import CameraRenderer
 from physbench.render.raster import RasterRenderer
 from physbench.scene import Body, Box, Circle, Scene
 from physbench.scenes import resolve_scene
 from physbench.trajectory import Trajectory
-from physbench.video.calibration import Calibration
 from physbench.video.segment import (
     Segmenter,
     SegmentError,
@@ -129,7 +129,7 @@ def test_a_ball_with_a_highlight_segments_without_a_hole() -> None:
     # The box scene's ball on its light wall: the specular highlight falls under the threshold
     # (a hole down to 0.28 in the 64 px masks, measured); the observed masks must be as solid
     # as the rendered ones.
-    from physbench.video.observe import filmed_observation
+    from physbench.video.footage import filmed_observation
 
     scene = resolve_scene("stacked_boxes", 10)
     cam = CameraRenderer(640, tilt=15.0, bitrate=2_000_000, seed=1)

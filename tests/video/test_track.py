@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physbench.plugins import create
+from physbench.calibration import Calibration
+from physbench.components import create
 from physbench.scene import Body, Box, Circle, Scene
 from physbench.scenes import bouncing_balls
-from physbench.video.calibration import Calibration
 from physbench.video.reader import Frame, VideoReader
 from physbench.video.track import (
     TrackError,
@@ -157,7 +157,7 @@ def test_touching_boxes_and_a_ball_split_along_their_outlines(film) -> None:
 def test_a_folder_of_images_is_tracked_at_the_scenes_frame_rate(tmp_path) -> None:
     from PIL import Image
 
-    from physbench.plugins import create
+    from physbench.components import create
     from physbench.render.camera import CameraRenderer
 
     scene = bouncing_balls.generate(1, n_balls=2)
@@ -178,7 +178,7 @@ def test_a_swinging_arm_is_measured_along_its_length(film, seed: int) -> None:
     # finds how long the arm covered it. Measured RMS along the arm: 4.9 and 5.7 mm with weights
     # from the contrast, 1.1 and 1.3 mm unmixed.
     from physbench.discover.synthetic import pendulum
-    from physbench.video.observe import motion_view
+    from physbench.video.footage import motion_view
 
     scene = pendulum(np.random.default_rng(seed), (0.9, 1.3)).validate()
     swing = create("simulator", "pymunk").simulate(scene)
@@ -202,7 +202,7 @@ def test_two_arms_joined_at_an_elbow_keep_their_own_angles() -> None:
     # track after 35 of 81 frames and the lower one followed the upper arm (0.23 rad RMS; 0.002
     # rad now), so discover named a joint friction that was not there.
     from physbench.discover.synthetic import filmed_run, make_case
-    from physbench.video.observe import frame_trajectory
+    from physbench.video.footage import frame_trajectory
 
     case = make_case(None, "double_pendulum", 1, create("simulator", "pymunk"))
     rec = filmed_run(case, 1).recording

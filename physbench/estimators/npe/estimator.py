@@ -16,13 +16,13 @@ from physbench.estimators.options import int_option
 
 if TYPE_CHECKING:
     from physbench.estimators.base import Step, Task
-    from physbench.params import Params
-    from physbench.posterior import Posterior
+    from physbench.posterior.samples import Posterior
+    from physbench.unknowns import Params
 
 
 class NPEEstimator(CorrectionEstimator):
     """Neural posterior estimation on the marked views (one body at a time; see
-    :mod:`physbench.estimators.npe.summary` for the embedding and why it is not the paper's
+    :mod:`physbench.estimators.npe.features` for the embedding and why it is not the paper's
     3D-ResNet). Each unknown body's posterior comes from its own marked view, and the joint is
     their product: correlations *between* bodies' unknowns (e.g. two masses known only as a ratio)
     are not represented.
@@ -63,9 +63,9 @@ class NPEEstimator(CorrectionEstimator):
         import torch
 
         from physbench.estimators.npe import weights
-        from physbench.estimators.npe.model import sample_unit
-        from physbench.estimators.npe.summary import summarize
-        from physbench.posterior import Posterior
+        from physbench.estimators.npe.features import summarize
+        from physbench.estimators.npe.network import sample_unit
+        from physbench.posterior.samples import Posterior
 
         if self.threads:
             torch.set_num_threads(self.threads)

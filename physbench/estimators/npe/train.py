@@ -15,8 +15,13 @@ from typing import Any
 
 import numpy as np
 
-from physbench.estimators.npe.data import TRAIN_SEED0, VAL_SEED0, NPEDataSpec, simulate_pairs
-from physbench.estimators.npe.model import MDNConfig, build_mdn, ensemble_log_prob, to_logit
+from physbench.estimators.npe.network import MDNConfig, build_mdn, ensemble_log_prob, to_logit
+from physbench.estimators.npe.training_data import (
+    TRAIN_SEED0,
+    VAL_SEED0,
+    NPEDataSpec,
+    simulate_pairs,
+)
 
 
 @dataclass(frozen=True)
@@ -100,7 +105,7 @@ def train(
 
     import physbench
     from physbench.estimators.npe import weights
-    from physbench.params import ParamSpace
+    from physbench.unknowns import ParamSpace
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -138,7 +143,7 @@ def train(
         "data": spec.to_dict(),
         "net": net.to_dict(),
         "ranges": {u.name: [u.low, u.high] for u in space.unknowns},
-        "embedding": "pixel summaries (physbench.estimators.npe.summary), not a 3D-ResNet",
+        "embedding": "pixel summaries (physbench.estimators.npe.features), not a 3D-ResNet",
         "density": "equal-weight ensemble of mixture density networks over logit(unit) values",
         "training": {
             **asdict(cfg),

@@ -51,7 +51,7 @@ def find(scene: str, params: tuple[str, ...]) -> Path:
 def load(path: str | Path) -> tuple[list[Any], dict[str, Any]]:
     """The ensemble members (torch modules, eval mode) and the sidecar of ``path``, checked: an
     npe sidecar, and tensors that are exactly the members its ``net`` describes."""
-    from physbench.estimators.npe.model import MDNConfig, build_mdn
+    from physbench.estimators.npe.network import MDNConfig, build_mdn
 
     tensors, meta = read(path)
     where = f"npe weights {str(path)!r}"

@@ -10,10 +10,10 @@ import numpy as np
 
 from physbench.errors import PhysbenchError
 from physbench.estimators.base import CorrectionEstimator, Step, Task
-from physbench.params import Params
+from physbench.unknowns import Params
 
 if TYPE_CHECKING:
-    from physbench.posterior import Posterior
+    from physbench.posterior.samples import Posterior
 
 
 class ResNet3DEstimator(CorrectionEstimator):
@@ -69,8 +69,8 @@ class ResNet3DEstimator(CorrectionEstimator):
         import torch
 
         from physbench.estimators.resnet3d import weights
-        from physbench.estimators.resnet3d.data import DataSpec
-        from physbench.estimators.resnet3d.model import NetConfig, build_net
+        from physbench.estimators.resnet3d.network import NetConfig, build_net
+        from physbench.estimators.resnet3d.training_data import DataSpec
 
         params = tuple(dict.fromkeys(u.name for u in task.space.unknowns))
         if self.weights_path:
@@ -168,7 +168,7 @@ class ResNet3DEstimator(CorrectionEstimator):
         ``None``."""
         import torch
 
-        from physbench.posterior import Posterior
+        from physbench.posterior.samples import Posterior
 
         if not self.posterior_samples or self.last is None:
             return None

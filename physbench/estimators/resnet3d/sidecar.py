@@ -187,7 +187,7 @@ def _net(c: _Check, net: object, data: dict[str, Any], params: tuple[str, ...]) 
     c.number(n["dropout"], "net.dropout", 0.0, 0.99)
     c.integer(n["resolution"], "net.resolution", *RESOLUTION)
     c.integer(n["frames"], "net.frames", *FRAMES)
-    from physbench.estimators.resnet3d.data import DataSpec
+    from physbench.estimators.resnet3d.training_data import DataSpec
 
     # Training made the inputs with data's layout; an absent key means DataSpec's default.
     for key in ("resolution", "frames"):

@@ -13,8 +13,8 @@ import numpy as np
 
 from physbench.errors import PhysbenchError
 from physbench.estimators.resnet3d import weights
-from physbench.estimators.resnet3d.data import DataSpec, stream, validation_set
-from physbench.estimators.resnet3d.model import NetConfig, build_net
+from physbench.estimators.resnet3d.network import NetConfig, build_net
+from physbench.estimators.resnet3d.training_data import DataSpec, stream, validation_set
 
 # The largest training run accepted: a typo (1e12 samples, a batch of a million) fails here,
 # not hours later. 1e9 samples is 25,000 times the default budget; a batch of 4096 sequences of
@@ -90,7 +90,7 @@ def weights_name(spec: DataSpec) -> str:
 
 
 def _ranges(spec: DataSpec) -> dict[str, list[float]]:
-    from physbench.params import ParamSpace
+    from physbench.unknowns import ParamSpace
 
     space = ParamSpace.from_scene(spec.instance(0), spec.params)
     return {u.name: [u.low, u.high] for u in space.unknowns}

@@ -147,7 +147,7 @@ def _match(tensors: dict[str, Any], net: dict[str, Any], path: Path) -> None:
     ``load_state_dict`` would fail (or, for shapes it broadcasts, not)."""
     import torch
 
-    from physbench.estimators.resnet3d.model import NetConfig, build_net
+    from physbench.estimators.resnet3d.network import NetConfig, build_net
 
     with torch.device("meta"):  # shapes only: no memory, no initialisation cost
         want = {

@@ -12,7 +12,7 @@ from physbench.hookspecs import hookimpl
 
 if TYPE_CHECKING:
     from physbench.estimators.base import Step, Task
-    from physbench.params import Params, ParamSpace
+    from physbench.unknowns import Params, ParamSpace
 
 METHODS = ("nelder-mead", "powell")
 

@@ -10,19 +10,18 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
+from physbench.components import create, make_renderer  # noqa: E402
 from physbench.errors import PhysbenchError  # noqa: E402
 from physbench.estimators.base import Step, Task  # noqa: E402
 from physbench.estimators.npe import weights  # noqa: E402
-from physbench.estimators.npe.data import NPEDataSpec  # noqa: E402
 from physbench.estimators.npe.estimator import NPEEstimator  # noqa: E402
-from physbench.estimators.npe.model import MDNConfig  # noqa: E402
+from physbench.estimators.npe.network import MDNConfig  # noqa: E402
 from physbench.estimators.npe.train import NPETrainConfig, train  # noqa: E402
-from physbench.experiment import make_renderer  # noqa: E402
+from physbench.estimators.npe.training_data import NPEDataSpec  # noqa: E402
 from physbench.loop import draw_problem  # noqa: E402
 from physbench.observation import simulate_observation  # noqa: E402
-from physbench.params import ParamSpace  # noqa: E402
-from physbench.plugins import create  # noqa: E402
 from physbench.scenes import resolve_scene  # noqa: E402
+from physbench.unknowns import ParamSpace  # noqa: E402
 
 
 def _task(seed: int, params: tuple[str, ...] = ("mass",)) -> Task:

@@ -9,7 +9,7 @@ torch = pytest.importorskip("torch")
 
 from physbench.errors import PhysbenchError  # noqa: E402
 from physbench.estimators.resnet3d import weights  # noqa: E402
-from physbench.estimators.resnet3d.data import DataSpec  # noqa: E402
+from physbench.estimators.resnet3d.training_data import DataSpec  # noqa: E402
 
 
 def shipped() -> list[weights.WeightsInfo]:
@@ -18,12 +18,13 @@ def shipped() -> list[weights.WeightsInfo]:
 
 @pytest.mark.parametrize("info", shipped(), ids=lambda w: f"{w.scene}-{'+'.join(w.params)}")
 def test_shipped_weights_beat_the_random_estimator(info: weights.WeightsInfo) -> None:
+    from physbench.components import create
     from physbench.estimators.random_search import RandomSearch
     from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
     from physbench.loop import draw_problem, refine
     from physbench.observation import simulate_observation
-    from physbench.params import ParamSpace
-    from physbench.plugins import create, get_registry
+    from physbench.plugins import get_registry
+    from physbench.unknowns import ParamSpace
 
     spec = DataSpec.from_dict(info.meta["data"])
     gen = get_registry().get("scene", spec.scene)
@@ -47,11 +48,12 @@ def test_shipped_weights_beat_the_random_estimator(info: weights.WeightsInfo) ->
 
 @pytest.mark.parametrize("symmetric", [False, True])
 def test_symmetric_option_makes_the_truth_an_exact_fixed_point(symmetric: bool) -> None:
+    from physbench.components import create
     from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
     from physbench.loop import draw_problem, refine
     from physbench.observation import simulate_observation
-    from physbench.params import ParamSpace
-    from physbench.plugins import create, get_registry
+    from physbench.plugins import get_registry
+    from physbench.unknowns import ParamSpace
 
     scene = get_registry().get("scene", "three_circles")(3)
     space = ParamSpace.from_scene(scene, ("mass",))
@@ -88,12 +90,13 @@ def test_weights_refuse_frames_of_another_renderer(squares_renderer) -> None:  #
 
 
 def test_posterior_samples_give_a_dropout_posterior_around_the_last_correction() -> None:
+    from physbench.components import create
     from physbench.estimators.options import EstimatorOptionError
     from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
     from physbench.loop import draw_problem, refine
     from physbench.observation import simulate_observation
-    from physbench.params import ParamSpace
-    from physbench.plugins import create, get_registry
+    from physbench.plugins import get_registry
+    from physbench.unknowns import ParamSpace
 
     scene = get_registry().get("scene", "three_circles")(2)
     space = ParamSpace.from_scene(scene, ("mass",))

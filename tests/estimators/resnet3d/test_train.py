@@ -10,9 +10,9 @@ torch = pytest.importorskip("torch")
 
 from physbench.errors import PhysbenchError  # noqa: E402
 from physbench.estimators.resnet3d import weights  # noqa: E402
-from physbench.estimators.resnet3d.data import DataSpec, PairMaker  # noqa: E402
-from physbench.estimators.resnet3d.model import NetConfig, build_net  # noqa: E402
+from physbench.estimators.resnet3d.network import NetConfig, build_net  # noqa: E402
 from physbench.estimators.resnet3d.train import TrainConfig, train  # noqa: E402
+from physbench.estimators.resnet3d.training_data import DataSpec, PairMaker  # noqa: E402
 
 TINY = NetConfig(n_outputs=1, widths=(4, 8, 8, 8), resolution=16, frames=6)
 TINY_DATA = DataSpec(

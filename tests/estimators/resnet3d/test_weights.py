@@ -11,8 +11,8 @@ torch = pytest.importorskip("torch")
 
 from physbench.errors import PhysbenchError  # noqa: E402
 from physbench.estimators.resnet3d import weights  # noqa: E402
-from physbench.estimators.resnet3d.data import DataSpec  # noqa: E402
-from physbench.estimators.resnet3d.model import NetConfig, build_net  # noqa: E402
+from physbench.estimators.resnet3d.network import NetConfig, build_net  # noqa: E402
+from physbench.estimators.resnet3d.training_data import DataSpec  # noqa: E402
 
 TINY = NetConfig(n_outputs=1, widths=(4, 8, 8, 8), resolution=16, frames=6)
 TINY_DATA = DataSpec(

@@ -23,8 +23,8 @@ from hypothesis import strategies as st  # noqa: E402
 
 from physbench.errors import PhysbenchError  # noqa: E402
 from physbench.estimators.resnet3d import weights  # noqa: E402
-from physbench.estimators.resnet3d.data import DataSpec  # noqa: E402
-from physbench.estimators.resnet3d.model import NetConfig, build_net  # noqa: E402
+from physbench.estimators.resnet3d.network import NetConfig, build_net  # noqa: E402
+from physbench.estimators.resnet3d.training_data import DataSpec  # noqa: E402
 
 TINY = NetConfig(n_outputs=1, widths=(4, 8, 8, 8), resolution=16, frames=6)
 TINY_DATA = DataSpec(
@@ -203,8 +203,8 @@ def _start(path: Path) -> None:
     """The estimator's start on a three_circles task with blank marked observations."""
     from physbench.estimators.base import Task
     from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
-    from physbench.params import ParamSpace
     from physbench.plugins import get_registry
+    from physbench.unknowns import ParamSpace
 
     scene = get_registry().get("scene", "three_circles")(0)
     space = ParamSpace.from_scene(scene, ("mass",))

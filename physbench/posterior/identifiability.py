@@ -19,10 +19,10 @@ from physbench.metrics import image_mse
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
-    from physbench.params import ParamSpace
     from physbench.render.base import Renderer
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
+    from physbench.unknowns import ParamSpace
 
 #: The probe's step, as a fraction of each unknown's range.
 STEP = 0.1

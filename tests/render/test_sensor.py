@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from physbench.render.base import RenderError
-from physbench.render.observe import ObservationModel, add_noise, gaussian_blur
 from physbench.render.raster import RasterRenderer
+from physbench.render.sensor import SensorModel, add_noise, gaussian_blur
 from physbench.scene import Body, Circle, Scene
 from physbench.trajectory import Trajectory
 
@@ -53,7 +53,7 @@ def still(scene: Scene) -> Trajectory:
 def test_blur_preserves_the_mass_of_a_centred_body() -> None:
     scene = make_scene(Body("c", Circle(0.4), (2.0, 2.0)))
     sharp = RasterRenderer(mode="mask").render(scene, still(scene))
-    blurred = ObservationModel(blur=2.0).apply(sharp.copy())
+    blurred = SensorModel(blur=2.0).apply(sharp.copy())
     assert blurred.sum() == pytest.approx(sharp.sum(), rel=1e-4)
     assert blurred.max() < sharp.max() and (blurred > 0).sum() > (sharp > 0).sum()
     np.testing.assert_allclose(gaussian_blur(sharp, 2.0), blurred)
@@ -62,14 +62,14 @@ def test_blur_preserves_the_mass_of_a_centred_body() -> None:
 def test_noise_is_a_pure_function_of_the_seed() -> None:
     scene = make_scene(Body("test", Circle(0.3), (0.8, 2.5)), Body("a", Circle(0.3), (2.0, 1.0)))
     clean = RasterRenderer().render(scene, still(scene), focus="a")
-    model = ObservationModel(noise=0.1, seed=3)
+    model = SensorModel(noise=0.1, seed=3)
     a, b = model.apply(clean.copy()), model.apply(clean.copy())
-    c = ObservationModel(noise=0.1, seed=4).apply(clean.copy())
+    c = SensorModel(noise=0.1, seed=4).apply(clean.copy())
     np.testing.assert_array_equal(a, b)
     assert not np.array_equal(a, c)
     assert a.min() >= 0 and a.max() <= 1 and a.dtype == np.float32
     assert 0.002 < float(((a - clean) ** 2).mean()) < 0.01
-    assert ObservationModel().identity and ObservationModel().apply(clean) is clean
+    assert SensorModel().identity and SensorModel().apply(clean) is clean
 
 
 @pytest.mark.parametrize(
@@ -82,4 +82,4 @@ def test_noise_is_a_pure_function_of_the_seed() -> None:
 )
 def test_bad_observation_models_are_refused(kwargs: dict[str, object], match: str) -> None:
     with pytest.raises(RenderError, match=match):
-        ObservationModel(**kwargs)  # type: ignore[arg-type]
+        SensorModel(**kwargs)  # type: ignore[arg-type]

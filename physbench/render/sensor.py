@@ -1,4 +1,4 @@
-"""How a camera degrades what a renderer draws: the observation model (:class:`ObservationModel`)
+"""How a camera degrades what a renderer draws: the observation model (:class:`SensorModel`)
 and its image filters, Gaussian blur and pixel noise (both take and return ``(..., H, W)`` float32
 arrays). The framework applies it to observed frames only, whatever renderer made them."""
 
@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from physbench.limits import MAX_NOISE
 from physbench.render.base import RenderError
 
 
@@ -42,11 +43,6 @@ def add_noise(frames: np.ndarray, sigma: float, rng: np.random.Generator) -> np.
     return out
 
 
-#: The widest pixel noise (standard deviation): pixel values lie in [0, 1], so noise of 1 already
-#: drowns every frame; more is a typo.
-MAX_NOISE = 1.0
-
-
 def _nonneg(name: str, value: object) -> float:
     if (
         isinstance(value, bool)
@@ -59,7 +55,7 @@ def _nonneg(name: str, value: object) -> float:
 
 
 @dataclass(frozen=True)
-class ObservationModel:
+class SensorModel:
     """How a camera degrades what a renderer draws: Gaussian blur of ``blur`` pixels, then
     Gaussian pixel noise of standard deviation ``noise`` (drawn from ``seed`` afresh for every
     call, so an observation is a pure function of its inputs), clipped to [0, 1]. Applied to

@@ -26,15 +26,14 @@ def evaluate_weights(
     so small seeds are held out. ``scene_options`` override the training ones (e.g. ``n_balls``);
     ``bodies`` restricts the unknowns to those bodies (the others keep the scene's values).
     """
+    from physbench.components import create, make_renderer
     from physbench.estimators.resnet3d import weights
-    from physbench.estimators.resnet3d.data import DataSpec
     from physbench.estimators.resnet3d.estimator import ResNet3DEstimator
-    from physbench.experiment import make_renderer
+    from physbench.estimators.resnet3d.training_data import DataSpec
     from physbench.loop import draw_problem, refine
     from physbench.observation import simulate_observation
-    from physbench.params import ParamSpace
-    from physbench.plugins import create
-    from physbench.render.observe import ObservationModel
+    from physbench.render.sensor import SensorModel
+    from physbench.unknowns import ParamSpace
 
     _, meta = weights.load(path)
     spec = DataSpec.from_dict(meta["data"])
@@ -46,13 +45,13 @@ def evaluate_weights(
         )
 
     model, observer = renderer(), renderer()
-    camera = ObservationModel(blur=blur)
+    sensor = SensorModel(blur=blur)
     rows = []
     for seed in seeds:
         scene = spec.instance(seed, **(scene_options or {}))
         space = ParamSpace.from_scene(scene, spec.params, bodies)
         truth, initial = draw_problem(space, seed)
-        obs = simulate_observation(scene, truth, sim, observer, marked=space.bodies, camera=camera)
+        obs = simulate_observation(scene, truth, sim, observer, marked=space.bodies, sensor=sensor)
         hist = refine(
             obs,
             scene,

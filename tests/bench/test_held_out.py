@@ -6,8 +6,8 @@ import pytest
 
 pytest.importorskip("torch")
 
+from physbench.bench.held_out import evaluate_weights
 from physbench.estimators.resnet3d import weights
-from physbench.estimators.resnet3d.evaluate import evaluate_weights
 
 
 def test_evaluation_reports_the_best_so_far_error_per_iteration() -> None:

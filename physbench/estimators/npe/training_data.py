@@ -2,7 +2,7 @@
 per simulation, its unknowns drawn from the prior (uniform on their ranges), simulated and rendered
 once per unknown body with that body marked, noise-free (the Table 1 observation).
 
-Seeds as resnet3d's (:mod:`physbench.estimators.resnet3d.data`): training instances from
+Seeds as resnet3d's (:mod:`physbench.estimators.resnet3d.training_data`): training instances from
 ``TRAIN_SEED0``, validation from ``VAL_SEED0``, evaluation and the benchmark's rows from small
 seeds (0, 1, 2, ...), so none of them meet.
 """
@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from physbench.estimators.npe.summary import summarize
-from physbench.estimators.resnet3d.data import TRAIN_SEED0, VAL_SEED0
+from physbench.estimators.npe.features import summarize
+from physbench.estimators.resnet3d.training_data import TRAIN_SEED0, VAL_SEED0
 
 if TYPE_CHECKING:
-    from physbench.params import ParamSpace
     from physbench.scene import Scene
+    from physbench.unknowns import ParamSpace
 
 __all__ = ["TRAIN_SEED0", "VAL_SEED0", "NPEDataSpec", "simulate_pairs"]
 
@@ -58,10 +58,9 @@ def unit_vector(space: ParamSpace, keys: list[str], params: dict[str, float]) ->
 def simulate_pairs(spec: NPEDataSpec, seeds: range) -> tuple[np.ndarray, np.ndarray]:
     """Features ``(N, F)`` and unit targets ``(N, P)``, one row per unknown body of each seed's
     simulation (a simulation that fails is skipped). Called by training for its data sets."""
+    from physbench.components import create, make_renderer
     from physbench.errors import SimulationError
-    from physbench.experiment import make_renderer
-    from physbench.params import ParamSpace
-    from physbench.plugins import create
+    from physbench.unknowns import ParamSpace
 
     sim = create("simulator", spec.engine)
     renderer = make_renderer(

@@ -21,16 +21,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from physbench.video.segment import SegmentError
+from physbench.video.writer import write_clip
 
 if TYPE_CHECKING:
+    from physbench.calibration import Calibration
     from physbench.observation import Observation
     from physbench.recording import Recording
-    from physbench.render.base import Renderer
-    from physbench.render.camera import CameraRenderer
+    from physbench.render.base import Camera, Renderer
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
     from physbench.trajectory import Trajectory
-    from physbench.video.calibration import Calibration
     from physbench.video.reader import Frame
 
 
@@ -93,12 +93,12 @@ def video_observation(
     marked: Iterable[str] = (),
 ) -> Observation:
     """The observation of a video file in ``renderer``'s frames (see the module docstring).
-    ``calibration``: a :class:`~physbench.video.calibration.Calibration` or a TOML file (default:
+    ``calibration``: a :class:`~physbench.calibration.Calibration` or a TOML file (default:
     ``scene.bounds`` fill the frame); ``background``: an image of the empty scene (array or file;
     default: the video's median)."""
+    from physbench.calibration import load_calibration
     from physbench.observation import Observation
     from physbench.video.background import load_plate, median_background
-    from physbench.video.calibration import load_calibration
     from physbench.video.reader import VideoReader
     from physbench.video.segment import (
         Segmenter,
@@ -167,7 +167,7 @@ def filmed_observation(
     scene: Scene,
     truth: Mapping[str, float],
     simulator: Simulator,
-    camera: CameraRenderer,
+    camera: Camera,
     renderer: Renderer,
     *,
     marked: Iterable[str] = (),
@@ -175,7 +175,7 @@ def filmed_observation(
     """Simulate ``scene`` with the true parameters, film it with ``camera`` into an encoded video
     file, and read that back with :func:`video_observation`: calibrated from the four corners of
     ``scene.bounds`` as a user would click them, with the camera's plate as the background."""
-    from physbench.video.calibration import Calibration
+    from physbench.calibration import Calibration
 
     traj = simulator.simulate(scene, dict(truth))
     xmin, ymin, xmax, ymax = scene.bounds
@@ -184,7 +184,7 @@ def filmed_observation(
     cal = Calibration.from_points(camera.image_points(scene, corners), corners, lens=true.lens)
     with tempfile.TemporaryDirectory(prefix="physbench-film-") as tmp:
         clip = Path(tmp) / "observation.mp4"
-        camera.write(clip, scene, traj)
+        write_clip(camera, clip, scene, traj)
         obs = video_observation(
             clip, scene, renderer, calibration=cal, background=camera.plate(scene), marked=marked
         )
@@ -222,7 +222,7 @@ def frame_trajectory(traj: Trajectory, times: np.ndarray) -> Trajectory:
 def filmed_recording(
     scene: Scene,
     traj: Trajectory,
-    camera: CameraRenderer,
+    camera: Camera,
     *,
     fields: tuple[str, ...] | None = None,
     run: str = "",
@@ -233,7 +233,7 @@ def filmed_recording(
     the tracks in the scene's metres; ``fields`` and ``run`` label the recording."""
     from dataclasses import replace
 
-    from physbench.video.calibration import Calibration
+    from physbench.calibration import Calibration
     from physbench.video.track import track_video
 
     xmin, ymin, xmax, ymax = camera.view if camera.view is not None else scene.bounds
@@ -243,7 +243,7 @@ def filmed_recording(
     )
     with tempfile.TemporaryDirectory(prefix="physbench-film-") as tmp:
         clip = Path(tmp) / "run.mp4"
-        camera.write(clip, scene, traj)
+        write_clip(camera, clip, scene, traj)
         rec = track_video(clip, scene, cal, background=camera.plate(scene)).recording
     return replace(
         rec,

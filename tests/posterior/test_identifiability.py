@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
+from physbench.components import create
 from physbench.experiment import RunConfig, config_space, run_config
-from physbench.identifiability import describe, probe, unseen
 from physbench.loop import History, draw_problem
-from physbench.plugins import create
+from physbench.posterior.identifiability import describe, probe, unseen
 from physbench.render.raster import RasterRenderer
 from physbench.scenes.generator import resolve_scene
 

@@ -7,12 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physbench.plugins import create
+from physbench.components import create
 from physbench.recording import Recording, Track
 from physbench.render.camera import CameraRenderer
 from physbench.render.raster import RasterRenderer
 from physbench.scenes import resolve_scene
-from physbench.video.observe import (
+from physbench.video.footage import (
     filmed_observation,
     filmed_recording,
     frame_trajectory,
@@ -23,6 +23,7 @@ from physbench.video.observe import (
 )
 from physbench.video.reader import Frame
 from physbench.video.segment import SegmentError
+from physbench.video.writer import write_clip
 
 
 def frames_at(times: list[float]) -> list[Frame]:
@@ -78,7 +79,7 @@ def test_a_filmed_encoded_clip_segments_into_the_sharp_masks(circles, tmp_path) 
     scene, traj = circles
     cam = CameraRenderer(640, tilt=15.0, seed=1)
     clip = tmp_path / "clip.mp4"
-    cam.write(clip, scene, traj)
+    write_clip(cam, clip, scene, traj)
     before = clip.read_bytes()
     sharp = RasterRenderer(64, "mark")
     marked = [b.name for b in scene.bodies]

@@ -83,8 +83,7 @@ class PairMaker:
     """Builds sample groups for one :class:`DataSpec` (one per worker process)."""
 
     def __init__(self, spec: DataSpec) -> None:
-        from physbench.experiment import make_renderer
-        from physbench.plugins import create
+        from physbench.components import create, make_renderer
 
         self.spec = spec
         spec.instance(0)  # an unknown name or a bad file fails here, not in a worker
@@ -96,7 +95,7 @@ class PairMaker:
     def group(self, seed: int) -> tuple[np.ndarray, np.ndarray]:
         """Samples ``x (S, 2, 2F, R, R)`` and targets ``y (S, P)`` from the instance ``seed``."""
         from physbench.errors import SimulationError
-        from physbench.params import ParamSpace
+        from physbench.unknowns import ParamSpace
 
         spec = self.spec
         scene = spec.instance(seed)
@@ -145,7 +144,7 @@ class PairMaker:
         self, frames: dict[str, np.ndarray], rng: np.random.Generator
     ) -> dict[str, np.ndarray]:
         """One simulation's marked views as a blurry camera might see them (one sigma for all)."""
-        from physbench.render.observe import gaussian_blur
+        from physbench.render.sensor import gaussian_blur
 
         if rng.random() >= self.spec.blur_prob:
             return frames

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from physbench.errors import PhysbenchError
-from physbench.posterior import Posterior
+from physbench.posterior.samples import Posterior
 
 
 def _post(samples: np.ndarray, **kw: object) -> Posterior:

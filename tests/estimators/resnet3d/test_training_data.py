@@ -7,8 +7,8 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from physbench.estimators.resnet3d.data import DataSpec, PairMaker  # noqa: E402
-from physbench.estimators.resnet3d.model import NetConfig  # noqa: E402
+from physbench.estimators.resnet3d.network import NetConfig  # noqa: E402
+from physbench.estimators.resnet3d.training_data import DataSpec, PairMaker  # noqa: E402
 
 TINY = NetConfig(n_outputs=1, widths=(4, 8, 8, 8), resolution=16, frames=6)
 TINY_DATA = DataSpec(

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from physbench.datasets.run import DatasetRun
+from physbench.datasets.recorded_run import DatasetRun
 from physbench.recording import Recording, Track
 from physbench.scene import Body, Circle, Scene
 

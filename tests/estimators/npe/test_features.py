@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from physbench.estimators.npe.summary import PER_FRAME, summarize
+from physbench.estimators.npe.features import PER_FRAME, summarize
 
 
 def test_summaries_of_known_blobs() -> None:

@@ -1,5 +1,5 @@
 """The image likelihood of an observation model with Gaussian pixel noise clipped to [0, 1]
-(:class:`~physbench.render.observe.ObservationModel`): how probable the observed frames are if
+(:class:`~physbench.render.sensor.SensorModel`): how probable the observed frames are if
 the simulated frames were the truth.
 
 A pixel observed strictly inside (0, 1) contributes the Gaussian density of its residual; one

@@ -6,7 +6,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from physbench.estimators.resnet3d.model import FULL_WIDTHS, NetConfig, build_net  # noqa: E402
+from physbench.estimators.resnet3d.network import FULL_WIDTHS, NetConfig, build_net  # noqa: E402
 
 
 @pytest.mark.parametrize(("n_out", "batch", "frames", "res"), [(1, 2, 6, 16), (2, 3, 15, 32)])

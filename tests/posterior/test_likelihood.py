@@ -7,8 +7,8 @@ import pytest
 from scipy.stats import norm
 
 from physbench.errors import PhysbenchError
-from physbench.likelihood import NOISE_FLOOR, PixelLikelihood, estimate_noise
-from physbench.render.observe import add_noise
+from physbench.posterior.likelihood import NOISE_FLOOR, PixelLikelihood, estimate_noise
+from physbench.render.sensor import add_noise
 
 
 def test_matches_a_direct_censored_gaussian_sum() -> None:

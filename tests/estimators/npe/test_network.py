@@ -10,7 +10,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from physbench.estimators.npe.model import (  # noqa: E402
+from physbench.estimators.npe.network import (  # noqa: E402
     SPREAD,
     MDNConfig,
     build_mdn,

@@ -62,7 +62,7 @@ class Posterior:
 
     @classmethod
     def from_unit(cls, space: Any, unit: np.ndarray, method: str, **kwargs: Any) -> Posterior:
-        """From ``(n, d)`` unit-cube samples of a :class:`~physbench.params.ParamSpace`."""
+        """From ``(n, d)`` unit-cube samples of a :class:`~physbench.unknowns.ParamSpace`."""
         unit = np.asarray(unit, dtype=float)
         lo, hi = space.low, space.high
         return cls(

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from physbench.errors import PhysbenchError, UnknownNameError
-from physbench.params import ParamSpace
 from physbench.scene import Body, Circle, Scene, body_unknown
 from physbench.testing import toy_task
+from physbench.unknowns import ParamSpace
 
 
 def test_normalized_mse_divides_by_the_range_maximum() -> None:

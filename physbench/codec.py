@@ -1,0 +1,76 @@
+"""Video codecs through PyAV (FFmpeg inside its wheel, ``pip install physbench[video]``): the one
+place that imports ``av``. The video package reads and writes files with it; a camera renderer
+passes its frames through an in-memory H.264 encode and decode (:func:`h264_round_trip`) so that
+they are what a video file would hold."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from physbench.errors import PhysbenchError
+
+
+class CodecError(PhysbenchError, ValueError):
+    """PyAV is missing, or a codec failed: names what to install or what went wrong."""
+
+
+def load_av() -> Any:
+    """The ``av`` module; :class:`CodecError` naming the extra to install when it is missing."""
+    try:
+        import av
+    except ImportError:
+        raise CodecError(
+            "reading or writing video needs PyAV: pip install 'physbench[video]' (or pip install "
+            "av)"
+        ) from None
+    return av
+
+
+def even(frames: np.ndarray) -> np.ndarray:
+    """Frames ``(T, H, W, 3)`` padded (edge pixels repeated) to an even height and width, as H.264
+    needs."""
+    _, h, w, _ = frames.shape
+    if h % 2 == 0 and w % 2 == 0:
+        return frames
+    return np.pad(frames, ((0, 0), (0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+
+
+def h264_round_trip(frames: np.ndarray, fps: float, bitrate: float, crf: int | None) -> np.ndarray:
+    """``frames`` (T, H, W, 3) uint8 encoded with H.264 (yuv420p) at ``bitrate`` (bit/s, > 0) or
+    ``crf``, and decoded again in memory; same shape."""
+    av = load_av()
+    t, h, w, _ = frames.shape
+    padded = even(frames)
+    enc = av.CodecContext.create("libx264", "w")
+    enc.width, enc.height = padded.shape[2], padded.shape[1]
+    enc.pix_fmt = "yuv420p"
+    rate = Fraction(fps).limit_denominator(1001)
+    enc.framerate = rate
+    enc.time_base = 1 / rate
+    if bitrate > 0:
+        enc.bit_rate = int(bitrate)
+    opts = {"preset": "veryfast", "tune": "zerolatency"}
+    if crf is not None:
+        opts["crf"] = str(crf)
+    enc.options = opts
+    dec = av.CodecContext.create("h264", "r")
+    got: list[np.ndarray] = []
+
+    def decode(packets: Any) -> None:
+        for packet in packets:
+            for frame in dec.decode(packet):
+                got.append(frame.to_ndarray(format="rgb24"))
+
+    for i in range(t):
+        frame = av.VideoFrame.from_ndarray(np.ascontiguousarray(padded[i]), format="rgb24")
+        frame.pts = i
+        decode(enc.encode(frame))
+    decode(enc.encode(None))
+    for frame in dec.decode(None):
+        got.append(frame.to_ndarray(format="rgb24"))
+    if len(got) != t:
+        raise CodecError(f"H.264 round trip returned {len(got)} frames for {t}")
+    return np.stack(got)[:, :h, :w]
