@@ -240,7 +240,7 @@ def _init_eval_worker() -> None:
 
 def _eval_cell(cell: tuple[str, str, str, float, int]) -> tuple[Any, ...]:
     """(cell, normalized min MSE after 2 iterations or None, error or None, seconds)."""
-    from physbench.estimators.resnet3d.evaluate import evaluate_weights
+    from physbench.bench.held_out import evaluate_weights
 
     _, _, path, blur, seed = cell
     t = time.perf_counter()

@@ -59,7 +59,7 @@ def test_the_summary_compares_on_the_seeds_every_model_finished() -> None:
 def test_a_killed_run_keeps_its_best_weights_with_its_own_input_size(tmp_path: Path) -> None:
     torch = pytest.importorskip("torch")
     from physbench.estimators.resnet3d import weights
-    from physbench.estimators.resnet3d.model import NetConfig, build_net
+    from physbench.estimators.resnet3d.network import NetConfig, build_net
 
     torch.manual_seed(0)
     run = tmp_path / "in64"

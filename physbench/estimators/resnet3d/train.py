@@ -112,6 +112,34 @@ def init_groups(meta: dict[str, Any]) -> int:
     return n
 
 
+def _init(path: str, net: Any, net_cfg: NetConfig, load: bool) -> int:
+    """``--init``: check that the weights at ``path`` fit ``net_cfg`` (only the input's resolution
+    and frames may differ), load them into ``net`` where ``load`` (not when a checkpoint will
+    replace them), and return the first training group (:func:`init_groups`)."""
+    state, meta = weights.load(path)
+    same_input = {"resolution": net_cfg.resolution, "frames": net_cfg.frames}
+    if replace(NetConfig.from_dict(meta["net"]), **same_input) != net_cfg:
+        raise PhysbenchError(
+            f"--init {path!r} has architecture {meta['net']}, expected {net_cfg.to_dict()} "
+            "(only resolution and frames may differ)"
+        )
+    if load:
+        net.load_state_dict({k: v.float() for k, v in state.items()})
+    return init_groups(meta)
+
+
+def _starting_point(
+    net: Any, vx: np.ndarray, vy: np.ndarray, out: Path, history: list[dict[str, Any]]
+) -> float:
+    """A fine-tune's starting point on this run's validation set: its curve's origin, and the best
+    so far (saved as such), so that a fine-tune that only gets worse keeps the weights it started
+    from. Returns that validation error."""
+    val = evaluate_net(net, vx, vy)
+    history.append({"samples": 0, "train_loss": None, "val_mse": val, "wall_s": 0.0})
+    weights.save(out / "best.safetensors", dict(net.state_dict()), {"samples": 0, "val_mse": val})
+    return val
+
+
 def _optimizer_tensors(opt: Any) -> tuple[dict[str, Any], dict[str, Any]]:
     sd = opt.state_dict()
     tensors = {f"opt.{i}.{k}": v for i, st in sd["state"].items() for k, v in st.items()}
@@ -182,18 +210,8 @@ def train(
     opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     ckpt = out / "checkpoint.safetensors"
     seen, best, history, wall0 = 0, float("inf"), [], 0.0
-    first_group = 0  # training groups start here (after the groups the --init weights saw)
-    if cfg.init:
-        state, meta = weights.load(cfg.init)
-        same_input = {"resolution": net_cfg.resolution, "frames": net_cfg.frames}
-        if replace(NetConfig.from_dict(meta["net"]), **same_input) != net_cfg:
-            raise PhysbenchError(
-                f"--init {cfg.init!r} has architecture {meta['net']}, expected {net_cfg.to_dict()} "
-                "(only resolution and frames may differ)"
-            )
-        first_group = init_groups(meta)
-        if not (resume and ckpt.is_file()):
-            net.load_state_dict({k: v.float() for k, v in state.items()})
+    # Training groups start here: after the groups the --init weights saw.
+    first_group = _init(cfg.init, net, net_cfg, not (resume and ckpt.is_file())) if cfg.init else 0
     if resume and ckpt.is_file():
         tensors, meta = weights.read(ckpt)
         net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
@@ -213,13 +231,7 @@ def train(
         cfg = replace(cfg, minutes=cfg.minutes + wall0 / 60.0)
     vx, vy = validation_set(spec, cfg.val_groups)
     if cfg.init and seen == 0:
-        # A fine-tune's starting point on this run's validation set: its curve's origin, and the
-        # best so far, so that a fine-tune that only gets worse keeps the weights it started from.
-        best = evaluate_net(net, vx, vy)
-        history.append({"samples": 0, "train_loss": None, "val_mse": best, "wall_s": 0.0})
-        weights.save(
-            out / "best.safetensors", dict(net.state_dict()), {"samples": 0, "val_mse": best}
-        )
+        best = _starting_point(net, vx, vy, out, history)
     loader = torch.utils.data.DataLoader(
         _pairs_dataset(spec, first_group + seen),
         batch_size=cfg.batch,
