@@ -217,14 +217,19 @@ def final_weights(run: Path, scene: str, params: str) -> tuple[Path | None, str]
     log_cmd = (run / "log.txt").read_text().splitlines()[0].split()
     res, frames = (int(log_cmd[log_cmd.index(k) + 1]) for k in ("--resolution", "--frames"))
     ck = run / "checkpoint.json"
-    history = json.loads(ck.read_text()).get("history", []) if ck.is_file() else []
+    saved = json.loads(ck.read_text()) if ck.is_file() else {}
+    history = saved.get("history", [])
     meta = {
         **{k: v for k, v in meta.items() if k != "sha256"},
         "data": {**meta["data"], "resolution": res, "frames": frames},
         "net": {**meta["net"], "resolution": res, "frames": frames},
         "history": history,
         "val_mse": min((h["val_mse"] for h in history), default=math.nan),
-        "training": {"unfinished": True},
+        "training": {
+            "unfinished": True,
+            "samples_seen": saved.get("samples"),
+            "wall_s": saved.get("wall_s"),
+        },
         "storage": weights.INT8,
     }
     out = run / "partial" / f"{name}.safetensors"

@@ -68,12 +68,15 @@ def test_a_killed_run_keeps_its_best_weights_with_its_own_input_size(tmp_path: P
     weights.save(run / "best.safetensors", dict(net.state_dict()), {"samples": 64})
     (run / "log.txt").write_text("-m physbench train --resolution 64 --frames 30 --lr 1e-3\n")
     history = [{"samples": 0, "val_mse": 0.2}, {"samples": 64, "val_mse": 0.1}]
-    (run / "checkpoint.json").write_text(json.dumps({"history": history}))
+    (run / "checkpoint.json").write_text(
+        json.dumps({"history": history, "samples": 64, "wall_s": 3.0})
+    )
     path, how = oneshot.final_weights(run, "three_circles", "elasticity")
     assert how == "best so far" and path is not None
     _, meta = weights.load(path)
     assert meta["net"]["resolution"] == 64 and meta["data"]["frames"] == 30
-    assert meta["val_mse"] == 0.1 and meta["training"] == {"unfinished": True}
+    assert meta["val_mse"] == 0.1
+    assert meta["training"] == {"unfinished": True, "samples_seen": 64, "wall_s": 3.0}
     assert oneshot.final_weights(tmp_path / "nothing", "three_circles", "elasticity") == (
         None,
         "no weights",
