@@ -21,5 +21,5 @@ cd "$(dirname "$0")/.." || exit 1
   export PYTHONPATH="$PWD:$SITE${PYTHONPATH:+:$PYTHONPATH}" PYTHONUNBUFFERED=1 OMP_NUM_THREADS=1
   nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>&1 | head -2
   echo "cores $(getconf _NPROCESSORS_ONLN); /dev/shm $(df -h /dev/shm | awk 'NR == 2 {print $2}'); $(python3 -V)"
-  python3 benchmarks/oneshot_gpu.py --out "$OUT" --site "$SITE" "$@"
+  python3 benchmarks/oneshot_gpu.py --out "$OUT" --runs /tmp/oneshot_runs --site "$SITE" "$@"
 } 2>&1 | tee "$OUT/log.txt"
