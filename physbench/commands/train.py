@@ -99,7 +99,9 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--init",
         default="",
-        help="fine-tune: start from these weights (.safetensors) instead of a fresh network",
+        help="fine-tune: start from these weights (.safetensors) instead of a fresh network; "
+        "their --widths must match, --resolution and --frames may differ (a bigger input from "
+        "the same tensors); training draws scene instances after the ones they were trained on",
     )
 
 

@@ -42,7 +42,11 @@ class TrainConfig:
     device: str = "cpu"  # "cuda" trains on a GPU; the weights are the same either way
     # Wall-clock budget of this session (0 = none); training stops at whichever budget ends first.
     minutes: float = 0.0
-    init: str = ""  # start from these weights (fine-tuning) instead of a fresh network
+    # Start from these weights (fine-tuning) instead of a fresh network. Their widths, blocks,
+    # dropout and outputs must be this network's; resolution and frames may differ (convolutions
+    # and a global average pool: the same tensors take any input size). Training then draws its
+    # scene instances after the ones those weights were trained on.
+    init: str = ""
 
     def __post_init__(self) -> None:
         for name, low, high in (
@@ -90,6 +94,50 @@ def _ranges(spec: DataSpec) -> dict[str, list[float]]:
 
     space = ParamSpace.from_scene(spec.instance(0), spec.params)
     return {u.name: [u.low, u.high] for u in space.unknowns}
+
+
+def init_groups(meta: dict[str, Any]) -> int:
+    """Training groups to skip when fine-tuning from weights whose sidecar is ``meta``: those
+    weights' own training drew groups from the start, one group per sample seen at most (a group
+    holds many samples), plus the groups their own ``--init`` skipped; 0 where the sidecar does
+    not say."""
+    t = meta.get("training")
+    if not isinstance(t, dict):
+        return 0
+    n = 0
+    for key in ("first_group", "samples_seen"):
+        v = t.get(key, 0)
+        if isinstance(v, int) and not isinstance(v, bool) and v > 0:
+            n += v
+    return n
+
+
+def _init(path: str, net: Any, net_cfg: NetConfig, load: bool) -> int:
+    """``--init``: check that the weights at ``path`` fit ``net_cfg`` (only the input's resolution
+    and frames may differ), load them into ``net`` where ``load`` (not when a checkpoint will
+    replace them), and return the first training group (:func:`init_groups`)."""
+    state, meta = weights.load(path)
+    same_input = {"resolution": net_cfg.resolution, "frames": net_cfg.frames}
+    if replace(NetConfig.from_dict(meta["net"]), **same_input) != net_cfg:
+        raise PhysbenchError(
+            f"--init {path!r} has architecture {meta['net']}, expected {net_cfg.to_dict()} "
+            "(only resolution and frames may differ)"
+        )
+    if load:
+        net.load_state_dict({k: v.float() for k, v in state.items()})
+    return init_groups(meta)
+
+
+def _starting_point(
+    net: Any, vx: np.ndarray, vy: np.ndarray, out: Path, history: list[dict[str, Any]]
+) -> float:
+    """A fine-tune's starting point on this run's validation set: its curve's origin, and the best
+    so far (saved as such), so that a fine-tune that only gets worse keeps the weights it started
+    from. Returns that validation error."""
+    val = evaluate_net(net, vx, vy)
+    history.append({"samples": 0, "train_loss": None, "val_mse": val, "wall_s": 0.0})
+    weights.save(out / "best.safetensors", dict(net.state_dict()), {"samples": 0, "val_mse": val})
+    return val
 
 
 def _optimizer_tensors(opt: Any) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -162,13 +210,8 @@ def train(
     opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     ckpt = out / "checkpoint.safetensors"
     seen, best, history, wall0 = 0, float("inf"), [], 0.0
-    if cfg.init and not (resume and ckpt.is_file()):
-        state, meta = weights.load(cfg.init)
-        if NetConfig.from_dict(meta["net"]) != net_cfg:
-            raise PhysbenchError(
-                f"--init {cfg.init!r} has architecture {meta['net']}, expected {net_cfg.to_dict()}"
-            )
-        net.load_state_dict({k: v.float() for k, v in state.items()})
+    # Training groups start here: after the groups the --init weights saw.
+    first_group = _init(cfg.init, net, net_cfg, not (resume and ckpt.is_file())) if cfg.init else 0
     if resume and ckpt.is_file():
         tensors, meta = weights.read(ckpt)
         net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
@@ -187,8 +230,10 @@ def train(
         # --minutes 10 after 10 minutes stopped at once).
         cfg = replace(cfg, minutes=cfg.minutes + wall0 / 60.0)
     vx, vy = validation_set(spec, cfg.val_groups)
+    if cfg.init and seen == 0:
+        best = _starting_point(net, vx, vy, out, history)
     loader = torch.utils.data.DataLoader(
-        _pairs_dataset(spec, seen),
+        _pairs_dataset(spec, first_group + seen),
         batch_size=cfg.batch,
         num_workers=cfg.workers,
         persistent_workers=cfg.workers > 0,
@@ -259,6 +304,7 @@ def train(
         "the marked body",
         "training": {
             **asdict(cfg),
+            "first_group": first_group,
             "samples_seen": seen,
             "wall_s": round(history[-1]["wall_s"], 1) if history else 0.0,
         },

@@ -117,18 +117,28 @@ class PairMaker:
             if spec.blur_max > 0
             else [f for _, f in sims]
         )
-        xs, ys = [], []
-        for body in space.bodies:
-            sub = space.subset(body)
-            scale = sub.high - sub.low
-            for i, (pi, _) in enumerate(sims):
-                for j, (pj, fj) in enumerate(sims):
-                    if i != j:
-                        xs.append(
-                            make_input(observed[i][body], fj[body], spec.frames, spec.resolution)
-                        )
-                        ys.append((sub.to_vector(pi) - sub.to_vector(pj)) / scale)
-        return np.stack(xs), np.asarray(ys, dtype=np.float32)
+        pairs = [
+            (b, i, j) for b in space.bodies for i in range(len(sims)) for j in range(len(sims))
+        ]
+        pairs = [(b, i, j) for b, i, j in pairs if i != j]
+        subs = {b: space.subset(b) for b in space.bodies}
+        xs: np.ndarray | None = None  # allocated once the first sample gives its shape
+        ys = []
+        for k, (body, i, j) in enumerate(pairs):
+            sub = subs[body]
+            obs, sim = observed[i][body], sims[j][1][body]
+            if xs is None:
+                first = make_input(obs, sim, spec.frames, spec.resolution)
+                xs = np.empty((len(pairs), *first.shape), np.float32)
+                xs[0] = first
+            else:
+                make_input(obs, sim, spec.frames, spec.resolution, out=xs[k])
+            ys.append(
+                (sub.to_vector(sims[i][0]) - sub.to_vector(sims[j][0])) / (sub.high - sub.low)
+            )
+        if xs is None:
+            raise ValueError(f"scene instance {seed}: no pair of simulations to train on")
+        return xs, np.asarray(ys, dtype=np.float32)
 
     def _blurred(
         self, frames: dict[str, np.ndarray], rng: np.random.Generator
