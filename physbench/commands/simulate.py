@@ -62,7 +62,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
+    """``--set BODY.PARAM=VALUE`` items as ``{"a.mass": 3.5}``; a value must be a finite number."""
     from physbench.errors import PhysbenchError
+    from physbench.numeric import ANY
 
     out: dict[str, float] = {}
     for item in items:
@@ -70,10 +72,10 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
         try:
             if not sep or "." not in key:
                 raise ValueError
-            out[key.strip()] = float(value)
+            out[key.strip()] = float(ANY.parse(value))
         except ValueError:
             raise PhysbenchError(
-                f"--set {item!r}: expected BODY.PARAM=NUMBER, e.g. a.mass=3.5"
+                f"--set {item!r}: expected BODY.PARAM=NUMBER (a finite number), e.g. a.mass=3.5"
             ) from None
     return out
 
@@ -82,6 +84,7 @@ def make_effects(items: list[str]) -> list:
     """Effect instances from ``--effect NAME[:KEY=VALUE,...]`` items."""
     from physbench.components import create
     from physbench.errors import PhysbenchError
+    from physbench.numeric import ANY
 
     out = []
     for item in items:
@@ -92,10 +95,11 @@ def make_effects(items: list[str]) -> list:
             try:
                 if not sep or not key.strip():
                     raise ValueError
-                values[key.strip()] = float(value)
+                values[key.strip()] = float(ANY.parse(value))
             except ValueError:
                 raise PhysbenchError(
-                    f"--effect {item!r}: expected NAME[:KEY=NUMBER,...], e.g. linear_drag:c=0.3"
+                    f"--effect {item!r}: expected NAME[:KEY=NUMBER,...] with finite numbers, e.g. "
+                    "linear_drag:c=0.3"
                 ) from None
         out.append(create("effect", name.strip(), values))
     return out
