@@ -83,9 +83,10 @@ def make_scene(name_or_path: str | Path, seed: int = 0) -> Scene:
         scene = physbench.make_scene("three_circles", seed=3)
         scene.body_names  # ('test', 'a', 'b')
     """
+    from physbench import numeric
     from physbench.scenes import resolve_scene
 
-    return resolve_scene(str(name_or_path), seed)
+    return resolve_scene(str(name_or_path), int(numeric.SEED.check(seed, "seed")))
 
 
 def _scene(scene: Scene | str | Path) -> Scene:
@@ -123,8 +124,11 @@ def simulate(
     from physbench.effects import apply_measurements
 
     sc = _scene(scene)
+    overrides = dict(params or {})
+    if overrides:  # refused by name (NaN, out of range, unknown key), before an engine sees them
+        sc.with_params(overrides).validate()
     made = _effects(effects)
-    traj = create("simulator", engine).simulate(sc, dict(params or {}), effects=made)
+    traj = create("simulator", engine).simulate(sc, overrides, effects=made)
     return apply_measurements(traj, made) if made else traj
 
 

@@ -326,3 +326,10 @@ def test_non_finite_numbers_are_refused_by_every_api_entry(tmp_path: Path, slide
         physbench.discover_effects(tmp_path / "rec.csv", slide, min_delta_bic=nan)
     with pytest.raises(PhysbenchError, match=r"noise = nan"):
         physbench.sweep({**TINY_SPEC, "noise": nan}, tmp_path / "out", executor="serial")
+    with pytest.raises(PhysbenchError, match=r"seed = nan: expected a whole number in \[0, "):
+        physbench.make_scene("three_circles", seed=nan)  # type: ignore[arg-type]
+    with pytest.raises(PhysbenchError, match=r"seed = 1180591620717411303424: expected a whole"):
+        physbench.make_scene("three_circles", seed=2**70)
+    # an engine would abort the process on a NaN mass (Chipmunk's assertion)
+    with pytest.raises(PhysbenchError, match=r"mass = nan: must be a finite number"):
+        physbench.simulate("three_circles", params={"a.mass": nan})
