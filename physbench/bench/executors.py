@@ -92,11 +92,16 @@ def start_worker(parent: int) -> None:
     (:func:`die_with_parent`) and, once its pool shuts it down, without the interpreter's
     teardown (:mod:`physbench.teardown`), which would otherwise keep a core busy after the cells
     are done. Its exit status is then always 0, which nothing reads: a worker that dies while it
-    works is told apart by its pool before it reaches that exit."""
+    works is told apart by its pool before it reaches that exit. A plugin that a built-in
+    shadows was named by the main process already; workers do not repeat it."""
+    import warnings
+
+    from physbench.plugins import PluginWarning
     from physbench.teardown import skip_at_exit
 
     die_with_parent(parent)
     skip_at_exit(lambda: 0)
+    warnings.simplefilter("ignore", PluginWarning)
 
 
 def how_it_died(exitcode: int | None) -> str:

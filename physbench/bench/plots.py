@@ -100,12 +100,13 @@ def _title(cfg: dict[str, Any], varying: Sequence[str]) -> str:
 
 def _save(fig: Figure, path: Path) -> Path:
     """PNG with a 128-colour palette: line plots lose nothing visible and shrink 2-4x (committed
-    files); every text fitted inside the figure first (:func:`~physbench.plotting.fit.fit_text`)."""
+    files); every text fitted inside the figure first
+    (:func:`~physbench.plotting.layout.fit_text`)."""
     import io
 
     from PIL import Image
 
-    from physbench.plotting.fit import fit_text
+    from physbench.plotting.layout import fit_text
 
     fit_text(fig)
     buf = io.BytesIO()
@@ -178,7 +179,7 @@ def _legend_below(fig: Figure, axes: Sequence[Any]) -> None:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             entries.setdefault(label, handle)
     if entries:
-        from physbench.plotting.fit import legend_below
+        from physbench.plotting.layout import legend_below
 
         legend_below(fig, list(entries.values()), list(entries), ncols=5, fontsize="x-small")
 

@@ -82,7 +82,7 @@ class _Report:
     def save(self, fig: Any, name: str, caption: str) -> tuple[str, str]:
         """Lay out (every text inside the figure), write and close ``fig``; returns its file name
         and caption."""
-        from physbench.plotting.fit import fit_text
+        from physbench.plotting.layout import fit_text
 
         fig.set_layout_engine("tight")
         fit_text(fig)

@@ -130,7 +130,7 @@ def convergence_figure(
     axes[-1, 0].xaxis.get_major_locator().set_params(integer=True)
     if title:
         fig.suptitle(title, fontsize="medium")
-    from physbench.plotting.fit import fit_text, legend_below
+    from physbench.plotting.layout import fit_text, legend_below
 
     handles, labels = axes[0, 0].get_legend_handles_labels()
     legend_below(fig, handles, labels, ncols=4, fontsize="small")

@@ -54,7 +54,7 @@ def posterior_figure(
         title or f"posterior ({posterior.method}{state}, {len(posterior)} samples)",
         fontsize="medium",
     )
-    from physbench.plotting.fit import fit_text, legend_below
+    from physbench.plotting.layout import fit_text, legend_below
 
     handles, labels = axes[0, 0].get_legend_handles_labels()
     legend_below(fig, handles, labels, ncols=4, fontsize="small")

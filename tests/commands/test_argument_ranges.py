@@ -74,6 +74,10 @@ LONG_SCENE = "x" * 100_000
         ),
         (["discover", "r.csv", "--min-delta-bic", "nan"], "argument --min-delta-bic: nan is not"),
         (["discover", "r.csv", "--min-gain", "1"], "argument --min-gain: 1 is not a finite number"),
+        (
+            ["discover", "r.csv", "--holdout", "0.95"],
+            "--holdout: 0.95 is not a finite number in [0.05, 0.8]",
+        ),
         (["compare", "a", "b", "--min-ratio", "inf"], "argument --min-ratio: inf is not a finite"),
         (["compare", "a", "b", "--alpha", "nan"], "argument --alpha: nan is not a finite number"),
         (["plot", "d", "--threshold", "inf"], "argument --threshold: inf is not a finite number"),

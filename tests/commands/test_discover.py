@@ -106,12 +106,6 @@ CASES = [
         r"none of the requested effects applies.*joint_viscous_damping.*needs a scene with joints",
     ),
     (
-        "holdout out of range",
-        {"r.csv": recording()},
-        ["r.csv", "--holdout", "0.95"],
-        r"holdout = 0\.95: expected a fraction in \[0\.05, 0\.8\]",
-    ),
-    (
         "recording too short",
         {"r.csv": recording(n=6)},
         ["r.csv"],

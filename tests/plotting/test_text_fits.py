@@ -1,7 +1,7 @@
 """No text of a figure physbench draws lies outside the figure (issue 28: titles and legends were
-cut at the image's edge): :func:`physbench.plotting.fit.fit_text` on a figure built to overflow,
-and every figure of ``physbench run --plot`` and of the discovery report (the sweep figures:
-tests/bench/test_plots.py)."""
+cut at the image's edge): :func:`physbench.plotting.layout.fit_text` on a figure built to
+overflow, and every figure of ``physbench run --plot`` and of the discovery report (the sweep
+figures: tests/bench/test_plots.py)."""
 
 from __future__ import annotations
 
@@ -19,13 +19,13 @@ LONG = "a title far wider than its figure, " * 3
 
 def _overflowing(legend: str) -> Any:
     """A small figure with titles wider than it and a legend of 7 long entries, made in one row
-    (``legend="raw"``) or by :func:`~physbench.plotting.fit.legend_below`."""
+    (``legend="raw"``) or by :func:`~physbench.plotting.layout.legend_below`."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from physbench.plotting.fit import legend_below
+    from physbench.plotting.layout import legend_below
 
     fig, ax = plt.subplots(figsize=(4, 3), layout="constrained")
     for i in range(7):
@@ -41,7 +41,7 @@ def _overflowing(legend: str) -> Any:
 
 @pytest.mark.parametrize("legend", ["raw", "below"])
 def test_an_overflowing_figure_is_fitted(texts_outside: Any, legend: str) -> None:
-    from physbench.plotting.fit import fit_text
+    from physbench.plotting.layout import fit_text
 
     fig = _overflowing(legend)
     with warnings.catch_warnings():  # the overflow may squeeze the axes to nothing
