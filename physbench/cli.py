@@ -4,11 +4,13 @@ imported only when chosen, so ``physbench --help`` stays fast."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import os
 import sys
 import traceback
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from typing import Any
 
 #: subcommand -> (module in physbench.commands, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -34,6 +36,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "find the missing physical effect behind a recording's disagreement with the model",
     ),
     "track": ("track", "follow a scene's bodies through a video into a recording CSV (metres)"),
+    "datasets": (
+        "datasets",
+        "the measured data sets that ship with physbench: list them, their runs, write them out",
+    ),
 }
 
 
@@ -100,7 +106,8 @@ def _run(argv: list[str], debug: bool) -> int:
     module = importlib.import_module(f"physbench.commands.{COMMANDS[args.command][0]}")
     try:
         try:
-            return int(module.main(args) or 0)
+            with _physbench_warnings(args.command):
+                return int(module.main(args) or 0)
         except (Exception, SystemExit) as exc:
             _blame_plugin(exc)
             raise
@@ -131,6 +138,31 @@ def _run(argv: list[str], debug: bool) -> int:
         # report the failed flush of stdout again at exit.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141  # 128 + SIGPIPE, what a shell reports for a tool killed by the signal
+
+
+@contextlib.contextmanager
+def _physbench_warnings(command: str) -> Iterator[None]:
+    """While a command runs, show physbench's own warnings
+    (:class:`~physbench.errors.PhysbenchWarning`) as one ``physbench COMMAND: warning: ...``
+    line on stderr, without Python's source path and line; other warnings as Python shows
+    them."""
+    import warnings
+
+    from physbench.errors import PhysbenchWarning
+
+    with warnings.catch_warnings():
+        show = warnings.showwarning
+
+        def one_line(
+            message: Warning | str, category: type[Warning], *rest: Any, **kw: Any
+        ) -> None:
+            if issubclass(category, PhysbenchWarning):
+                print(f"physbench {command}: warning: {message}", file=sys.stderr)
+            else:
+                show(message, category, *rest, **kw)
+
+        warnings.showwarning = one_line
+        yield
 
 
 def _blame_plugin(exc: BaseException) -> None:

@@ -193,6 +193,8 @@ def make_effect(text: str, *, where: str = "--effect") -> Effect:
     """The registered effect of ``text``, ``NAME[:KEY=NUMBER,...]`` (``linear_drag:c=0.3``: its
     parameters' values when not unknown), as ``physbench simulate --effect`` and ``physbench run
     --effect`` take it; ``where`` names the setting in the error."""
+    from physbench.numeric import ANY
+
     name, _, rest = text.partition(":")
     values: dict[str, float] = {}
     for pair in filter(None, (p.strip() for p in rest.split(","))):
@@ -200,9 +202,10 @@ def make_effect(text: str, *, where: str = "--effect") -> Effect:
         try:
             if not sep or not key.strip():
                 raise ValueError
-            values[key.strip()] = float(value)
+            values[key.strip()] = float(ANY.parse(value))
         except ValueError:
             raise PhysbenchError(
-                f"{where} {text!r}: expected NAME[:KEY=NUMBER,...], e.g. linear_drag:c=0.3"
+                f"{where} {text!r}: expected NAME[:KEY=NUMBER,...] with finite numbers, e.g. "
+                "linear_drag:c=0.3"
             ) from None
     return create("effect", name.strip(), values)  # type: ignore[no-any-return]

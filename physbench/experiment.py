@@ -84,6 +84,24 @@ class RunConfig:
     video_end: float | None = None
     effects: tuple[str, ...] = ()
 
+    def __post_init__(self) -> None:
+        """Refuse a numeric setting outside its range (:mod:`physbench.numeric`), NaN and the
+        infinities included, naming it."""
+        from physbench import numeric
+
+        checks = {
+            "seed": numeric.SEED,
+            "iterations": numeric.COUNT,
+            "blur": numeric.BLUR,
+            "noise": numeric.NOISE,
+            "resolution": numeric.RESOLUTION,
+        }
+        for name, number in checks.items():
+            number.check(getattr(self, name), f"run setting {name}")
+        for name in ("video_start", "video_end"):
+            if getattr(self, name) is not None:
+                numeric.SECONDS.check(getattr(self, name), f"run setting {name}")
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings (tuples as lists); :meth:`from_dict` inverts it. Settings added
         after a sweep format existed are left out while at their defaults, so the cell keys of

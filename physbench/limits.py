@@ -12,3 +12,9 @@ MAX_SEED = 2**32 - 1
 MAX_NOISE = 1.0
 #: The longest ``--scene``: Linux's PATH_MAX (a longer path cannot name a file).
 MAX_SCENE_ARGUMENT = 4096
+#: The most local worker processes of a sweep (each a Python interpreter of ~100 MB with its
+#: libraries loaded): well above the cores of one machine.
+MAX_WORKERS = 512
+#: The most scene instances the image-MSE landscape averages (each simulates the scene ~40 times
+#: per parameter): a figure's mean is steady long before.
+MAX_LANDSCAPE_SEEDS = 100

@@ -53,16 +53,16 @@ import functools
 import hashlib
 import itertools
 import json
-import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from physbench import numeric
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
-from physbench.limits import MAX_NOISE, MAX_RESOLUTION, MAX_SEED
+from physbench.limits import MAX_SEED
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 from physbench.unknowns import split_params
@@ -257,6 +257,15 @@ def _seeds(value: Any, where: str) -> tuple[int, ...]:
     return tuple(seeds)
 
 
+#: The ranges of the numeric axes (:mod:`physbench.numeric`).
+NUMBERS = {
+    "blur": numeric.BLUR,
+    "noise": numeric.NOISE,
+    "resolution": numeric.RESOLUTION,
+    "iterations": numeric.COUNT,
+}
+
+
 def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
     def bad(v: Any, expected: str) -> SpecError:
         return SpecError(f"{where} = {v!r}: expected {expected}")
@@ -266,22 +275,10 @@ def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
         if name in ("engine", "render_mode") or (name == "observe_engine" and v is not None):
             if not isinstance(v, str) or not v:
                 raise bad(v, "a name (string)")
-        elif name in ("blur", "noise"):
-            most = MAX_RESOLUTION if name == "blur" else MAX_NOISE
-            if (
-                isinstance(v, bool)
-                or not isinstance(v, int | float)
-                or not math.isfinite(v)
-                or not 0 <= v <= most
-            ):
-                raise bad(v, f"a finite number in [0, {most:g}]")
-            v = float(v)
-        elif name in ("resolution", "iterations") and (
-            isinstance(v, bool) or not isinstance(v, int) or v < 1
-        ):
-            raise bad(v, "a whole number >= 1")
-        elif name == "resolution" and v > MAX_RESOLUTION:
-            raise bad(v, f"a whole number in [1, {MAX_RESOLUTION}]")
+        elif name in NUMBERS:
+            if not NUMBERS[name].accepts(v):
+                raise bad(v, NUMBERS[name].describe())
+            v = float(v) if name in ("blur", "noise") else v
         out.append(v)
     if len(set(out)) != len(out):
         raise SpecError(f"{where} = {values!r}: values repeat")

@@ -25,10 +25,11 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from collections.abc import Callable
 from typing import Any
 
-from physbench.limits import MAX_RESOLUTION, MAX_SCENE_ARGUMENT, MAX_SEED
+from physbench import numeric
+from physbench.limits import MAX_SCENE_ARGUMENT
+from physbench.numeric import Number, finite, whole
 
 #: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
 RENDER_MODES = ("mark", "instance", "mask", "rgb")
@@ -44,50 +45,26 @@ SIZE_CHECK_HELP = (
 )
 
 
-def bounded_int(low: int, high: int | None = None) -> Callable[[str], int]:
+def bounded_int(low: int, high: int | None = None) -> Number:
     """An argparse ``type=`` that accepts whole numbers in ``[low, high]`` (no upper bound when
-    ``high`` is ``None``); the error names the value and the range."""
-    accepted = f"a whole number >= {low}" if high is None else f"a whole number in [{low}, {high}]"
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not {accepted}") from None
-        if value < low or (high is not None and value > high):
-            raise argparse.ArgumentTypeError(f"{value} is not {accepted}")
-        return value
-
-    parse.__name__ = "whole number"  # argparse names the type in its own messages
-    return parse
+    ``high`` is ``None``); the error names the value and the range (:mod:`physbench.numeric`)."""
+    return whole(low, high)
 
 
-def bounded_float(low: float, high: float) -> Callable[[str], float]:
+def bounded_float(low: float, high: float) -> Number:
     """An argparse ``type=`` that accepts finite numbers in ``[low, high]``; the error names the
-    value and the range."""
-    accepted = f"a finite number in [{low:g}, {high:g}]"
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not {accepted}") from None
-        if not (math.isfinite(value) and low <= value <= high):
-            raise argparse.ArgumentTypeError(f"{text} is not {accepted}")
-        return value
-
-    parse.__name__ = "number"
-    return parse
+    value and the range (:mod:`physbench.numeric`)."""
+    return finite(low, high)
 
 
 #: ``type=`` for counts that must be at least 1 (iterations, validation groups, intervals).
-positive_int = bounded_int(1)
+positive_int = numeric.COUNT
 #: ``type=`` for counts where 0 means "none" (threads, evaluation seeds).
-nonnegative_int = bounded_int(0)
+nonnegative_int = numeric.COUNT_OR_NONE
 #: ``type=`` for ``--seed``.
-seed_int = bounded_int(0, MAX_SEED)
+seed_int = numeric.SEED
 #: ``type=`` for ``--resolution``.
-resolution_int = bounded_int(1, MAX_RESOLUTION)
+resolution_int = numeric.RESOLUTION
 
 
 def scene_argument(text: str) -> str:
@@ -144,9 +121,30 @@ def add_json_argument(p: argparse.ArgumentParser, what: str) -> None:
     )
 
 
+def _finite(value: Any) -> bool:
+    """Whether every number in the JSON value ``value`` is finite."""
+    if isinstance(value, float):
+        return math.isfinite(value)
+    if isinstance(value, list):
+        return all(_finite(v) for v in value)
+    if isinstance(value, dict):
+        return all(_finite(v) for v in value.values())
+    return True
+
+
+class _NonFinite(Exception):
+    """JSON's NaN, Infinity or -Infinity in a ``KEY=VALUE`` value."""
+
+
+def _refuse_constant(name: str) -> float:
+    raise _NonFinite(name)
+
+
 def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
     """``["startup=5", "sampler=cmaes"]`` -> ``{"startup": 5, "sampler": "cmaes"}``: values parse
-    as JSON, else stay text. ``flag`` names the option in errors."""
+    as JSON, else stay text; a number that is not finite (``NaN``, ``Infinity``, ``1e999``) is
+    refused, as every numeric setting is (:mod:`physbench.numeric`). ``flag`` names the option in
+    errors."""
     from physbench.errors import PhysbenchError
 
     out: dict[str, Any] = {}
@@ -155,9 +153,16 @@ def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
         if not sep or not key.strip():
             raise PhysbenchError(f"{flag} {item!r}: expected KEY=VALUE, e.g. {flag} startup=5")
         try:
-            value = json.loads(raw)
-        except ValueError:
+            value = json.loads(raw, parse_constant=_refuse_constant)
+        except _NonFinite:
+            value = math.nan
+        except (ValueError, RecursionError):
             value = raw
+        if not _finite(value):
+            raise PhysbenchError(
+                f"{flag} {item!r}: {raw.strip()} is not a finite number; a value is a finite "
+                "number, text or JSON"
+            )
         out[key.strip()] = value
     return out
 
@@ -248,8 +253,16 @@ def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
         help="a picture of the empty scene (default: the video's median)",
     )
     group.add_argument(
-        "--start", type=float, default=None, metavar="S", help="skip the video's first S seconds"
+        "--start",
+        type=numeric.SECONDS,
+        default=None,
+        metavar="S",
+        help="skip the video's first S seconds",
     )
     group.add_argument(
-        "--end", type=float, default=None, metavar="S", help="stop at S seconds into the video"
+        "--end",
+        type=numeric.SECONDS,
+        default=None,
+        metavar="S",
+        help="stop at S seconds into the video",
     )

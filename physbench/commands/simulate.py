@@ -62,7 +62,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
+    """``--set BODY.PARAM=VALUE`` items as ``{"a.mass": 3.5}``; a value must be a finite number."""
     from physbench.errors import PhysbenchError
+    from physbench.numeric import ANY
 
     out: dict[str, float] = {}
     for item in items:
@@ -70,10 +72,10 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
         try:
             if not sep or "." not in key:
                 raise ValueError
-            out[key.strip()] = float(value)
+            out[key.strip()] = float(ANY.parse(value))
         except ValueError:
             raise PhysbenchError(
-                f"--set {item!r}: expected BODY.PARAM=NUMBER, e.g. a.mass=3.5"
+                f"--set {item!r}: expected BODY.PARAM=NUMBER (a finite number), e.g. a.mass=3.5"
             ) from None
     return out
 

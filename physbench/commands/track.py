@@ -8,6 +8,7 @@ from physbench.commands.arguments import (
     add_quiet_argument,
     add_scene_argument,
     add_video_input_arguments,
+    seed_int,
 )
 
 
@@ -22,7 +23,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         required=True,
         help="the filmed scene (its initial positions say where the bodies start)",
     )
-    p.add_argument("--seed", type=int, default=0, help="scene instance seed (default 0)")
+    p.add_argument("--seed", type=seed_int, default=0, help="scene instance seed (default 0)")
     p.add_argument("--out", required=True, metavar="REC.csv", help="write the recording here")
     p.add_argument(
         "--preview", metavar="FILE.mp4|.gif", help="write the video with the tracks drawn on"

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from physbench import numeric
 from physbench.commands.arguments import (
     SIZE_CHECK_HELP,
     add_params_argument,
@@ -61,7 +62,9 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
         default=None,
         help="sequences per training step (default 16; --posterior: 256)",
     )
-    p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument(
+        "--lr", type=numeric.LEARNING_RATE, default=1e-3, help="learning rate (default 1e-3)"
+    )
     p.add_argument(
         "--widths",
         default="16,32,64,128",
@@ -81,7 +84,7 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--minutes",
-        type=float,
+        type=numeric.NON_NEGATIVE,
         default=0.0,
         help="wall-clock budget of this session (a resumed run gets it afresh); training ends at "
         "this or --samples, whichever comes first (default: none)",
@@ -91,7 +94,7 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--blur-max",
-        type=float,
+        type=numeric.BLUR,
         default=0.0,
         help="augment: blur half the observed sequences by sigma ~ U(0, this) pixels (default 0: "
         "off)",

@@ -20,15 +20,16 @@ from physbench.cli import COMMANDS, build_parser, main
 from physbench.unknowns import split_params
 
 #: commands that write files: all take --out for their result
-WRITERS = {"run", "simulate", "track", "train", "bench", "plot", "discover"}
+WRITERS = {"run", "simulate", "track", "train", "bench", "plot", "discover", "datasets"}
 #: the only other flags that name a file or folder to write
 NAMED_OUTPUTS = {"--preview", "--plot", "--report", "--plate", "--track-out", "--save-observation"}
 #: listings, instant, that print only their result
-LISTINGS = {"scenes", "plugins"}
+LISTINGS = {"scenes", "plugins", "datasets"}
 #: commands with --json, and what it prints
 JSON = {"run", "discover", "plugins"}
-#: --scene is required where it must describe given data, else defaults to three_circles
-SCENE_REQUIRED = {"track": True, "discover": True, "run": False, "simulate": False, "train": False}
+#: --scene is required where it must describe given data, else defaults to three_circles;
+#: discover needs it with a RECORDING, not with a shipped --dataset (which brings its scenes)
+SCENE_REQUIRED = {"track": True, "discover": None, "run": False, "simulate": False, "train": False}
 
 
 def subparser(name: str) -> argparse.ArgumentParser:
@@ -76,6 +77,7 @@ REQUIRED: dict[str, list[str]] = {
     "bench": ["spec.toml", "--out", "o"],
     "plot": ["o"],
     "compare": ["a", "b"],
+    "datasets": [],
     "discover": ["r.csv", "--scene", "s.toml"],
     "track": ["v.mp4", "--scene", "s.toml", "--out", "r.csv"],
 }
@@ -96,8 +98,10 @@ def test_json_is_a_switch_for_stdout(name: str) -> None:
 def test_scene_takes_a_name_or_a_toml_file(name: str) -> None:
     action = options(name)["--scene"]
     assert action.metavar == "NAME|FILE" and ".toml file" in action.help
-    assert action.required is SCENE_REQUIRED[name]
-    if not action.required:
+    assert action.required is bool(SCENE_REQUIRED[name])
+    if SCENE_REQUIRED[name] is None:
+        assert action.default is None and "required with RECORDING" in action.help
+    elif not action.required:
         assert action.default is None and "(default: three_circles)" in action.help
     rest = [a for a in REQUIRED[name] if a not in ("--scene", "s.toml")]
     for value in ("ball_drop", "drop.toml"):
