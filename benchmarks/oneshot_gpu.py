@@ -56,6 +56,9 @@ ROWS: list[tuple[str, str]] = [("three_circles", "elasticity"), ("bouncing_balls
 ARMS: dict[str, list[str]] = {
     "ft32": ["--resolution", "32", "--frames", "15", "--lr", "3e-4"],
     "in64": ["--resolution", "64", "--frames", "30", "--lr", "1e-3"],
+    # ft32 with half the simulations drawn near another's parameters: pairs aimed at the second
+    # correction, which the first run's arms never trained on.
+    "near32": ["--resolution", "32", "--frames", "15", "--lr", "3e-4", "--near", "0.5"],
 }
 BLURS = (0.0, 3.0)
 #: An arm still running this long after its training budget began is killed (start-up included).

@@ -100,6 +100,20 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
         "off)",
     )
     p.add_argument(
+        "--near",
+        type=numeric.SHARE,
+        default=0.0,
+        help="share of a sample group's simulations drawn near another one's parameters (each "
+        "unknown moved by N(0, --near-scale) of its range), for pairs as close as the loop's "
+        "second correction sees (default 0: every simulation from the prior, as the first)",
+    )
+    p.add_argument(
+        "--near-scale",
+        type=numeric.LEVEL,
+        default=0.05,
+        help="spread of --near simulations, as a share of each unknown's range (default 0.05)",
+    )
+    p.add_argument(
         "--init",
         default="",
         help="fine-tune: start from these weights (.safetensors) instead of a fresh network; "
@@ -196,6 +210,8 @@ def main(args: argparse.Namespace) -> int:
         resolution=args.resolution,
         frames=args.frames,
         blur_max=args.blur_max,
+        near=args.near,
+        near_scale=args.near_scale,
     )
     check_size(spec, args.samples, scene, args.minutes)
     path, meta = _train(args, spec, widths)

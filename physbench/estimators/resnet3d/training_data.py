@@ -47,6 +47,12 @@ class DataSpec:
     # the render resolution, the blur of the loop's observation model.
     blur_max: float = 0.0
     blur_prob: float = 0.5
+    # Pairs aimed at a later correction: with probability ``near`` a simulation of a group is drawn
+    # near another one's parameters (each unknown moved by N(0, ``near_scale``) of its range,
+    # clipped), so the group holds pairs as close as the loop's second step sees; 0: every
+    # simulation from the prior, as the loop's first step sees them.
+    near: float = 0.0
+    near_scale: float = 0.05
 
     def instance(self, seed: int, **options: Any) -> Scene:
         """Called for each sample group, validation group and evaluation run: the scene instance
@@ -106,7 +112,12 @@ class PairMaker:
         for _ in range(spec.group * 2):
             if len(sims) == spec.group:
                 break
-            p = space.sample(rng)
+            if sims and self.spec.near > 0 and rng.random() < self.spec.near:
+                base = space.to_unit(sims[int(rng.integers(len(sims)))][0])
+                moved = base + rng.normal(0.0, self.spec.near_scale, base.shape)
+                p = space.from_unit(np.clip(moved, 0.0, 1.0))
+            else:
+                p = space.sample(rng)
             try:
                 traj = self.sim.simulate(scene, p)
             except SimulationError:
