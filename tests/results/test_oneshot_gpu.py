@@ -119,3 +119,17 @@ def test_the_committed_gpu_run_measured_the_distance() -> None:
             assert rows[(row, blur, "ft32")]["over_paper"] > 1.3
             assert rows[(row, blur, "in64")]["mean"] > rows[(row, blur, "shipped")]["mean"]
     assert (ROOT / "results/resnet3d/oneshot_gpu/summary.md").read_text().startswith("# One shot")
+
+
+def test_the_committed_near_pair_run_kept_the_shipped_weights() -> None:
+    """results/resnet3d/oneshot_gpu_near: the second H100 call, fine-tuning on pairs half of which
+    are drawn near each other (``train --near 0.5``) for 220 s. Validation MSE only rose from the
+    shipped weights' (so the best, kept, weights are the shipped ones: ratios of exactly 1)."""
+    run = json.loads((ROOT / "results/resnet3d/oneshot_gpu_near/results.json").read_text())
+    assert run["info"]["arms"]["near32"][-2:] == ["--near", "0.5"]
+    for arm, train in run["training"].items():
+        curve = [h["val_mse"] for h in train["history"]]
+        assert len(curve) > 5 and min(curve[1:]) > curve[0], arm
+    rows = [r for r in run["summary"] if r["weights"] == "near32"]
+    assert len(rows) == 4 and all(r["seeds"] == 200 and not r["met"] for r in rows)
+    assert all(r["over_shipped"][0] == pytest.approx(1.0) for r in rows)
