@@ -40,6 +40,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    from physbench.commands.arguments import refuse_empty_values
+
     parser = argparse.ArgumentParser(
         prog="physbench",
         description="Identify physical object properties from video or trajectories, and benchmark "
@@ -55,6 +57,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         if only is None or only == name:
             # Argument definitions are cheap; the heavy work sits in each module's main().
             importlib.import_module(f"physbench.commands.{module}").add_arguments(p)
+            refuse_empty_values(p)
     return parser
 
 

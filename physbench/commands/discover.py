@@ -177,7 +177,7 @@ def main(args: argparse.Namespace) -> int:
         progress=show_progress(args),
     )
     if args.track_out:
-        wrote(args.track_out)
+        wrote(args.track_out, args)
     nuisance = args.nuisance[0] if args.nuisance in (["auto"], ["none"]) else list(args.nuisance)
     kw = {
         k: v
@@ -227,9 +227,9 @@ def main(args: argparse.Namespace) -> int:
     if out:
         Path(out).parent.mkdir(parents=True, exist_ok=True)
         Path(out).write_text(json.dumps(to_dict(disc), indent=2) + "\n", encoding="utf-8")
-        wrote(out)
+        wrote(out, args)
     if args.report:
         from physbench.discover.report import write_report
 
-        wrote(write_report(disc, args.report))
+        wrote(write_report(disc, args.report), args)
     return 0

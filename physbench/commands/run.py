@@ -83,7 +83,7 @@ def _add_problem_arguments(p: argparse.ArgumentParser) -> None:
         nargs="+",
         default=None,
         metavar="BODY",
-        help="only these bodies' unknowns (default: all)",
+        help="only these bodies' unknowns: a, or a b, a+b, a,b (default: all)",
     )
     p.add_argument(
         "--iterations",
@@ -281,17 +281,13 @@ def _check_arguments(args: argparse.Namespace) -> None:
 
 def _build_config(args: argparse.Namespace) -> Any:
     """The checked :class:`~physbench.experiment.RunConfig` the flags describe."""
-    from physbench.commands.arguments import parse_key_values, renderer_choice
+    from physbench.commands.arguments import parse_key_values, renderer_choice, split_bodies
     from physbench.components import default_render_mode
     from physbench.experiment import RunConfig, check_config
     from physbench.unknowns import split_params
 
     params = split_params(args.params)
-    bodies = (
-        None
-        if args.bodies is None
-        else tuple(b for item in args.bodies for b in item.split(",") if b)
-    )
+    bodies = None if args.bodies is None else split_bodies(args.bodies)
     renderer, renderer_options = renderer_choice(args)
     config = RunConfig(
         scene=args.scene,
@@ -363,21 +359,22 @@ def _save_outputs(args: argparse.Namespace, history: Any) -> None:
     if args.save_observation:
         # numpy adds .npz to a name without it
         saved = str(args.save_observation)
-        wrote(saved if saved.endswith(".npz") else saved + ".npz")
+        wrote(saved if saved.endswith(".npz") else saved + ".npz", args)
     if args.plot:
         from physbench.plotting.convergence import plot_convergence, run_title
 
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         plot_convergence({f"{history.estimator}": [history]}, args.plot, title=run_title(history))
-        wrote(args.plot)
+        wrote(args.plot, args)
         if history.posterior is not None:
             from physbench.plotting.posterior import plot_posterior, posterior_path
 
-            wrote(str(plot_posterior(history.posterior, posterior_path(args.plot), history.truth)))
+            drawn = plot_posterior(history.posterior, posterior_path(args.plot), history.truth)
+            wrote(str(drawn), args)
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(history.to_json(indent=1) + "\n", encoding="utf-8")
-        wrote(args.out)
+        wrote(args.out, args)
 
 
 def _warn_about_result(history: Any) -> None:

@@ -58,7 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "an image, the clean plate a tracker takes as background",
     )
     p.add_argument("--preview", metavar="FILE.gif|png", help="write a picture of the run")
-    add_quiet_argument(p, "print only the files written")
+    add_quiet_argument(p, "no output but errors and warnings")
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
@@ -225,7 +225,7 @@ def _write_out(
             effects=np.array([repr(e) for e in effects], dtype=str),
             **traj.to_npz_dict(),
         )
-    wrote(args.out)
+    wrote(args.out, args)
 
 
 def _write_pictures(args: argparse.Namespace, scene: Any, traj: Any, camera: Any) -> None:

@@ -194,7 +194,7 @@ def main(args: argparse.Namespace) -> int:
     )
     check_size(spec, args.samples, scene, args.minutes)
     path, meta = _train(args, spec, widths)
-    _print_trained(path, meta)
+    _print_trained(args, path, meta)
     if args.eval_seeds:
         _print_held_out(path, args.eval_seeds)
     return 0
@@ -316,12 +316,12 @@ def _say_resuming(checkpoint: Any, samples: int) -> None:
     )
 
 
-def _print_trained(path: Any, meta: dict[str, Any]) -> None:
+def _print_trained(args: argparse.Namespace, path: Any, meta: dict[str, Any]) -> None:
     """The files written and the training's result line."""
     from physbench.commands.console import wrote
 
-    wrote(path)
-    wrote(path.with_suffix(".json"))
+    wrote(path, args)
+    wrote(path.with_suffix(".json"), args)
     print(
         f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: "
         f"{meta['val_mse']:.3g}; "
@@ -387,8 +387,8 @@ def _posterior(args: argparse.Namespace) -> int:
     cfg = NPETrainConfig(samples=samples, batch=batch, lr=args.lr, threads=args.threads)
     out = Path(args.out or f"runs/train/npe/{weights_name(spec)}")
     path, meta = train(spec, None, cfg, out, progress=not args.quiet)
-    wrote(path)
-    wrote(path.with_suffix(".json"))
+    wrote(path, args)
+    wrote(path.with_suffix(".json"), args)
     t = meta["training"]
     print(
         f"npe weights: {path} (+ {path.with_suffix('.json').name}); validation NLL in logit-unit "
