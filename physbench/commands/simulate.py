@@ -240,9 +240,11 @@ def _write_pictures(args: argparse.Namespace, scene: Any, traj: Any, camera: Any
         assert camera is not None
         Path(args.plate).parent.mkdir(parents=True, exist_ok=True)
         Image.fromarray(camera.plate(scene)).save(args.plate)
-        wrote(args.plate)
+        wrote(args.plate, args)
     if args.preview:
+        from physbench.commands.arguments import renderer_choice
         from physbench.render.preview import save_preview
 
-        save_preview(scene, traj, args.preview)
-        wrote(args.preview)
+        name, options = renderer_choice(args)
+        save_preview(scene, traj, args.preview, renderer=name, options=options)
+        wrote(args.preview, args)
