@@ -424,6 +424,26 @@ def _print_details(args: argparse.Namespace, history: Any) -> None:
             for k, v in best.params.items()
         )
     )
+    _explain_worse_than_initial(history)
+
+
+def _explain_worse_than_initial(history: Any) -> None:
+    """Say why, when the result ends further from the truth than the initial guess: the result
+    is the iterate that matches the frames best, and the truth is not in the frames."""
+    best, start = history.best_nmse, history.initial_nmse
+    if best is None or start is None or best <= start:
+        return
+    nearest = min(
+        (r for r in history.iterations if r.nmse is not None and not r.failed),
+        key=lambda r: r.nmse,
+    )
+    print(
+        f"note: the result (normalized MSE {best:.3e}) is further from the truth than the initial "
+        f"guess ({start:.3e}): an estimator sees only the frames, and iteration "
+        f"{history.best.iteration} matches them best (image MSE {history.best.loss:.3e}); "
+        f"iteration {nearest.iteration} came nearer the truth (normalized MSE "
+        f"{nearest.nmse:.3e}) but matched the frames less well (image MSE {nearest.loss:.3e})"
+    )
 
 
 def _print_posterior(history: Any) -> None:
