@@ -348,7 +348,7 @@ def _posterior(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
-    from physbench.commands.console import wrote
+    from physbench.commands.console import show_progress, wrote
     from physbench.components import make_renderer
     from physbench.errors import PhysbenchError
     from physbench.estimators.npe.estimator import NPEEstimator
@@ -386,7 +386,7 @@ def _posterior(args: argparse.Namespace) -> int:
     check_size(spec, samples, resolve_scene(scene_name, 0))
     cfg = NPETrainConfig(samples=samples, batch=batch, lr=args.lr, threads=args.threads)
     out = Path(args.out or f"runs/train/npe/{weights_name(spec)}")
-    path, meta = train(spec, None, cfg, out, progress=not args.quiet)
+    path, meta = train(spec, None, cfg, out, progress=show_progress(args))
     wrote(path, args)
     wrote(path.with_suffix(".json"), args)
     t = meta["training"]
