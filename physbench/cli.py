@@ -4,13 +4,13 @@ imported only when chosen, so ``physbench --help`` stays fast."""
 from __future__ import annotations
 
 import argparse
-import contextlib
 import importlib
 import os
 import sys
 import traceback
 from collections.abc import Iterator, Sequence
-from typing import Any
+from contextlib import contextmanager
+from pathlib import Path
 
 #: subcommand -> (module in physbench.commands, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -44,6 +44,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    from physbench.commands.arguments import refuse_empty_values
+
     parser = argparse.ArgumentParser(
         prog="physbench",
         description="Identify physical object properties from video or trajectories, and benchmark "
@@ -59,6 +61,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         if only is None or only == name:
             # Argument definitions are cheap; the heavy work sits in each module's main().
             importlib.import_module(f"physbench.commands.{module}").add_arguments(p)
+            refuse_empty_values(p)
     return parser
 
 
@@ -106,7 +109,7 @@ def _run(argv: list[str], debug: bool) -> int:
     module = importlib.import_module(f"physbench.commands.{COMMANDS[args.command][0]}")
     try:
         try:
-            with _physbench_warnings(args.command):
+            with warnings_as_lines(args.command):
                 return int(module.main(args) or 0)
         except (Exception, SystemExit) as exc:
             _blame_plugin(exc)
@@ -140,29 +143,45 @@ def _run(argv: list[str], debug: bool) -> int:
         return 141  # 128 + SIGPIPE, what a shell reports for a tool killed by the signal
 
 
-@contextlib.contextmanager
-def _physbench_warnings(command: str) -> Iterator[None]:
-    """While a command runs, show physbench's own warnings
-    (:class:`~physbench.errors.PhysbenchWarning`) as one ``physbench COMMAND: warning: ...``
-    line on stderr, without Python's source path and line; other warnings as Python shows
-    them."""
+def warning_line(
+    command: str, message: Warning | str, category: type[Warning], filename: str
+) -> str:
+    """``physbench COMMAND: warning: MESSAGE`` on one line, as the commands word their own
+    warnings; a warning from outside physbench (numpy, a plugin) adds its category, e.g.
+    ``(RuntimeWarning)``."""
+    text = " ".join(str(message).split())
+    own = Path(__file__).parent in Path(filename).resolve().parents
+    return f"physbench {command}: warning: {text}" + ("" if own else f" ({category.__name__})")
+
+
+@contextmanager
+def warnings_as_lines(command: str) -> Iterator[None]:
+    """While ``command`` runs, Python's warnings (``warnings.warn``) reach stderr as one
+    :func:`warning_line` each, instead of Python's two lines with the source path and code.
+    Which warnings are shown, and how often, stays the warnings filters' business (``-W``)."""
     import warnings
 
-    from physbench.errors import PhysbenchWarning
+    shown = warnings.showwarning
 
-    with warnings.catch_warnings():
-        show = warnings.showwarning
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: object = None,
+        line: str | None = None,
+    ) -> None:
+        text = warning_line(command, message, category, filename)
+        if "tqdm" in sys.modules:  # above a progress bar, not through it
+            sys.modules["tqdm"].tqdm.write(text, file=sys.stderr)
+        else:
+            print(text, file=sys.stderr)
 
-        def one_line(
-            message: Warning | str, category: type[Warning], *rest: Any, **kw: Any
-        ) -> None:
-            if issubclass(category, PhysbenchWarning):
-                print(f"physbench {command}: warning: {message}", file=sys.stderr)
-            else:
-                show(message, category, *rest, **kw)
-
-        warnings.showwarning = one_line
+    warnings.showwarning = show
+    try:
         yield
+    finally:
+        warnings.showwarning = shown
 
 
 def _blame_plugin(exc: BaseException) -> None:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from physbench.errors import SceneError
+from physbench.limits import FPS, MAX_COORDINATE, MAX_FRAMES, MAX_SPIN
 from physbench.parameter import Parameter
 
 Vec = tuple[float, float]
@@ -28,25 +29,18 @@ BODY_PARAMS: dict[str, tuple[float, float]] = {
 
 # Limits a scene must keep, so that a typo fails when the scene is loaded rather than deep inside
 # an engine or the rasteriser (pixel coordinates that overflow, areas that underflow to 0, an
-# allocation per substep).
-#: m: the largest |coordinate| of a bound, position, anchor or vertex; far beyond any lab set-up.
-MAX_COORDINATE = 1e6
+# allocation per substep). Those that recordings share live in physbench.limits: MAX_COORDINATE,
+# FPS, MAX_SPIN, MAX_FRAMES.
 #: m: the smallest radius, width and height (and square root of a polygon's area); a smaller shape
 #: has an area and a moment that underflow.
 MIN_SIZE = 1e-6
-#: Hz: the frame rates accepted, from a frame every 10 s to a high-speed camera's 100,000 fps.
-FPS = (0.1, 100_000.0)
 #: m/s: the largest initial speed along an axis (ten times a rifle bullet's).
 MAX_SPEED = 1e4
-#: rad/s: the largest initial angular speed (about a million rpm).
-MAX_SPIN = 1e5
 #: m/s²: the largest gravity along an axis (a thousand g).
 MAX_GRAVITY = 1e4
 #: kg: the masses accepted, a milligram to a thousand tonnes: outside them the engines' contact
 #: solvers lose precision (pymunk turns a subnormal mass into NaN).
 MASS = (1e-6, 1e6)
-#: Recorded frames: about an hour of video at 30 fps.
-MAX_FRAMES = 100_000
 #: Physics steps per recorded frame; more only costs time (1e4 steps per frame at 30 fps is a
 #: 3 microsecond step).
 MAX_SUBSTEPS = 10_000

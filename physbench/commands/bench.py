@@ -128,13 +128,15 @@ def _spec_path(args: argparse.Namespace) -> str:
 def main(args: argparse.Namespace) -> int:
     from physbench.bench.runner import run_sweep
     from physbench.bench.spec import load_spec, with_renderer
-    from physbench.commands.arguments import parse_key_values
+    from physbench.commands.arguments import check_renderer_options, parse_key_values
     from physbench.commands.console import show_progress, wrote
     from physbench.errors import counted
 
     spec = load_spec(_spec_path(args))
     if args.renderer is not None or args.renderer_option:
         options = parse_key_values(args.renderer_option, "--renderer-option")
+        if args.renderer is not None or len(spec.renderers) == 1:
+            check_renderer_options(args.renderer or spec.renderers[0].name, options)
         spec = with_renderer(spec, args.renderer, options)
     command = ""
     if sys.argv[1:2] == ["bench"]:
@@ -164,7 +166,7 @@ def main(args: argparse.Namespace) -> int:
         from physbench.bench.tables import markdown, paper_layout
 
         print(markdown(paper_layout(res.stats)))
-    wrote(res.out)
+    wrote(res.out, args)
     print(
         f"{spec.name}: {counted(res.cells, 'cell')} ({res.ran} run, {res.skipped} already done, "
         f"{res.failed} failed) in {res.wall_s:.1f} s with {res.executor}; "

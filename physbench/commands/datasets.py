@@ -53,7 +53,7 @@ def main(args: argparse.Namespace) -> int:
         return 0
     runs = select(args.dataset)
     if args.out:
-        _write(runs, args.out)
+        _write(runs, args.out, args)
         return 0
     for run in runs:
         print(_run_line(run))
@@ -75,7 +75,7 @@ def _run_line(run: Any) -> str:
     )
 
 
-def _write(runs: list[Any], out: str) -> None:
+def _write(runs: list[Any], out: str, args: argparse.Namespace) -> None:
     """Each run as ``out/RUN.csv`` and ``out/RUN.toml`` (``/`` in a run's name becomes ``_``)."""
     from pathlib import Path
 
@@ -89,8 +89,8 @@ def _write(runs: list[Any], out: str) -> None:
         stem = run.name.replace("/", "_")
         write_recordings(folder / f"{stem}.csv", run.recording)
         (folder / f"{stem}.toml").write_text(dumps_scene(run.scene), encoding="utf-8")
-        wrote(folder / f"{stem}.csv")
-        wrote(folder / f"{stem}.toml")
+        wrote(folder / f"{stem}.csv", args)
+        wrote(folder / f"{stem}.toml", args)
     first = runs[0].name.replace("/", "_")
     print(
         f"{len(runs)} runs in {folder}; e.g. physbench discover {folder / first}.csv --scene "

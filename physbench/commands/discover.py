@@ -231,7 +231,7 @@ def _runs(args: argparse.Namespace) -> list[Any]:
         progress=show_progress(args),
     )
     if args.track_out:
-        wrote(args.track_out)
+        wrote(args.track_out, args)
     return runs
 
 
@@ -303,9 +303,9 @@ def main(args: argparse.Namespace) -> int:
     if out:
         Path(out).parent.mkdir(parents=True, exist_ok=True)
         Path(out).write_text(json.dumps(to_dict(disc), indent=2) + "\n", encoding="utf-8")
-        wrote(out)
+        wrote(out, args)
     if args.report:
         from physbench.discover.report import write_report
 
-        wrote(write_report(disc, args.report))
+        wrote(write_report(disc, args.report), args)
     return 0

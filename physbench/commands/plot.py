@@ -63,7 +63,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "(default: the paper's NN value after 11 iterations, per row; rows the paper lacks are "
         "left out)",
     )
-    add_quiet_argument(p, "the files written and the final line")
+    add_quiet_argument(p, "only the final line")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -106,10 +106,10 @@ def main(args: argparse.Namespace) -> int:
         page = report.build(df, out, figures, title=title, run_log=log, threshold=args.threshold)
     count = sum(len(v) for v in figures.values())
     for path in (p for group in figures.values() for p in group):
-        wrote(path)
-    wrote(out / "win_rate.csv")
+        wrote(path, args)
+    wrote(out / "win_rate.csv", args)
     for name in SUMMARIES:
-        wrote(out / name)
-    wrote(page)
+        wrote(out / name, args)
+    wrote(page, args)
     print(f"{counted(count, 'figure')} in {out / 'plots'}; report {page}")
     return 0

@@ -58,7 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "an image, the clean plate a tracker takes as background",
     )
     p.add_argument("--preview", metavar="FILE.gif|png", help="write a picture of the run")
-    add_quiet_argument(p, "print only the files written")
+    add_quiet_argument(p, "no output but errors and warnings")
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
@@ -227,7 +227,7 @@ def _write_out(
             effects=np.array([repr(e) for e in effects], dtype=str),
             **traj.to_npz_dict(),
         )
-    wrote(args.out)
+    wrote(args.out, args)
 
 
 def _write_pictures(args: argparse.Namespace, scene: Any, traj: Any, camera: Any) -> None:
@@ -242,9 +242,11 @@ def _write_pictures(args: argparse.Namespace, scene: Any, traj: Any, camera: Any
         assert camera is not None
         Path(args.plate).parent.mkdir(parents=True, exist_ok=True)
         Image.fromarray(camera.plate(scene)).save(args.plate)
-        wrote(args.plate)
+        wrote(args.plate, args)
     if args.preview:
+        from physbench.commands.arguments import renderer_choice
         from physbench.render.preview import save_preview
 
-        save_preview(scene, traj, args.preview)
-        wrote(args.preview)
+        name, options = renderer_choice(args)
+        save_preview(scene, traj, args.preview, renderer=name, options=options)
+        wrote(args.preview, args)

@@ -29,7 +29,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--preview", metavar="FILE.mp4|.gif", help="write the video with the tracks drawn on"
     )
     add_video_input_arguments(p)
-    add_quiet_argument(p, "print only the files written")
+    add_quiet_argument(p, "no output but errors and warnings")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -68,8 +68,8 @@ def main(args: argparse.Namespace) -> int:
     write_recordings(args.out, result.recording)
     if not args.quiet:
         print(result.summary.format())
-    wrote(args.out)
+    wrote(args.out, args)
     if args.preview:
         write_overlay(args.preview, video, result.pixels, start=args.start, end=args.end)
-        wrote(args.preview)
+        wrote(args.preview, args)
     return 0

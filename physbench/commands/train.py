@@ -215,7 +215,7 @@ def main(args: argparse.Namespace) -> int:
     )
     check_size(spec, args.samples, scene, args.minutes)
     path, meta = _train(args, spec, widths)
-    _print_trained(path, meta)
+    _print_trained(args, path, meta)
     if args.eval_seeds:
         _print_held_out(path, args.eval_seeds)
     return 0
@@ -337,12 +337,12 @@ def _say_resuming(checkpoint: Any, samples: int) -> None:
     )
 
 
-def _print_trained(path: Any, meta: dict[str, Any]) -> None:
+def _print_trained(args: argparse.Namespace, path: Any, meta: dict[str, Any]) -> None:
     """The files written and the training's result line."""
     from physbench.commands.console import wrote
 
-    wrote(path)
-    wrote(path.with_suffix(".json"))
+    wrote(path, args)
+    wrote(path.with_suffix(".json"), args)
     print(
         f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: "
         f"{meta['val_mse']:.3g}; "
@@ -369,7 +369,7 @@ def _posterior(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
-    from physbench.commands.console import wrote
+    from physbench.commands.console import show_progress, wrote
     from physbench.components import make_renderer
     from physbench.errors import PhysbenchError
     from physbench.estimators.npe.estimator import NPEEstimator
@@ -407,9 +407,9 @@ def _posterior(args: argparse.Namespace) -> int:
     check_size(spec, samples, resolve_scene(scene_name, 0))
     cfg = NPETrainConfig(samples=samples, batch=batch, lr=args.lr, threads=args.threads)
     out = Path(args.out or f"runs/train/npe/{weights_name(spec)}")
-    path, meta = train(spec, None, cfg, out, progress=not args.quiet)
-    wrote(path)
-    wrote(path.with_suffix(".json"))
+    path, meta = train(spec, None, cfg, out, progress=show_progress(args))
+    wrote(path, args)
+    wrote(path.with_suffix(".json"), args)
     t = meta["training"]
     print(
         f"npe weights: {path} (+ {path.with_suffix('.json').name}); validation NLL in logit-unit "

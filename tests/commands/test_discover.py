@@ -184,7 +184,8 @@ RENDERER_CASES = [
     (
         "option it does not take",
         ["-R", "nope=1"],
-        r"renderer 'raster' \(physbench's own\) does not take option 'nope'; its options: none",
+        r"-R nope=1: renderer 'raster' \(physbench's own\) has no option 'nope'; the options -R "
+        "can set: none",
     ),
     (
         "mode against the channels",

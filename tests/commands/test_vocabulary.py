@@ -253,6 +253,9 @@ def test_plot_reports_its_stages_and_echoes_its_files(
     assert written and all(Path(p).is_file() for p in written)
     assert {str(out / "report.html"), str(out / "win_rate.csv")} <= set(written)
     assert captured.out.count("\n") == 1  # the summary line only
+    assert main([*argv, "-q"]) == 0  # quiet: the summary line alone, no 'wrote' lines
+    captured = capsys.readouterr()
+    assert captured.err == "" and captured.out.count("\n") == 1, captured
 
 
 def test_train_is_quiet_in_a_pipe_and_says_where_it_resumes(
@@ -285,16 +288,25 @@ def test_run_echoes_every_file_it_writes(
     # the plot goes into a folder that does not exist yet: it is created
     plot, out, obs = tmp_path / "new" / "c.png", tmp_path / "h.json", tmp_path / "o.npz"
     argv = [*RUN, "--plot", str(plot), "--out", str(out), "--save-observation", str(obs)]
-    assert main([*argv, "-q"]) == 0
+    assert main(argv) == 0
     captured = capsys.readouterr()
     for path in (plot, out, obs):
         assert path.is_file() and f"wrote {path}\n" in captured.err
     assert "wrote" not in captured.out  # stdout holds only the result
     assert json.loads(out.read_text())["iterations"]
-
-
-def test_simulate_echoes_on_stderr(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    out = tmp_path / "s.npz"
-    assert main(["simulate", "--out", str(out), "--resolution", "16", "-q"]) == 0
+    assert main([*argv, "-q"]) == 0  # quiet: the final line alone
     captured = capsys.readouterr()
-    assert captured.out == "" and captured.err == f"wrote {out}\n"
+    assert captured.err == "" and captured.out.startswith("normalized min MSE after 3 iterations")
+    assert captured.out.count("\n") == 1
+
+
+def test_simulate_echoes_on_stderr_and_is_silent_with_q(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "s.npz"
+    assert main(["simulate", "--out", str(out), "--resolution", "16"]) == 0
+    captured = capsys.readouterr()
+    assert f"wrote {out}" not in captured.out and captured.err == f"wrote {out}\n"
+    out.unlink()
+    assert main(["simulate", "--out", str(out), "--resolution", "16", "-q"]) == 0
+    assert capsys.readouterr() == ("", "") and out.is_file()
