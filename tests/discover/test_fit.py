@@ -54,7 +54,11 @@ def test_budgets_and_horizons_follow_the_settings_and_the_scene(slide, noisy):
     assert is_rough([Run("r", scene, frames=np.zeros((41, 1, 8, 8), np.float32))])
     model = start_model(problem_for([smooth], "pymunk", s), s)
     assert fit_horizons(model, s) == (1.0,)
-    assert fit_horizons(model, Settings(horizons=(0.3, 2.0))) == (0.3, 1.0)
+    assert fit_horizons(model, Settings(horizons=(0.3, 1.0))) == (0.3, 1.0)
+    with pytest.raises(
+        PhysbenchError, match=r"horizons = 2.0: expected a finite number in \(0, 1\]"
+    ):
+        Settings(horizons=(0.3, 2.0))  # a horizon past the data is refused, not dropped
     walls = start_model(problem_for([Run("r", floor, recording=track)], "pymunk", s), s)
     assert fit_horizons(walls, s) == (0.5, 1.0)
 
