@@ -17,6 +17,21 @@ def _interrupted_while_starting(signum: int, frame: object) -> None:
 signal.signal(signal.SIGINT, _interrupted_while_starting)
 
 
+def _redeliver_swallowed_interrupt(unraisable: "sys.UnraisableHookArgs") -> None:
+    """Installed as :data:`sys.unraisablehook` while the command runs: Python calls it for an
+    exception it cannot raise, e.g. one inside a finalizer. A Ctrl-C that lands in pymunk's
+    space finalizer (an ``ffi.gc`` callback) would be dropped there and the command would run on,
+    so the signal is sent again a moment later, when the finalizer has returned."""
+    if unraisable.exc_type is not None and issubclass(unraisable.exc_type, KeyboardInterrupt):
+        import threading
+
+        timer = threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT))
+        timer.daemon = True
+        timer.start()
+        return
+    sys.__unraisablehook__(unraisable)
+
+
 #: The status the process ends with; 1 until :func:`main` returns (an exception escaped it).
 _status = 1
 
@@ -35,6 +50,7 @@ def main() -> int:
         # From here Ctrl-C raises KeyboardInterrupt, so the command cleans up (saves finished
         # cells, ...) and run_command turns it into the line and 130.
         signal.signal(signal.SIGINT, signal.default_int_handler)
+        sys.unraisablehook = _redeliver_swallowed_interrupt
         _status = run_command()
     except SystemExit as exc:  # argparse's usage errors and --help
         _status = exc.code if isinstance(exc.code, int) else int(exc.code is not None)

@@ -250,3 +250,29 @@ def test_python_warnings_reach_stderr_as_one_physbench_line(
         "physbench run: warning: overflow encountered in matmul (RuntimeWarning)",
     ]
     assert warnings.showwarning is before  # restored afterwards
+
+
+def test_a_ctrl_c_swallowed_by_a_finalizer_still_ends_the_command() -> None:
+    # CI once hung here: the Ctrl-C landed inside pymunk's space finalizer (an ffi.gc callback),
+    # Python printed "Exception ignored from callback for ffi.gc" and the run went on.
+    code = (
+        "import signal, sys, time\n"
+        "import cffi\n"
+        "import physbench.__main__ as entry\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "sys.unraisablehook = entry._redeliver_swallowed_interrupt\n"
+        "ffi = cffi.FFI()\n"
+        "def finalizer(_):\n"
+        "    raise KeyboardInterrupt\n"
+        "cell = ffi.gc(ffi.new('int *'), finalizer)\n"
+        "del cell\n"
+        "try:\n"
+        "    time.sleep(20)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=60, env=os.environ
+    )
+    assert done.stdout == "interrupted\n", (done.stdout, done.stderr)
+    assert "Exception ignored" not in done.stderr, done.stderr
