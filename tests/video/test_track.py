@@ -14,6 +14,7 @@ from physbench.scenes import bouncing_balls
 from physbench.video.reader import Frame, VideoReader
 from physbench.video.track import (
     TrackError,
+    TrackLostError,
     TrackSummary,
     bounds_calibration,
     track_frames,
@@ -33,13 +34,15 @@ def test_centres_are_sub_pixel_on_realistic_footage(film, engine: str) -> None:
     # The recording is in metres: the true positions, to the pixel's size.
     rec = result.recording
     assert rec.bodies == clip.scene.body_names and rec.track("test").angle is None
-    true = clip.traj.states[:, clip.scene.body_index("b0"), :2]
-    got = np.column_stack([rec.track("b0").x, rec.track("b0").y])
-    assert np.abs(got - true).max() < 0.02
-    assert result.summary.gaps == dict.fromkeys(clip.scene.body_names, 0)
-    # It states its accuracy (half a pixel) in metres, for discover's measurement floor.
+    b0 = rec.track("b0")  # without the frame of its collision
+    true = clip.traj.states[np.round(b0.t * clip.scene.fps).astype(int), 1, :2]
+    assert np.abs(np.column_stack([b0.x, b0.y]) - true).max() < 0.02
+    assert not result.summary.lost and not result.summary.failures()
+    # It states its accuracy in metres, for discover's measurement floor: the disc floor or
+    # twice the noise it measured on each track, whichever is larger.
     mpp = cal.metres_per_pixel((320.0, 240.0))
-    assert 0.4 * mpp < rec.accuracy < 0.7 * mpp
+    assert min(result.summary.accuracy_px.values()) >= 0.25
+    assert 0.2 * mpp < rec.accuracy < 0.7 * mpp
 
 
 @pytest.mark.parametrize("seed,n", [(0, 2), (1, 3), (2, 4), (3, 5), (4, 6)])
@@ -115,11 +118,28 @@ def test_occlusions_are_gaps_and_a_long_one_is_lost(film) -> None:
     assert 1 <= result.summary.contacts["test"] <= 3
     assert len(tr) == len(frames) - 3 - result.summary.contacts["test"]
     assert not np.isin(np.round(tr.t * clip.scene.fps), list(hidden)).any()
-    assert result.summary.gaps["test"] == 1 and not result.summary.lost
+    # Said with its times; 3 of 30 frames is not more than a tenth of the clip: no failure. (The
+    # patch hides part of a rack ball too: a disc seen over too little of its outline is unseen
+    # rather than measured off centre.)
+    lost = result.summary.lost
+    assert lost["test"] == [(8 / 30, 10 / 30)]
+    assert all(8 / 30 <= a <= b <= 10 / 30 for spans in lost.values() for a, b in spans)
+    assert "test: seen in 27/30 frames; lost from 0.27 to 0.33 s" in result.summary.format()
+    assert not result.summary.failures()
     errors, swaps = clip.errors(result.pixels)
     assert swaps == 0 and np.percentile(errors, 95) <= 1.5  # found again after the gap
-    lost = track_frames(occluded(frames, set(range(8, 30))), clip.scene, cal, plate, max_gap=0.3)
-    assert "test" in lost.summary.lost and "lost" in lost.summary.format()
+    # Lost for most of the clip: a failure, unless gaps are allowed.
+    with pytest.raises(
+        TrackLostError,
+        match=r"'test' was lost in 22 of the 30 frames .* from "
+        r"0\.27 to 0\.97 s.*--allow-gaps",
+    ) as caught:
+        track_frames(occluded(frames, set(range(8, 30))), clip.scene, cal, plate)
+    assert "lost from 0.27 to 0.97 s" in caught.value.result.summary.format()
+    kept = track_frames(
+        occluded(frames, set(range(8, 30))), clip.scene, cal, plate, allow_gaps=True
+    )
+    assert len(kept.recording.track("test")) <= 8
 
 
 def test_bounds_calibration_fills_the_image_keeping_the_aspect() -> None:
@@ -167,8 +187,12 @@ def test_a_folder_of_images_is_tracked_at_the_scenes_frame_rate(tmp_path) -> Non
         Image.fromarray(image).save(tmp_path / f"frame{k:04d}.png")
     result = track_video(tmp_path, scene, cam.calibration(scene), background=cam.plate(scene))
     tr = result.recording.track("test")
-    np.testing.assert_allclose(tr.t, np.arange(scene.frames) / scene.fps)
-    np.testing.assert_allclose(tr.x, traj.states[:, 0, 0], atol=0.02)
+    # Every frame's time at the scene's rate, but those whose exposure spans a collision.
+    assert result.summary.detections["test"] == scene.frames
+    frame = np.round(tr.t * scene.fps).astype(int)
+    np.testing.assert_allclose(tr.t, frame / scene.fps, atol=1e-9)
+    assert len(frame) == scene.frames - result.summary.contacts.get("test", 0) >= 27
+    np.testing.assert_allclose(tr.x, traj.states[frame, 0, 0], atol=0.02)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -217,14 +241,22 @@ def test_two_arms_joined_at_an_elbow_keep_their_own_angles() -> None:
         assert np.sqrt(np.mean(err**2)) < 0.01, (name, np.sqrt(np.mean(err**2)))
 
 
-def test_the_summary_counts_in_words_that_agree() -> None:
-    one = TrackSummary(1, 0.1, {"ball": 1}, {"ball": 1}, {}, 0.25, fps=30.0)
+def test_the_summary_says_when_a_body_was_lost_never_how_many_gaps() -> None:
+    one = TrackSummary(11, 3.33, {"ball": 1}, {"ball": 11}, {"ball": [(0.33, 3.33)]}, 0.25, 30.0)
     assert one.format().splitlines() == [
-        "tracked 1 body over 1 frame (0.10 s) at 30 frames/s; calibration reprojection error "
+        "tracked 1 body over 11 frames (3.33 s) at 30 frames/s; calibration reprojection error "
         "0.25 px",
-        "      ball: seen in 1/1 frames, 1 gap",
+        "      ball: seen in 1/11 frames; lost from 0.33 to 3.33 s",
     ]
-    two = TrackSummary(5, 0.2, {"a": 5, "b": 3}, {"a": 0, "b": 2}, {}, 0.25)
-    assert "tracked 2 bodies over 5 frames" in two.format() and "b: seen in 3/5 frames, 2 gaps" in (
-        two.format()
+    assert "gap" not in one.format()
+    (why,) = one.failures()
+    assert why == (
+        "body 'ball' was lost in 10 of the 11 frames where it was in view (91%, more than 10%): "
+        "lost from 0.33 to 3.33 s"
     )
+    # Out of view is not lost: a body that leaves the view is seen in all the frames it is in.
+    two = TrackSummary(
+        5, 0.2, {"a": 5, "b": 3}, {"a": 5, "b": 3}, {}, 0.25, out_of_view={"b": [(0.15, 0.2)]}
+    )
+    assert "b: seen in 3/3 frames in view; out of view from 0.15 to 0.20 s" in two.format()
+    assert "tracked 2 bodies over 5 frames" in two.format() and not two.failures()

@@ -1,0 +1,213 @@
+"""A disc's centre from its silhouette: edge points found along rays, fitted by a circle on the
+scene's plane.
+
+The centroid of a lit sphere's pixels is not its centre: the highlight and the shaded side
+differ from the wall by different amounts, so any weighting by the difference leans away from
+the highlight (measured: 0.7-1.1 px on 13-22 px spheres; up to 4 px for a light grey ball on a
+wall of its brightness). The outline does not depend on the shading. From a first guess of the
+centre, rays go out in every direction; along each, the outermost point where the difference
+falls below half of its level just inside (the edge's half-way point, or the foreground
+threshold where that is higher) is an edge point. Edge points map into the plane
+(:meth:`~physbench.calibration.Calibration.to_scene`, so an oblique view's foreshortening does
+not bias the centre) and a circle is fitted to them; points far off the circle are dropped and the
+circle fitted again. A ray that never leaves the foreground (a rod joined to a pendulum's bob,
+a touching ball, an occluder), that leaves the image, or whose edge is far off the circle adds
+nothing, so the fit holds where part of the outline is hidden. Motion blur stretches the disc
+into a stadium, symmetric about the disc's pose at mid-exposure: its edge points' circle has
+that centre.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from physbench.calibration import Calibration
+
+#: Radial sampling step along a ray (px).
+STEP = 0.5
+#: Rays are this far apart (px) along the disc's outline: 43 rays on a 27 px disc, whose centre
+#: they fix to a few hundredths of a pixel.
+SPACING = 4.0
+#: How far inside an edge its inner level is searched for (px, at most half the radius): past
+#: an anti-aliased, coded or blurred edge, short of a highlight.
+INNER = 4.0
+#: The largest angle (rad) between two neighbouring edge points that a fit accepts: a disc seen
+#: over less than ~210 degrees of its outline is too little of it.
+MAX_ARC_GAP = math.radians(150.0)
+
+
+@dataclass(frozen=True)
+class DiscFit:
+    """A disc fitted to its outline: centre ``xy`` (m) and ``uv`` (px), ``radius`` (m), the
+    share of rays whose edge was kept, and the RMS distance (px) of the kept edge points from the
+    circle."""
+
+    xy: np.ndarray
+    uv: np.ndarray
+    radius: float
+    kept: float
+    rms_px: float
+
+
+def _sample(image: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Bilinear samples (float32) of ``image`` ``(h, w)`` at fractional ``rows``, ``cols``
+    (clamped to the image)."""
+    h, w = image.shape
+    r = np.clip(rows, 0, h - 1.001)
+    c = np.clip(cols, 0, w - 1.001)
+    r0, c0 = r.astype(np.intp), c.astype(np.intp)
+    fr, fc = r - r0, c - c0
+    flat = image.ravel()
+    i = r0 * w + c0
+    a, b = flat[i].astype(np.float32), flat[i + 1].astype(np.float32)
+    top = a + (b - a) * fc
+    a, b = flat[i + w].astype(np.float32), flat[i + w + 1].astype(np.float32)
+    bottom = a + (b - a) * fc
+    return top + (bottom - top) * fr
+
+
+@dataclass(frozen=True)
+class Rays:
+    """Where rays look for one disc's edge: from ``centre`` (frame px) for a disc of about
+    ``radius`` px, out to ``reach`` px."""
+
+    centre: np.ndarray
+    radius: float
+    reach: float
+
+
+def edge_points(
+    diff: np.ndarray, offset: tuple[int, int], rays: Sequence[Rays], low: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Edge points of several discs in one difference image ``diff`` (a crop whose top-left
+    pixel is ``offset = (row, col)``), all rays at once: for each of ``rays``, rays every
+    :data:`SPACING` px of its outline (16-64), searched from half its radius out to its reach;
+    ``low`` is the foreground threshold. Returns the edge points ``(n, 2)`` (frame px), their
+    rays' angles ``(n,)``, each edge's contrast (grey levels, its inner level over the outside)
+    and the index into ``rays`` of the disc each belongs to. Rays that leave the crop, or find
+    no edge, are left out."""
+    counts = [int(np.clip(round(2 * math.pi * r.radius / SPACING), 16, 64)) for r in rays]
+    owner = np.repeat(np.arange(len(rays)), counts)
+    theta = np.concatenate([np.arange(n) * (2 * math.pi / n) for n in counts])
+    radius = np.array([r.radius for r in rays])[owner]
+    start = np.maximum(0.0, 0.5 * radius - INNER)
+    length = np.array([r.reach for r in rays])[owner] - start
+    m = int(np.ceil(length.max() / STEP)) + 1
+    steps = np.minimum(np.floor(length / STEP).astype(np.intp) + 1, m)  # samples per ray
+    s = start[:, None] + STEP * np.arange(m)[None]  # (n, m)
+    du, dv = np.cos(theta), np.sin(theta)
+    centres = np.array([r.centre for r in rays], dtype=float)[owner]
+    cu, cv = centres[:, 0] - offset[1], centres[:, 1] - offset[0]
+    h, w = diff.shape
+    # Rays are straight: inside the crop where both their ends are.
+    ok = np.ones(len(theta), dtype=bool)
+    for far in (start, start + STEP * (steps - 1)):
+        eu, ev = cu + du * far, cv + dv * far
+        ok &= (eu >= 0) & (eu <= w - 1) & (ev >= 0) & (ev <= h - 1)
+    p = _sample(diff, cv[:, None] + dv[:, None] * s, cu[:, None] + du[:, None] * s)  # (n, m)
+    above = (p >= low) & (np.arange(m)[None] < steps[:, None])
+    last = m - 1 - np.argmax(above[:, ::-1], axis=1)
+    ok &= above.any(axis=1) & (last < steps - 1)
+    # The edge's inner level is where the profile stops falling steeply, walking in from its
+    # steepest point near the threshold crossing: the rim's own brightness, not the shading
+    # further in (a lit sphere brightens inwards from a limb as dark as the wall).
+    k = max(2, round(min(INNER, 0.5 * float(radius.min())) / STEP))
+    rows = np.arange(len(theta))
+    idx = np.clip(last[:, None] + np.arange(-k, 2), 0, m - 1)  # (n, k + 2): inside out
+    near = p[rows[:, None], idx]
+    slope = near[:, :-1] - near[:, 1:]  # (n, k + 1): the fall over each step outwards
+    outer = max(1, round(2.0 / STEP))
+    steep = k + 1 - outer + np.argmax(slope[:, -outer:], axis=1)
+    flat = (slope < 0.3 * slope[rows, steep][:, None]) & (np.arange(k + 1) < steep[:, None])
+    shoulder = np.where(flat.any(axis=1), k - np.argmax(flat[:, ::-1], axis=1), 0)
+    inner = near[rows, shoulder]
+    outside = near[:, -1]
+    contrast = inner - outside
+    # An edge whose inner level is under the threshold over the outside is placed by the
+    # threshold, not by its half-way point (inwards by up to a pixel): it adds nothing.
+    ok &= contrast >= low
+    level = 0.5 * (inner + outside)
+    # The outermost sample at or above the level, and the next one out (below it).
+    at = near[:, :-1] >= level[:, None]
+    j = k - np.argmax(at[:, ::-1], axis=1)
+    pj, pn = near[rows, j], near[rows, j + 1]
+    frac = np.clip((pj - level) / np.maximum(pj - pn, 1e-6), 0.0, 1.0)
+    dist = s[rows, idx[rows, j]] + STEP * frac
+    uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
+    return uv[ok], theta[ok], contrast[ok], owner[ok]
+
+
+def _circle(xy: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, float]:
+    """Weighted least-squares circle through ``xy`` ``(n, 2)`` (algebraic: Kasa, by its normal
+    equations), as ``(centre, r)``."""
+    mean = xy.mean(axis=0)
+    q = xy - mean
+    a = np.column_stack([q, np.ones(len(q))])
+    b = (q * q).sum(axis=1)
+    aw = a * weight[:, None]
+    sol = np.linalg.solve(aw.T @ a + 1e-12 * np.eye(3), aw.T @ b)
+    c = sol[:2] / 2
+    return c + mean, float(math.sqrt(max(sol[2] + c @ c, 0.0)))
+
+
+def fit_circle(
+    xy: np.ndarray, theta: np.ndarray, weight: np.ndarray, tolerance: float
+) -> tuple[np.ndarray, float, np.ndarray] | None:
+    """The circle through edge points ``xy`` ``(n, 2)`` (m) seen along rays at angles ``theta``,
+    robustly: points further than 3 robust standard deviations (at least ``tolerance`` m) off the
+    first circle are dropped and the circle refitted. ``(centre, radius, kept mask)``, or ``None``
+    when too few points remain or they cover too little of the outline."""
+    if len(xy) < 6:
+        return None
+    centre, r = _circle(xy, weight)
+    res = np.abs(np.hypot(xy[:, 0] - centre[0], xy[:, 1] - centre[1]) - r)
+    keep = res <= max(3.0 * 1.4826 * float(np.median(res)), tolerance)
+    if keep.sum() < 6:
+        return None
+    if not keep.all():
+        centre, r = _circle(xy[keep], weight[keep])
+    angles = theta[keep]  # increasing: rays go round in order
+    gaps = np.diff(angles, append=angles[0] + 2 * math.pi)
+    if gaps.max() > MAX_ARC_GAP:
+        return None
+    return centre, r, keep
+
+
+def fit_disc(
+    uv: np.ndarray,
+    theta: np.ndarray,
+    contrast: np.ndarray,
+    radius: float,
+    calibration: Calibration,
+    mpp: float,
+) -> DiscFit | None:
+    """A disc's centre from its edge points ``uv`` (frame px; rays at ``theta``, edges of
+    ``contrast``, from :func:`edge_points`), fitted by a circle on the plane (see the module
+    docstring), where ``mpp`` metres make a pixel. ``None`` when the outline is not a disc's of
+    about ``radius`` px (too few edges, too little of the outline, another radius)."""
+    if len(uv) < 6:
+        return None
+    xy = calibration.to_scene(uv)
+    # An edge of little contrast is placed less surely (a lit limb as bright as the wall shows
+    # only where the sphere brightens inwards): it counts for less.
+    weight = np.minimum(1.0, contrast / (0.5 * contrast.max())) ** 2
+    fit = fit_circle(xy, theta, weight, 0.75 * mpp)
+    if fit is None:
+        return None
+    centre, r, keep = fit
+    if not 0.5 * radius * mpp <= r <= 2.5 * radius * mpp:
+        return None
+    res = np.hypot(*(xy[keep] - centre).T) - r
+    return DiscFit(
+        centre,
+        calibration.to_image(centre),
+        r,
+        float(keep.mean()),
+        float(np.sqrt(np.mean(res * res)) / mpp),
+    )
