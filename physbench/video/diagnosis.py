@@ -6,7 +6,8 @@ What it measures there, in the frame's light (:class:`~physbench.video.photometr
 - **A blob of the body's size elsewhere** (searched out to 8 radii): the scene's initial position,
   the calibration or ``--start`` is off; the message gives the blob's pixel and distance.
 - **Some contrast, under the threshold**: the body differs from the wall behind it by fewer grey
-  levels than the frame's noise or the other bodies' contrast allow; more contrast is the fix.
+  levels than the frame's noise or the other bodies' contrast allow, or does so over too little
+  of its area to be found; more contrast is the fix.
 - **Nothing there**: with a plate, the body is elsewhere (or the plate is of another view); with
   the clip's median as the background, either that, or the body stays put for most of the clip
   and the median holds it (then a plate of the empty scene is the fix).
@@ -84,12 +85,21 @@ def not_found(
             f"v={best.v:.0f}): the scene's initial position, --seed, --start or the calibration "
             f"is off{lit}"
         )
+    fix = (
+        "too little contrast. Give it a colour or brightness unlike the wall behind it, light "
+        f"it evenly, and film a plate of the empty scene (--background){lit}"
+    )
+    if low <= peak:
+        covered = sum(b.area for b, *_ in blobs if np.hypot(b.u - u, b.v - v) <= body.radius)
+        return (
+            f"{head}; only {covered / body.area:.0%} of its area there differs from the "
+            f"background by more than the threshold of {low:.0f} grey levels (the frame's noise: "
+            f"{noise:.0f}; the most contrasted tenth of it: {peak:.0f}): {fix}"
+        )
     if peak > 0.5 * noise:
         return (
             f"{head}; it differs from the background there by at most {peak:.0f} grey levels, "
-            f"under the threshold of {low:.0f} (the frame's noise: {noise:.0f}): too little "
-            "contrast. Give it a colour or brightness unlike the wall behind it, light it "
-            f"evenly, and film a plate of the empty scene (--background){lit}"
+            f"under the threshold of {low:.0f} (the frame's noise: {noise:.0f}): {fix}"
         )
     if median:
         return (

@@ -82,16 +82,33 @@ class Rays:
     reach: float
 
 
+@dataclass(frozen=True)
+class Edges:
+    """Edge points found along rays: ``uv`` ``(n, 2)`` (frame px), the rays' angles ``theta``,
+    each edge's ``contrast`` (grey levels, its inner level over the outside) and ``width`` (px
+    from where it rises out of the noise to its half-way point: a sharp edge's is about a
+    pixel), and the index of the disc each belongs to (``owner``)."""
+
+    uv: np.ndarray
+    theta: np.ndarray
+    contrast: np.ndarray
+    width: np.ndarray
+    owner: np.ndarray
+
+    def of(self, disc: int) -> Edges:
+        """The edges of disc ``disc``."""
+        k = self.owner == disc
+        return Edges(self.uv[k], self.theta[k], self.contrast[k], self.width[k], self.owner[k])
+
+
 def edge_points(
     diff: np.ndarray, offset: tuple[int, int], rays: Sequence[Rays], low: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> Edges:
     """Edge points of several discs in one difference image ``diff`` (a crop whose top-left
     pixel is ``offset = (row, col)``), all rays at once: for each of ``rays``, rays every
     :data:`SPACING` px of its outline (16-64), searched from half its radius out to its reach;
-    ``low`` is the foreground threshold. Returns the edge points ``(n, 2)`` (frame px), their
-    rays' angles ``(n,)``, each edge's contrast (grey levels, its inner level over the outside)
-    and the index into ``rays`` of the disc each belongs to. Rays that leave the crop, or find
-    no edge, are left out."""
+    ``low`` is the foreground threshold. Rays that leave the crop, or find no edge, are left
+    out."""
     counts = [int(np.clip(round(2 * math.pi * r.radius / SPACING), 16, 64)) for r in rays]
     owner = np.repeat(np.arange(len(rays)), counts)
     theta = np.concatenate([np.arange(n) * (2 * math.pi / n) for n in counts])
@@ -140,7 +157,8 @@ def edge_points(
     frac = np.clip((pj - level) / np.maximum(pj - pn, 1e-6), 0.0, 1.0)
     dist = s[rows, idx[rows, j]] + STEP * frac
     uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
-    return uv[ok], theta[ok], contrast[ok], owner[ok]
+    width = s[rows, last] + 0.5 * STEP - dist
+    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], owner[ok])
 
 
 def _circle(xy: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, float]:
@@ -179,25 +197,20 @@ def fit_circle(
     return centre, r, keep
 
 
-def fit_disc(
-    uv: np.ndarray,
-    theta: np.ndarray,
-    contrast: np.ndarray,
-    radius: float,
-    calibration: Calibration,
-    mpp: float,
-) -> DiscFit | None:
-    """A disc's centre from its edge points ``uv`` (frame px; rays at ``theta``, edges of
-    ``contrast``, from :func:`edge_points`), fitted by a circle on the plane (see the module
+def fit_disc(edges: Edges, radius: float, calibration: Calibration, mpp: float) -> DiscFit | None:
+    """A disc's centre from its :class:`Edges`, fitted by a circle on the plane (see the module
     docstring), where ``mpp`` metres make a pixel. ``None`` when the outline is not a disc's of
-    about ``radius`` px (too few edges, too little of the outline, another radius)."""
-    if len(uv) < 6:
+    about ``radius`` px (too few edges, too little of the outline, another radius).
+
+    Edges count by how surely they are placed: one of little contrast, or one that rises out of
+    the noise slowly (a lit limb as bright as the wall shows only where the sphere brightens
+    inwards, pixels inside the true outline), counts for less than a sharp one."""
+    if len(edges.uv) < 6:
         return None
-    xy = calibration.to_scene(uv)
-    # An edge of little contrast is placed less surely (a lit limb as bright as the wall shows
-    # only where the sphere brightens inwards): it counts for less.
-    weight = np.minimum(1.0, contrast / (0.5 * contrast.max())) ** 2
-    fit = fit_circle(xy, theta, weight, 0.75 * mpp)
+    xy = calibration.to_scene(edges.uv)
+    sharp = np.minimum(1.0, float(np.median(edges.width)) / np.maximum(edges.width, 1e-3))
+    weight = (np.minimum(1.0, edges.contrast / (0.5 * edges.contrast.max())) * sharp) ** 2
+    fit = fit_circle(xy, edges.theta, weight, 0.75 * mpp)
     if fit is None:
         return None
     centre, r, keep = fit

@@ -802,19 +802,9 @@ class Tracker:
             (inside if ok and c[0] + m <= c0 + w - 1 else outside).append(i)
         fits: dict[int, DiscFit | None] = {}
         if inside:
-            uv, theta, contrast, owner = edge_points(
-                diff, (r0, c0), [plans[i].rays for i in inside], self.low
-            )
+            edges = edge_points(diff, (r0, c0), [plans[i].rays for i in inside], self.low)
             for k, i in enumerate(inside):
-                mine = owner == k
-                fits[i] = fit_disc(
-                    uv[mine],
-                    theta[mine],
-                    contrast[mine],
-                    plans[i].rays.radius,
-                    self.cal,
-                    plans[i].mpp,
-                )
+                fits[i] = fit_disc(edges.of(k), plans[i].rays.radius, self.cal, plans[i].mpp)
         for i in outside:
             fits[i] = self._fit_one(image, plans[i].rays, plans[i].mpp)
         for i, fit in fits.items():
@@ -833,8 +823,8 @@ class Tracker:
         diff = self.light.difference(
             image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1], self.bg_index[r0:r1, c0:c1]
         )
-        uv, theta, contrast, _ = edge_points(diff, (r0, c0), [rays], self.low)
-        return fit_disc(uv, theta, contrast, rays.radius, self.cal, mpp)
+        edges = edge_points(diff, (r0, c0), [rays], self.low)
+        return fit_disc(edges, rays.radius, self.cal, mpp)
 
     def _disc(
         self,
