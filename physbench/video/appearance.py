@@ -11,6 +11,7 @@ unseen in that frame rather than recorded where something else is.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,17 +30,21 @@ BRIGHTNESS_RATIO = 1.8
 #: Added to each channel (grey levels) before a colour's direction is taken: a dark body's
 #: direction is noise.
 DARK = 16.0
+#: Below this area (px) a body's measured size is loose: the size ratio allowed grows as the
+#: root of this over its area.
+SMALL = 50.0
 #: Weight of a new detection in the running appearance.
 RATE = 0.1
 
 
 @dataclass(frozen=True)
 class Look:
-    """One detection's appearance: ``size`` (covered area over the scene's area for the body
-    there) and ``colour`` ``(3,)`` (grey levels in the background's light)."""
+    """One detection's appearance: ``size`` (covered area over the area the scene gives the
+    body there, ``pixels``) and ``colour`` ``(3,)`` (grey levels in the background's light)."""
 
     size: float
     colour: np.ndarray
+    pixels: float = math.inf
 
 
 def _direction(c: np.ndarray) -> np.ndarray:
@@ -63,7 +68,9 @@ class Appearance:
     def mismatch(self, look: Look) -> str | None:
         """Why ``look`` is not this body (a few words with the measured values), or ``None``."""
         ratio = look.size / max(self.size, 1e-9)
-        if not 1 / SIZE_RATIO <= ratio <= SIZE_RATIO:
+        # A body of a few pixels has a size of a few pixels, give or take most of them.
+        allowed = SIZE_RATIO * max(1.0, math.sqrt(SMALL / max(look.pixels, 1e-9)))
+        if not 1 / allowed <= ratio <= allowed:
             return f"{ratio:.2f} times its size"
         hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread):

@@ -40,19 +40,24 @@ INNER = 4.0
 #: The largest angle (rad) between two neighbouring edge points that a fit accepts: a disc seen
 #: over less than ~210 degrees of its outline is too little of it.
 MAX_ARC_GAP = math.radians(150.0)
+#: With the disc's radius known from earlier frames, this much of its outline (rad) fixes its
+#: centre.
+MIN_ARC = math.radians(120.0)
 
 
 @dataclass(frozen=True)
 class DiscFit:
     """A disc fitted to its outline: centre ``xy`` (m) and ``uv`` (px), ``radius`` (m), the
-    share of rays whose edge was kept, and the RMS distance (px) of the kept edge points from the
-    circle."""
+    share of rays whose edge was kept, the RMS distance (px) of the kept edge points from the
+    circle, and whether the radius was the one known from earlier frames (``fixed``: too little
+    of the outline to fit it)."""
 
     xy: np.ndarray
     uv: np.ndarray
     radius: float
     kept: float
     rms_px: float
+    fixed: bool = False
 
 
 def _sample(image: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -87,18 +92,30 @@ class Edges:
     """Edge points found along rays: ``uv`` ``(n, 2)`` (frame px), the rays' angles ``theta``,
     each edge's ``contrast`` (grey levels, its inner level over the outside) and ``width`` (px
     from where it rises out of the noise to its half-way point: a sharp edge's is about a
-    pixel), and the index of the disc each belongs to (``owner``)."""
+    pixel), its distance from the rays' origin (``reach``, px), and the index of the disc each
+    belongs to (``owner``)."""
 
     uv: np.ndarray
     theta: np.ndarray
     contrast: np.ndarray
     width: np.ndarray
+    reach: np.ndarray
     owner: np.ndarray
+
+    def select(self, keep: np.ndarray) -> Edges:
+        """The edges where ``keep`` (a mask or indices)."""
+        return Edges(
+            self.uv[keep],
+            self.theta[keep],
+            self.contrast[keep],
+            self.width[keep],
+            self.reach[keep],
+            self.owner[keep],
+        )
 
     def of(self, disc: int) -> Edges:
         """The edges of disc ``disc``."""
-        k = self.owner == disc
-        return Edges(self.uv[k], self.theta[k], self.contrast[k], self.width[k], self.owner[k])
+        return self.select(self.owner == disc)
 
 
 def edge_points(
@@ -158,7 +175,7 @@ def edge_points(
     dist = s[rows, idx[rows, j]] + STEP * frac
     uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
     width = s[rows, last] + 0.5 * STEP - dist
-    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], owner[ok])
+    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok])
 
 
 def _circle(xy: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, float]:
@@ -174,43 +191,99 @@ def _circle(xy: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, float]:
     return c + mean, float(math.sqrt(max(sol[2] + c @ c, 0.0)))
 
 
+def _circle_of_radius(
+    xy: np.ndarray, weight: np.ndarray, start: np.ndarray, r: float
+) -> np.ndarray:
+    """The centre of the circle of radius ``r`` through ``xy`` (weighted least squares on the
+    distances to it, Gauss-Newton from ``start``)."""
+    c = np.asarray(start, dtype=float).copy()
+    for _ in range(8):
+        d = xy - c
+        dist = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-12)
+        jac = -d / dist[:, None]
+        res = dist - r
+        jw = jac * weight[:, None]
+        step = np.linalg.solve(jw.T @ jac + 1e-12 * np.eye(2), -(jw.T @ res))
+        c += step
+        if float(np.hypot(*step)) < 1e-6 * r:
+            break
+    return c
+
+
+def _arc_gap(theta: np.ndarray) -> float:
+    """The largest angle (rad) between neighbouring rays ``theta`` (increasing) round the
+    circle."""
+    return float(np.diff(theta, append=theta[0] + 2 * math.pi).max())
+
+
 def fit_circle(
-    xy: np.ndarray, theta: np.ndarray, weight: np.ndarray, tolerance: float
+    xy: np.ndarray,
+    theta: np.ndarray,
+    weight: np.ndarray,
+    tolerance: float,
+    radius: float | None = None,
+    expected: float = 0.0,
 ) -> tuple[np.ndarray, float, np.ndarray] | None:
-    """The circle through edge points ``xy`` ``(n, 2)`` (m) seen along rays at angles ``theta``,
-    robustly: points further than 3 robust standard deviations (at least ``tolerance`` m) off the
-    first circle are dropped and the circle refitted. ``(centre, radius, kept mask)``, or ``None``
-    when too few points remain or they cover too little of the outline."""
+    """The circle through edge points ``xy`` ``(n, 2)`` (m) seen along rays at angles
+    ``theta``, robustly: from the circle of the three quarters of the points that fit it best,
+    points further than 3 robust standard deviations (at least ``tolerance`` m) off it, or
+    nearer its centre than 70 % of its radius or of the ``expected`` radius (m), are dropped and
+    the circle refitted. ``(centre,
+    radius, kept mask)``, or ``None`` when too few points remain or they cover too little of the
+    outline: less than 360 - :data:`MAX_ARC_GAP` degrees of it, or, with the disc's ``radius``
+    known (m), less than :data:`MIN_ARC` degrees (then that radius is fitted)."""
     if len(xy) < 6:
         return None
     centre, r = _circle(xy, weight)
-    res = np.abs(np.hypot(xy[:, 0] - centre[0], xy[:, 1] - centre[1]) - r)
-    keep = res <= max(3.0 * 1.4826 * float(np.median(res)), tolerance)
+    # Least trimmed squares: refit to the three quarters nearest the circle, twice (a highlight's
+    # rim is a tight cluster of edges inside the outline, which a fit to all of them leans to).
+    best = max(6, int(0.75 * len(xy)))
+    for _ in range(2):
+        res = np.abs(np.hypot(xy[:, 0] - centre[0], xy[:, 1] - centre[1]) - r)
+        trim = np.argsort(res)[:best]
+        centre, r = _circle(xy[trim], weight[trim])
+    res = np.hypot(xy[:, 0] - centre[0], xy[:, 1] - centre[1]) - r
+    scale = 1.4826 * float(np.median(np.abs(res[trim])))
+    keep = np.abs(res) <= max(3.0 * scale, tolerance)
+    keep &= res + r >= 0.7 * max(r, expected)
     if keep.sum() < 6:
         return None
-    if not keep.all():
-        centre, r = _circle(xy[keep], weight[keep])
-    angles = theta[keep]  # increasing: rays go round in order
-    gaps = np.diff(angles, append=angles[0] + 2 * math.pi)
-    if gaps.max() > MAX_ARC_GAP:
+    centre, r = _circle(xy[keep], weight[keep])
+    gap = _arc_gap(theta[keep])
+    if gap <= MAX_ARC_GAP:
+        return centre, r, keep
+    if radius is None or gap > 2 * math.pi - MIN_ARC:
         return None
-    return centre, r, keep
+    centre = _circle_of_radius(xy[keep], weight[keep], centre, radius)
+    return centre, radius, keep
 
 
-def fit_disc(edges: Edges, radius: float, calibration: Calibration, mpp: float) -> DiscFit | None:
+def fit_disc(
+    edges: Edges,
+    radius: float,
+    calibration: Calibration,
+    mpp: float,
+    known: float | None = None,
+) -> DiscFit | None:
     """A disc's centre from its :class:`Edges`, fitted by a circle on the plane (see the module
     docstring), where ``mpp`` metres make a pixel. ``None`` when the outline is not a disc's of
-    about ``radius`` px (too few edges, too little of the outline, another radius).
+    about ``radius`` px (too few edges, too little of the outline, another radius). ``known``:
+    the disc's radius on the plane (m) as fitted in earlier frames, for an outline seen over
+    too little of its circle to fit one freely.
 
-    Edges count by how surely they are placed: one of little contrast, or one that rises out of
-    the noise slowly (a lit limb as bright as the wall shows only where the sphere brightens
-    inwards, pixels inside the true outline), counts for less than a sharp one."""
+    An edge nearer the rays' origin than half the radius, or nearer the fitted centre than 70 %
+    of the radius, is not the outline (a highlight's rim, where the rest of a lit side is as
+    bright as the wall). Edges count by how surely they are
+    placed: one of little contrast, or one that rises out of the noise slowly (a lit limb shows
+    only where the sphere brightens inwards, inside the true outline), counts for less than a
+    sharp one."""
+    edges = edges.select(edges.reach >= 0.5 * radius)
     if len(edges.uv) < 6:
         return None
     xy = calibration.to_scene(edges.uv)
     sharp = np.minimum(1.0, float(np.median(edges.width)) / np.maximum(edges.width, 1e-3))
     weight = (np.minimum(1.0, edges.contrast / (0.5 * edges.contrast.max())) * sharp) ** 2
-    fit = fit_circle(xy, edges.theta, weight, 0.75 * mpp)
+    fit = fit_circle(xy, edges.theta, weight, 0.75 * mpp, known, radius * mpp)
     if fit is None:
         return None
     centre, r, keep = fit
@@ -223,4 +296,5 @@ def fit_disc(edges: Edges, radius: float, calibration: Calibration, mpp: float) 
         r,
         float(keep.mean()),
         float(np.sqrt(np.mean(res * res)) / mpp),
+        r == known,
     )

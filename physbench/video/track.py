@@ -90,6 +90,9 @@ NOISE_K = 2.0
 UNMODELLED = 0.5
 #: How far a body's first move may depart from the scene's initial velocity, as a share of it.
 VELOCITY_PRIOR = 0.5
+#: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
+#: taken where no outline fits.
+SMALL_DISC = 5.0
 
 
 class TrackError(PhysbenchError, ValueError):
@@ -195,6 +198,7 @@ class _State:
     last_uv: np.ndarray | None = None
     contact: np.ndarray | None = None  # normal of the static its prediction touches
     look: Appearance | None = None
+    radius_m: float | None = None  # a disc's radius on the plane, from its outlines so far
     rejected: int = 0  # detections whose appearance was not the body's
     in_view: int = 0
     unseen: _Runs = field(default_factory=_Runs)
@@ -215,12 +219,13 @@ class _State:
 @dataclass(frozen=True)
 class _Found:
     """One body's measurement in one frame: centre ``xy`` (m) and ``uv`` (px), the pose for its
-    angle, its blob (area, count) and what it looks like."""
+    angle, what it looks like, and a disc's radius where its outline gave one."""
 
     xy: np.ndarray
     uv: np.ndarray
     pose: PlanePose
     look: Look
+    radius: float | None = None  # m, a disc's radius fitted freely to its outline
 
 
 @dataclass(frozen=True)
@@ -231,6 +236,7 @@ class _Plan:
     rays: Rays
     mpp: float
     expected: float
+    known: float | None = None
 
 
 @dataclass(frozen=True)
@@ -540,6 +546,10 @@ class Tracker:
             s.look = Appearance.first(found.look)
         else:
             s.look.update(found.look)
+        if found.radius is not None:
+            s.radius_m = (
+                found.radius if s.radius_m is None else 0.8 * s.radius_m + 0.2 * found.radius
+            )
 
     def _angle(self, s: _State, pose: PlanePose, t: float) -> float | None:
         assert s.angle is not None
@@ -781,7 +791,7 @@ class Tracker:
             c = blob.centre
         else:
             c = self._shift(u, v, w, pred, r)
-        return _Plan(Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0), mpp, expected)
+        return _Plan(Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0), mpp, expected, s.radius_m)
 
     def _fit_discs(
         self,
@@ -804,17 +814,20 @@ class Tracker:
         if inside:
             edges = edge_points(diff, (r0, c0), [plans[i].rays for i in inside], self.low)
             for k, i in enumerate(inside):
-                fits[i] = fit_disc(edges.of(k), plans[i].rays.radius, self.cal, plans[i].mpp)
+                p = plans[i]
+                fits[i] = fit_disc(edges.of(k), p.rays.radius, self.cal, p.mpp, p.known)
         for i in outside:
-            fits[i] = self._fit_one(image, plans[i].rays, plans[i].mpp)
+            fits[i] = self._fit_one(image, plans[i])
         for i, fit in fits.items():
             rays = plans[i].rays
             if fit is not None and float(np.hypot(*(fit.uv - rays.centre))) > 0.25 * rays.radius:
-                fits[i] = self._fit_one(image, replace(rays, centre=fit.uv), plans[i].mpp)
+                again = replace(plans[i], rays=replace(rays, centre=fit.uv))
+                fits[i] = self._fit_one(image, again)
         return fits
 
-    def _fit_one(self, image: np.ndarray, rays: Rays, mpp: float) -> DiscFit | None:
+    def _fit_one(self, image: np.ndarray, plan: _Plan) -> DiscFit | None:
         """One disc's outline fit on a crop of its own."""
+        rays = plan.rays
         c, m = rays.centre, rays.reach + 2.0
         r0, r1 = max(0, math.floor(c[1] - m)), min(self.h, math.ceil(c[1] + m) + 1)
         c0, c1 = max(0, math.floor(c[0] - m)), min(self.w, math.ceil(c[0] + m) + 1)
@@ -824,7 +837,7 @@ class Tracker:
             image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1], self.bg_index[r0:r1, c0:c1]
         )
         edges = edge_points(diff, (r0, c0), [rays], self.low)
-        return fit_disc(edges, rays.radius, self.cal, mpp)
+        return fit_disc(edges, rays.radius, self.cal, plan.mpp, plan.known)
 
     def _disc(
         self,
@@ -840,7 +853,11 @@ class Tracker:
         is the body's alone and of its size gives its centroid; otherwise the disc is unseen."""
         blob, u, v, w = found_blob
         if fit is None:
-            if not alone or not 1 / 1.6 <= blob.area / plan.expected <= 1.6:
+            # The centroid only where an outline cannot be had and shading moves little: a
+            # disc of a few pixels, or one smeared into a streak (whose faint parts fall under
+            # the threshold); alone, and not bigger than a disc.
+            small = plan.rays.radius < SMALL_DISC or blob.elongation > 4.0
+            if not alone or not small or not 0.3 <= blob.area / plan.expected <= 1.6:
                 return None  # neither a disc's outline nor a disc's area: something else
             colours = image[v.astype(np.intp), u.astype(np.intp)]
             look = self._look(i, blob.area, colours, w, mpp=plan.mpp)
@@ -852,7 +869,8 @@ class Tracker:
         inner = near <= (0.6 * rf) ** 2
         colours = image[v[inner].astype(np.intp), u[inner].astype(np.intp)]
         look = self._look(i, area, colours, None, mpp=plan.mpp)
-        return _Found(fit.xy, fit.uv, PlanePose(fit.xy, 0.0, 1.0, 0.0), look)
+        radius = None if fit.fixed else fit.radius
+        return _Found(fit.xy, fit.uv, PlanePose(fit.xy, 0.0, 1.0, 0.0), look, radius)
 
     @staticmethod
     def _shift(
@@ -909,7 +927,7 @@ class Tracker:
             colours = colours[::4]
         raw = np.median(colours, axis=0).astype(float) if len(colours) else np.zeros(3)
         colour = (raw - self.light.offset) / np.maximum(self.light.gain, 1e-3)
-        return Look(area / max(expected, 1e-9), colour)
+        return Look(area / max(expected, 1e-9), colour, expected)
 
     # ----------------------------------------------------------------- result
 
