@@ -51,7 +51,9 @@ class RunConfig:
     which is then tracked and segmented back into the model renderer's frames (the visual gap;
     ``None``: the model renderer draws the observation); ``video``, ``calibration``,
     ``background``, ``video_start`` and ``video_end``: observe a video file instead (a camera's
-    footage, tracked and segmented the same way; no truth then)."""
+    footage, tracked and segmented the same way; no truth then); ``allow_gaps``: keep a video's
+    tracks where a body was lost for more than the tracker's share of the clip (else that is an
+    error)."""
 
     scene: str | None = DEFAULT_SCENE
     params: tuple[str, ...] = ("mass",)
@@ -76,6 +78,7 @@ class RunConfig:
     background: str | None = None
     video_start: float | None = None
     video_end: float | None = None
+    allow_gaps: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings (tuples as lists); :meth:`from_dict` inverts it. Settings added
@@ -121,6 +124,7 @@ _LATER = (
     "background",
     "video_start",
     "video_end",
+    "allow_gaps",
 )
 
 
@@ -148,6 +152,7 @@ def _check_observation(config: RunConfig) -> None:
         "--background": config.background,
         "--start": config.video_start,
         "--end": config.video_end,
+        "--allow-gaps": config.allow_gaps or None,
     }
     if config.observer_options and not config.observer:
         raise PhysbenchError(
@@ -283,6 +288,7 @@ def make_observation(
             start=config.video_start,
             end=config.video_end,
             marked=marked,
+            allow_gaps=config.allow_gaps,
         )
     simulator = create("simulator", config.observer_engine)
     if config.observer:

@@ -174,6 +174,7 @@ def main(args: argparse.Namespace) -> int:
         start=args.start,
         end=args.end,
         track_out=args.track_out,
+        allow_gaps=args.allow_gaps,
         progress=show_progress(args),
     )
     if args.track_out:

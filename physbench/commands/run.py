@@ -304,6 +304,7 @@ def _build_config(args: argparse.Namespace) -> Any:
         background=args.background,
         video_start=args.start,
         video_end=args.end,
+        allow_gaps=args.allow_gaps,
     )
     check_config(config)  # a bad name or option: fail before the progress bar appears
     return config

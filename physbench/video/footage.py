@@ -91,11 +91,13 @@ def video_observation(
     start: float | None = None,
     end: float | None = None,
     marked: Iterable[str] = (),
+    allow_gaps: bool = False,
 ) -> Observation:
     """The observation of a video file in ``renderer``'s frames (see the module docstring).
     ``calibration``: a :class:`~physbench.calibration.Calibration` or a TOML file (default:
     ``scene.bounds`` fill the frame); ``background``: an image of the empty scene (array or file;
-    default: the video's median)."""
+    default: the video's median); ``allow_gaps``: keep tracks where a body was lost for more
+    than the tracker's share of the clip (else :class:`~physbench.video.track.TrackLostError`)."""
     from physbench.calibration import load_calibration
     from physbench.observation import Observation
     from physbench.video.background import load_plate, median_background
@@ -117,7 +119,15 @@ def video_observation(
         calibration = bounds_calibration(scene, (info.height, info.width))
     if isinstance(background, str | Path):
         background = load_plate(background)
-    tracked = track_video(path, scene, calibration, start=start, end=end, background=background)
+    tracked = track_video(
+        path,
+        scene,
+        calibration,
+        start=start,
+        end=end,
+        background=background,
+        allow_gaps=allow_gaps,
+    )
     recording = tracked.recording
     if background is None:
         background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
