@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -64,8 +64,8 @@ def _sample(image: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray
     """Bilinear samples (float32) of ``image`` ``(h, w)`` at fractional ``rows``, ``cols``
     (clamped to the image)."""
     h, w = image.shape
-    r = np.clip(rows, 0, h - 1.001)
-    c = np.clip(cols, 0, w - 1.001)
+    r = np.clip(rows, 0, h - 1.001, dtype=rows.dtype)
+    c = np.clip(cols, 0, w - 1.001, dtype=cols.dtype)
     r0, c0 = r.astype(np.intp), c.astype(np.intp)
     fr, fc = r - r0, c - c0
     flat = image.ravel()
@@ -123,18 +123,19 @@ def edge_points(
 ) -> Edges:
     """Edge points of several discs in one difference image ``diff`` (a crop whose top-left
     pixel is ``offset = (row, col)``), all rays at once: for each of ``rays``, rays every
-    :data:`SPACING` px of its outline (16-64), searched from half its radius out to its reach;
+    :data:`SPACING` px of its outline (16-64), searched from 70 % of its radius less
+    :data:`INNER` out to its reach;
     ``low`` is the foreground threshold. Rays that leave the crop, or find no edge, are left
     out."""
     counts = [int(np.clip(round(2 * math.pi * r.radius / SPACING), 16, 64)) for r in rays]
     owner = np.repeat(np.arange(len(rays)), counts)
     theta = np.concatenate([np.arange(n) * (2 * math.pi / n) for n in counts])
     radius = np.array([r.radius for r in rays])[owner]
-    start = np.maximum(0.0, 0.5 * radius - INNER)
+    start = np.maximum(0.0, 0.7 * radius - INNER)
     length = np.array([r.reach for r in rays])[owner] - start
     m = int(np.ceil(length.max() / STEP)) + 1
     steps = np.minimum(np.floor(length / STEP).astype(np.intp) + 1, m)  # samples per ray
-    s = start[:, None] + STEP * np.arange(m)[None]  # (n, m)
+    s = (start[:, None] + STEP * np.arange(m)[None]).astype(np.float32)  # (n, m)
     du, dv = np.cos(theta), np.sin(theta)
     centres = np.array([r.centre for r in rays], dtype=float)[owner]
     cu, cv = centres[:, 0] - offset[1], centres[:, 1] - offset[0]
@@ -144,7 +145,12 @@ def edge_points(
     for far in (start, start + STEP * (steps - 1)):
         eu, ev = cu + du * far, cv + dv * far
         ok &= (eu >= 0) & (eu <= w - 1) & (ev >= 0) & (ev <= h - 1)
-    p = _sample(diff, cv[:, None] + dv[:, None] * s, cu[:, None] + du[:, None] * s)  # (n, m)
+    f32 = np.float32
+    rows_, cols_ = (
+        cv.astype(f32)[:, None] + dv.astype(f32)[:, None] * s,
+        cu.astype(f32)[:, None] + du.astype(f32)[:, None] * s,
+    )
+    p = _sample(diff, rows_, cols_)  # (n, m)
     above = (p >= low) & (np.arange(m)[None] < steps[:, None])
     last = m - 1 - np.argmax(above[:, ::-1], axis=1)
     ok &= above.any(axis=1) & (last < steps - 1)
@@ -178,17 +184,57 @@ def edge_points(
     return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok])
 
 
-def _circle(xy: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, float]:
-    """Weighted least-squares circle through ``xy`` ``(n, 2)`` (algebraic: Kasa, by its normal
-    equations), as ``(centre, r)``."""
-    mean = xy.mean(axis=0)
-    q = xy - mean
-    a = np.column_stack([q, np.ones(len(q))])
-    b = (q * q).sum(axis=1)
-    aw = a * weight[:, None]
-    sol = np.linalg.solve(aw.T @ a + 1e-12 * np.eye(3), aw.T @ b)
-    c = sol[:2] / 2
-    return c + mean, float(math.sqrt(max(sol[2] + c @ c, 0.0)))
+def _groups(owner: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The number of members of each of ``count`` groups and the index of each group's first
+    member, for ``owner`` sorted increasing."""
+    sizes = np.bincount(owner, minlength=count)
+    return sizes, np.cumsum(sizes) - sizes
+
+
+def _rank(values: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
+    """Each value's rank (0: smallest) among its group's."""
+    _, starts = _groups(owner, count)
+    order = np.lexsort((values, owner))
+    rank = np.empty(len(values), dtype=np.intp)
+    rank[order] = np.arange(len(values)) - starts[owner[order]]
+    return rank
+
+
+def _medians(values: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
+    """Each group's (lower) median of ``values``; 0 for an empty group."""
+    sizes, starts = _groups(owner, count)
+    order = np.lexsort((values, owner))
+    at = np.clip(starts + (sizes - 1) // 2, 0, max(len(values) - 1, 0))
+    return np.where(sizes > 0, values[order][at] if len(values) else 0.0, 0.0)
+
+
+def _circles(
+    xy: np.ndarray, weight: np.ndarray, owner: np.ndarray, count: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each group's weighted least-squares circle through its points ``xy`` (algebraic: Kasa, by
+    its normal equations), as centres ``(count, 2)`` and radii ``(count,)``; NaN for a group
+    without three weighted points."""
+    sizes, _ = _groups(owner, count)
+    mean = np.stack([np.bincount(owner, xy[:, k], count) for k in (0, 1)], 1)
+    mean /= np.maximum(sizes, 1)[:, None]
+    a = np.ones((len(xy), 4))
+    a[:, :2] = xy - mean[owner]
+    a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
+    outer = (a[:, :3] * weight[:, None])[:, :, None] * a[:, None, :]  # (n, 3, 4)
+    g = np.zeros((count, 3, 4))
+    _, starts = _groups(owner, count)
+    some = sizes > 0
+    g[some] = np.add.reduceat(outer, starts[some], axis=0)  # the groups are contiguous
+    g[:, :, :3] += 1e-24 * np.eye(3)
+    solvable = (np.bincount(owner, weight > 0, count) >= 3) & (
+        np.abs(np.linalg.det(g[:, :, :3])) > 0
+    )
+    sol = np.full((count, 3), np.nan)
+    if solvable.any():
+        sol[solvable] = np.linalg.solve(g[solvable, :, :3], g[solvable, :, 3:])[:, :, 0]
+    c = sol[:, :2] / 2
+    r = np.sqrt(np.maximum(sol[:, 2] + (c * c).sum(axis=1), 0.0))
+    return c + mean, r
 
 
 def _circle_of_radius(
@@ -210,52 +256,94 @@ def _circle_of_radius(
     return c
 
 
-def _arc_gap(theta: np.ndarray) -> float:
-    """The largest angle (rad) between neighbouring rays ``theta`` (increasing) round the
-    circle."""
-    return float(np.diff(theta, append=theta[0] + 2 * math.pi).max())
+def _arc_gaps(theta: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
+    """Each group's largest angle (rad) between neighbouring rays ``theta`` (increasing within
+    a group) round the circle; 2 pi for a group of fewer than two."""
+    sizes, starts = _groups(owner, count)
+    gaps = np.full(count, 2 * math.pi)
+    full = sizes >= 2
+    if not full.any():
+        return gaps
+    ends = starts + sizes - 1
+    gaps[full] = theta[starts[full]] + 2 * math.pi - theta[ends[full]]
+    same = owner[1:] == owner[:-1]
+    np.maximum.at(gaps, owner[1:][same], np.diff(theta)[same])
+    return gaps
 
 
-def fit_circle(
-    xy: np.ndarray,
-    theta: np.ndarray,
-    weight: np.ndarray,
-    tolerance: float,
-    radius: float | None = None,
-    expected: float = 0.0,
-) -> tuple[np.ndarray, float, np.ndarray] | None:
-    """The circle through edge points ``xy`` ``(n, 2)`` (m) seen along rays at angles
-    ``theta``, robustly: from the circle of the three quarters of the points that fit it best,
-    points further than 3 robust standard deviations (at least ``tolerance`` m) off it, or
-    nearer its centre than 70 % of its radius or of the ``expected`` radius (m), are dropped and
-    the circle refitted. ``(centre,
-    radius, kept mask)``, or ``None`` when too few points remain or they cover too little of the
-    outline: less than 360 - :data:`MAX_ARC_GAP` degrees of it, or, with the disc's ``radius``
-    known (m), less than :data:`MIN_ARC` degrees (then that radius is fitted)."""
-    if len(xy) < 6:
-        return None
-    centre, r = _circle(xy, weight)
-    # Least trimmed squares: refit to the three quarters nearest the circle, twice (a highlight's
-    # rim is a tight cluster of edges inside the outline, which a fit to all of them leans to).
-    best = max(6, int(0.75 * len(xy)))
-    for _ in range(2):
-        res = np.abs(np.hypot(xy[:, 0] - centre[0], xy[:, 1] - centre[1]) - r)
-        trim = np.argsort(res)[:best]
-        centre, r = _circle(xy[trim], weight[trim])
-    res = np.hypot(xy[:, 0] - centre[0], xy[:, 1] - centre[1]) - r
-    scale = 1.4826 * float(np.median(np.abs(res[trim])))
-    keep = np.abs(res) <= max(3.0 * scale, tolerance)
-    keep &= res + r >= 0.7 * max(r, expected)
-    if keep.sum() < 6:
-        return None
-    centre, r = _circle(xy[keep], weight[keep])
-    gap = _arc_gap(theta[keep])
-    if gap <= MAX_ARC_GAP:
-        return centre, r, keep
-    if radius is None or gap > 2 * math.pi - MIN_ARC:
-        return None
-    centre = _circle_of_radius(xy[keep], weight[keep], centre, radius)
-    return centre, radius, keep
+def fit_discs(
+    edges: Edges,
+    radii: Sequence[float],
+    calibration: Calibration,
+    mpp: Sequence[float],
+    known: Sequence[float | None],
+) -> list[DiscFit | None]:
+    """Each disc's centre from its :class:`Edges` (``owner``: the index into ``radii``), fitted
+    by a circle on the plane (see the module docstring), all discs at once; ``mpp``: metres per
+    pixel at each. ``None`` for a disc whose outline is not a disc's of about its radius (px)
+    (too few edges, too little of the outline, another radius). ``known``: a disc's radius on
+    the plane (m) as fitted in earlier frames, for an outline seen over too little of its circle
+    to fit one freely (then fitted with that radius: ``fixed``).
+
+    An edge nearer the rays' origin than half the radius, or nearer the fitted centre than 70 %
+    of the radius, is not the outline (a highlight's rim, where the rest of a lit side is as
+    bright as the wall). Edges count by how surely they are placed: one of little contrast, or
+    one that rises out of the noise slowly (a lit limb shows only where the sphere brightens
+    inwards, inside the true outline), counts for less than a sharp one. The fit is robust: from
+    the circle of the three quarters of a disc's edges that fit it best, edges further than 3
+    robust standard deviations (at least 0.75 px) off it are dropped and the circle refitted."""
+    count = len(radii)
+    radius = np.asarray(radii, dtype=float)
+    mpp_ = np.asarray(mpp, dtype=float)
+    e = edges.select(edges.reach >= 0.5 * radius[edges.owner])
+    own = e.owner
+    if not len(own):
+        return [None] * count
+    xy = calibration.to_scene(e.uv)
+    width = _medians(e.width, own, count)[own]
+    top = np.zeros(count)
+    np.maximum.at(top, own, e.contrast)
+    sharp = np.minimum(1.0, width / np.maximum(e.width, 1e-3))
+    weight = (np.minimum(1.0, e.contrast / (0.5 * top[own])) * sharp) ** 2
+    centre, r = _circles(xy, weight, own, count)
+    res = np.abs(np.hypot(*(xy - centre[own]).T) - r[own])
+    sizes, _ = _groups(own, count)
+    # Least trimmed squares: the three quarters nearest the circle (a highlight's rim is a tight
+    # cluster of edges inside the outline, which a fit to all of them leans to).
+    trim = _rank(np.nan_to_num(res, nan=np.inf), own, count) < np.maximum(6, 3 * sizes // 4)[own]
+    centre, r = _circles(xy, weight * trim, own, count)
+    dist = np.hypot(*(xy - centre[own]).T)
+    res = dist - r[own]
+    scale = 1.4826 * _medians(np.where(trim, np.abs(res), np.inf), own, count)
+    bound = np.maximum(3.0 * scale, 0.75 * mpp_)
+    keep = (np.abs(res) <= bound[own]) & (dist >= 0.7 * np.maximum(r, radius * mpp_)[own])
+    centre, r = _circles(xy, weight * keep, own, count)
+    kept = np.bincount(own, keep, count)
+    gaps = _arc_gaps(e.theta[keep], own[keep], count)
+    fits: list[DiscFit | None] = [None] * count
+    for d in range(count):
+        fixed = False
+        if kept[d] < 6 or not np.isfinite(r[d]):
+            continue
+        if gaps[d] > MAX_ARC_GAP:
+            if known[d] is None or gaps[d] > 2 * math.pi - MIN_ARC:
+                continue
+            mine = keep & (own == d)
+            centre[d] = _circle_of_radius(xy[mine], weight[mine], centre[d], known[d])
+            r[d], fixed = known[d], True
+        if not 0.5 * radius[d] * mpp_[d] <= r[d] <= 2.5 * radius[d] * mpp_[d]:
+            continue
+        mine = keep & (own == d)
+        rms = float(np.sqrt(np.mean((np.hypot(*(xy[mine] - centre[d]).T) - r[d]) ** 2)))
+        fits[d] = DiscFit(
+            centre[d].copy(), np.zeros(2), float(r[d]), kept[d] / sizes[d], rms / mpp_[d], fixed
+        )
+    found = [d for d in range(count) if fits[d] is not None]
+    if found:
+        uv = calibration.to_image(centre[found])
+        for k, d in enumerate(found):
+            fits[d] = replace(fits[d], uv=uv[k])  # type: ignore[arg-type]
+    return fits
 
 
 def fit_disc(
@@ -265,36 +353,7 @@ def fit_disc(
     mpp: float,
     known: float | None = None,
 ) -> DiscFit | None:
-    """A disc's centre from its :class:`Edges`, fitted by a circle on the plane (see the module
-    docstring), where ``mpp`` metres make a pixel. ``None`` when the outline is not a disc's of
-    about ``radius`` px (too few edges, too little of the outline, another radius). ``known``:
-    the disc's radius on the plane (m) as fitted in earlier frames, for an outline seen over
-    too little of its circle to fit one freely.
-
-    An edge nearer the rays' origin than half the radius, or nearer the fitted centre than 70 %
-    of the radius, is not the outline (a highlight's rim, where the rest of a lit side is as
-    bright as the wall). Edges count by how surely they are
-    placed: one of little contrast, or one that rises out of the noise slowly (a lit limb shows
-    only where the sphere brightens inwards, inside the true outline), counts for less than a
-    sharp one."""
-    edges = edges.select(edges.reach >= 0.5 * radius)
-    if len(edges.uv) < 6:
-        return None
-    xy = calibration.to_scene(edges.uv)
-    sharp = np.minimum(1.0, float(np.median(edges.width)) / np.maximum(edges.width, 1e-3))
-    weight = (np.minimum(1.0, edges.contrast / (0.5 * edges.contrast.max())) * sharp) ** 2
-    fit = fit_circle(xy, edges.theta, weight, 0.75 * mpp, known, radius * mpp)
-    if fit is None:
-        return None
-    centre, r, keep = fit
-    if not 0.5 * radius * mpp <= r <= 2.5 * radius * mpp:
-        return None
-    res = np.hypot(*(xy[keep] - centre).T) - r
-    return DiscFit(
-        centre,
-        calibration.to_image(centre),
-        r,
-        float(keep.mean()),
-        float(np.sqrt(np.mean(res * res)) / mpp),
-        r == known,
-    )
+    """:func:`fit_discs` for the edges of one disc."""
+    one = Edges(edges.uv, edges.theta, edges.contrast, edges.width, edges.reach,
+                np.zeros(len(edges.uv), dtype=np.intp))  # fmt: skip
+    return fit_discs(one, [radius], calibration, [mpp], [known])[0]

@@ -63,7 +63,7 @@ from physbench.video.detect import (
 )
 from physbench.video.motion import Motion
 from physbench.video.photometry import Light, LightMeter, plate_index
-from physbench.video.silhouette import DiscFit, Rays, edge_points, fit_disc
+from physbench.video.silhouette import DiscFit, Rays, edge_points, fit_disc, fit_discs
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -813,9 +813,15 @@ class Tracker:
         fits: dict[int, DiscFit | None] = {}
         if inside:
             edges = edge_points(diff, (r0, c0), [plans[i].rays for i in inside], self.low)
-            for k, i in enumerate(inside):
-                p = plans[i]
-                fits[i] = fit_disc(edges.of(k), p.rays.radius, self.cal, p.mpp, p.known)
+            mine = [plans[i] for i in inside]
+            got = fit_discs(
+                edges,
+                [p.rays.radius for p in mine],
+                self.cal,
+                [p.mpp for p in mine],
+                [p.known for p in mine],
+            )
+            fits.update(zip(inside, got, strict=True))
         for i in outside:
             fits[i] = self._fit_one(image, plans[i])
         for i, fit in fits.items():

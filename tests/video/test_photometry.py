@@ -19,8 +19,10 @@ def test_gain_and_offset_are_measured_through_foreground_the_meter_did_not_expec
     got = LightMeter(background).measure(frame, [(40.0, 40.0, 20.0)])
     gain, offset = np.array([1.08, 1.05, 0.97]), 0.02 * 255
     np.testing.assert_allclose(got.gain, gain, atol=0.02)
-    for level in (80.0, 120.0, 160.0):  # the wall's levels in this frame's light
-        np.testing.assert_allclose(got.gain * level + got.offset, gain * level + offset, atol=1.0)
+    # The wall's levels in this frame's light, within 2 grey levels (the foreground threshold is
+    # 12 at least).
+    for level in (80.0, 120.0, 160.0):
+        np.testing.assert_allclose(got.gain * level + got.offset, gain * level + offset, atol=2.0)
     assert abs(got.change - 0.073) < 0.01  # the mean gain less 1, and the offset of mid-grey
     # Noise of 2.5 grey levels per channel: 6 robust standard deviations of the largest channel
     # difference, as before the light was measured.
