@@ -80,6 +80,13 @@ def not_found(
     if sized:
         best = min(sized, key=lambda b: float(np.hypot(b.u - u, b.v - v)))
         far = float(np.hypot(best.u - u, best.v - v))
+        if far <= max(2 * body.radius, 12.0):
+            return (
+                f"{head}; a blob there, at pixel (u={best.u:.0f}, v={best.v:.0f}), covers "
+                f"{best.area / body.area:.0%} of its area but is not a disc's of {body.radius:.1f} "
+                "px radius nor of its area: check the body's size in the scene and the "
+                f"calibration's scale{lit}"
+            )
         return (
             f"{head}; a blob of its size is {far:.0f} px away, at pixel (u={best.u:.0f}, "
             f"v={best.v:.0f}): the scene's initial position, --seed, --start or the calibration "

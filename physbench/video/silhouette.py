@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -184,54 +184,57 @@ def edge_points(
     return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok])
 
 
-def _groups(owner: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """The number of members of each of ``count`` groups and the index of each group's first
-    member, for ``owner`` sorted increasing."""
-    sizes = np.bincount(owner, minlength=count)
-    return sizes, np.cumsum(sizes) - sizes
+@dataclass(frozen=True)
+class _Groups:
+    """Points in ``count`` contiguous groups (``owner`` increasing): each group's ``sizes`` and
+    the index of its first point (``starts``)."""
+
+    owner: np.ndarray
+    count: int
+    sizes: np.ndarray
+    starts: np.ndarray
+
+    @classmethod
+    def of(cls, owner: np.ndarray, count: int) -> _Groups:
+        sizes = np.bincount(owner, minlength=count)
+        return cls(owner, count, sizes, np.cumsum(sizes) - sizes)
+
+    def rank(self, values: np.ndarray) -> np.ndarray:
+        """Each value's rank (0: smallest) within its group."""
+        order = np.lexsort((values, self.owner))
+        rank = np.empty(len(values), dtype=np.intp)
+        rank[order] = np.arange(len(values)) - self.starts[self.owner[order]]
+        return rank
+
+    def median(self, values: np.ndarray) -> np.ndarray:
+        """Each group's (lower) median of ``values`` (inf values sort last); 0 if empty."""
+        order = np.lexsort((values, self.owner))
+        at = np.clip(self.starts + (self.sizes - 1) // 2, 0, len(values) - 1)
+        return np.where(self.sizes > 0, values[order][at], 0.0)
+
+    def total(self, values: np.ndarray) -> np.ndarray:
+        return np.bincount(self.owner, values, self.count)
 
 
-def _rank(values: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
-    """Each value's rank (0: smallest) among its group's."""
-    _, starts = _groups(owner, count)
-    order = np.lexsort((values, owner))
-    rank = np.empty(len(values), dtype=np.intp)
-    rank[order] = np.arange(len(values)) - starts[owner[order]]
-    return rank
-
-
-def _medians(values: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
-    """Each group's (lower) median of ``values``; 0 for an empty group."""
-    sizes, starts = _groups(owner, count)
-    order = np.lexsort((values, owner))
-    at = np.clip(starts + (sizes - 1) // 2, 0, max(len(values) - 1, 0))
-    return np.where(sizes > 0, values[order][at] if len(values) else 0.0, 0.0)
-
-
-def _circles(
-    xy: np.ndarray, weight: np.ndarray, owner: np.ndarray, count: int
-) -> tuple[np.ndarray, np.ndarray]:
+def _circles(xy: np.ndarray, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray, np.ndarray]:
     """Each group's weighted least-squares circle through its points ``xy`` (algebraic: Kasa, by
     its normal equations), as centres ``(count, 2)`` and radii ``(count,)``; NaN for a group
     without three weighted points."""
-    sizes, _ = _groups(owner, count)
-    mean = np.stack([np.bincount(owner, xy[:, k], count) for k in (0, 1)], 1)
-    mean /= np.maximum(sizes, 1)[:, None]
+    some = g.sizes > 0
+    mean = np.zeros((g.count, 2))
+    mean[some] = np.add.reduceat(xy, g.starts[some], axis=0) / g.sizes[some, None]
     a = np.ones((len(xy), 4))
-    a[:, :2] = xy - mean[owner]
+    a[:, :2] = xy - mean[g.owner]
     a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
     outer = (a[:, :3] * weight[:, None])[:, :, None] * a[:, None, :]  # (n, 3, 4)
-    g = np.zeros((count, 3, 4))
-    _, starts = _groups(owner, count)
-    some = sizes > 0
-    g[some] = np.add.reduceat(outer, starts[some], axis=0)  # the groups are contiguous
-    g[:, :, :3] += 1e-24 * np.eye(3)
-    solvable = (np.bincount(owner, weight > 0, count) >= 3) & (
-        np.abs(np.linalg.det(g[:, :, :3])) > 0
-    )
-    sol = np.full((count, 3), np.nan)
-    if solvable.any():
-        sol[solvable] = np.linalg.solve(g[solvable, :, :3], g[solvable, :, 3:])[:, :, 0]
+    m = np.zeros((g.count, 3, 4))
+    m[some] = np.add.reduceat(outer, g.starts[some], axis=0)
+    sol = np.full((g.count, 3), np.nan)
+    ok = g.total(weight > 0) >= 3
+    if ok.any():
+        lhs = m[ok, :, :3]
+        lhs += 1e-12 * np.trace(lhs, axis1=1, axis2=2)[:, None, None] * np.eye(3)
+        sol[ok] = np.linalg.solve(lhs, m[ok, :, 3:])[:, :, 0]
     c = sol[:, :2] / 2
     r = np.sqrt(np.maximum(sol[:, 2] + (c * c).sum(axis=1), 0.0))
     return c + mean, r
@@ -256,18 +259,16 @@ def _circle_of_radius(
     return c
 
 
-def _arc_gaps(theta: np.ndarray, owner: np.ndarray, count: int) -> np.ndarray:
+def _arc_gaps(theta: np.ndarray, g: _Groups) -> np.ndarray:
     """Each group's largest angle (rad) between neighbouring rays ``theta`` (increasing within
     a group) round the circle; 2 pi for a group of fewer than two."""
-    sizes, starts = _groups(owner, count)
-    gaps = np.full(count, 2 * math.pi)
-    full = sizes >= 2
-    if not full.any():
-        return gaps
-    ends = starts + sizes - 1
-    gaps[full] = theta[starts[full]] + 2 * math.pi - theta[ends[full]]
-    same = owner[1:] == owner[:-1]
-    np.maximum.at(gaps, owner[1:][same], np.diff(theta)[same])
+    gaps = np.full(g.count, 2 * math.pi)
+    full = g.sizes >= 2
+    if full.any():
+        ends = g.starts + g.sizes - 1
+        gaps[full] = theta[g.starts[full]] + 2 * math.pi - theta[ends[full]]
+        same = g.owner[1:] == g.owner[:-1]
+        np.maximum.at(gaps, g.owner[1:][same], np.diff(theta)[same])
     return gaps
 
 
@@ -296,53 +297,45 @@ def fit_discs(
     radius = np.asarray(radii, dtype=float)
     mpp_ = np.asarray(mpp, dtype=float)
     e = edges.select(edges.reach >= 0.5 * radius[edges.owner])
-    own = e.owner
-    if not len(own):
+    if not len(e.owner):
         return [None] * count
+    g = _Groups.of(e.owner, count)
+    own = e.owner
     xy = calibration.to_scene(e.uv)
-    width = _medians(e.width, own, count)[own]
     top = np.zeros(count)
     np.maximum.at(top, own, e.contrast)
-    sharp = np.minimum(1.0, width / np.maximum(e.width, 1e-3))
+    sharp = np.minimum(1.0, g.median(e.width)[own] / np.maximum(e.width, 1e-3))
     weight = (np.minimum(1.0, e.contrast / (0.5 * top[own])) * sharp) ** 2
-    centre, r = _circles(xy, weight, own, count)
+    centre, r = _circles(xy, weight, g)
     res = np.abs(np.hypot(*(xy - centre[own]).T) - r[own])
-    sizes, _ = _groups(own, count)
     # Least trimmed squares: the three quarters nearest the circle (a highlight's rim is a tight
     # cluster of edges inside the outline, which a fit to all of them leans to).
-    trim = _rank(np.nan_to_num(res, nan=np.inf), own, count) < np.maximum(6, 3 * sizes // 4)[own]
-    centre, r = _circles(xy, weight * trim, own, count)
+    trim = g.rank(np.nan_to_num(res, nan=np.inf)) < np.maximum(6, 3 * g.sizes // 4)[own]
+    centre, r = _circles(xy, weight * trim, g)
     dist = np.hypot(*(xy - centre[own]).T)
     res = dist - r[own]
-    scale = 1.4826 * _medians(np.where(trim, np.abs(res), np.inf), own, count)
+    scale = 1.4826 * g.median(np.where(trim, np.abs(res), np.inf))
     bound = np.maximum(3.0 * scale, 0.75 * mpp_)
     keep = (np.abs(res) <= bound[own]) & (dist >= 0.7 * np.maximum(r, radius * mpp_)[own])
-    centre, r = _circles(xy, weight * keep, own, count)
-    kept = np.bincount(own, keep, count)
-    gaps = _arc_gaps(e.theta[keep], own[keep], count)
-    fits: list[DiscFit | None] = [None] * count
-    for d in range(count):
-        fixed = False
-        if kept[d] < 6 or not np.isfinite(r[d]):
-            continue
-        if gaps[d] > MAX_ARC_GAP:
-            if known[d] is None or gaps[d] > 2 * math.pi - MIN_ARC:
-                continue
+    centre, r = _circles(xy, weight * keep, g)
+    kept = g.total(keep)
+    gaps = _arc_gaps(e.theta[keep], _Groups.of(own[keep], count))
+    fixed = np.zeros(count, dtype=bool)
+    for d in np.nonzero((gaps > MAX_ARC_GAP) & (kept >= 6))[0]:
+        if known[d] is not None and gaps[d] <= 2 * math.pi - MIN_ARC:
             mine = keep & (own == d)
             centre[d] = _circle_of_radius(xy[mine], weight[mine], centre[d], known[d])
-            r[d], fixed = known[d], True
-        if not 0.5 * radius[d] * mpp_[d] <= r[d] <= 2.5 * radius[d] * mpp_[d]:
-            continue
-        mine = keep & (own == d)
-        rms = float(np.sqrt(np.mean((np.hypot(*(xy[mine] - centre[d]).T) - r[d]) ** 2)))
-        fits[d] = DiscFit(
-            centre[d].copy(), np.zeros(2), float(r[d]), kept[d] / sizes[d], rms / mpp_[d], fixed
-        )
-    found = [d for d in range(count) if fits[d] is not None]
-    if found:
-        uv = calibration.to_image(centre[found])
-        for k, d in enumerate(found):
-            fits[d] = replace(fits[d], uv=uv[k])  # type: ignore[arg-type]
+            r[d], fixed[d] = known[d], True
+    res = np.hypot(*(xy - centre[own]).T) - r[own]
+    rms = np.sqrt(g.total(np.where(keep, res * res, 0.0)) / np.maximum(kept, 1)) / mpp_
+    good = (kept >= 6) & ((gaps <= MAX_ARC_GAP) | fixed) & np.isfinite(r)
+    good &= (0.5 * radius * mpp_ <= r) & (r <= 2.5 * radius * mpp_)
+    fits: list[DiscFit | None] = [None] * count
+    if good.any():
+        uv = calibration.to_image(centre[good])
+        for k, d in enumerate(np.nonzero(good)[0]):
+            share = float(kept[d] / g.sizes[d])
+            fits[d] = DiscFit(centre[d], uv[k], float(r[d]), share, float(rms[d]), bool(fixed[d]))
     return fits
 
 

@@ -200,6 +200,7 @@ class _State:
     look: Appearance | None = None
     radius_m: float | None = None  # a disc's radius on the plane, from its outlines so far
     rejected: int = 0  # detections whose appearance was not the body's
+    centroids: int = 0  # a disc's frames measured by their centroid (no outline fitted)
     in_view: int = 0
     unseen: _Runs = field(default_factory=_Runs)
     out: _Runs = field(default_factory=_Runs)
@@ -226,6 +227,7 @@ class _Found:
     pose: PlanePose
     look: Look
     radius: float | None = None  # m, a disc's radius fitted freely to its outline
+    centroid: bool = False  # a disc measured by its centroid, without an outline
 
 
 @dataclass(frozen=True)
@@ -245,8 +247,9 @@ class TrackSummary:
     (frames with a measurement), the frames where it was ``in_view``, the spans ``(first, last)``
     (s) of frames where it was in view but ``lost``, and those where it was ``out_of_view``; the
     calibration's reprojection error (px), the processing speed (frames/s), the samples left out
-    at collisions (``contacts``), the detections ``rejected`` for not looking like the body, and
-    each track's stated accuracy (px, ``accuracy_px``)."""
+    at collisions (``contacts``), the detections ``rejected`` for not looking like the body,
+    each track's stated accuracy (px, ``accuracy_px``), and a disc's frames measured by their
+    ``centroids`` for want of an outline."""
 
     frames: int
     duration: float
@@ -261,6 +264,8 @@ class TrackSummary:
     out_of_view: dict[str, list[tuple[float, float]]] = field(default_factory=dict)
     rejected: dict[str, int] = field(default_factory=dict)
     accuracy_px: dict[str, float] = field(default_factory=dict)
+    #: Per disc, the frames measured by their centroid (no outline could be fitted).
+    centroids: dict[str, int] = field(default_factory=dict)
 
     def unseen(self, body: str) -> int:
         """Frames where ``body`` was in view but not found."""
@@ -299,6 +304,10 @@ class TrackSummary:
             if self.rejected.get(name):
                 parts.append(
                     f"{counted(self.rejected[name], 'detection')} rejected (not its size or colour)"
+                )
+            if self.centroids.get(name):
+                parts.append(
+                    f"{counted(self.centroids[name], 'frame')} by the centroid (no outline fitted)"
                 )
             if self.contacts.get(name):
                 parts.append(
@@ -546,6 +555,7 @@ class Tracker:
             s.look = Appearance.first(found.look)
         else:
             s.look.update(found.look)
+        s.centroids += found.centroid
         if found.radius is not None:
             s.radius_m = (
                 found.radius if s.radius_m is None else 0.8 * s.radius_m + 0.2 * found.radius
@@ -859,16 +869,17 @@ class Tracker:
         is the body's alone and of its size gives its centroid; otherwise the disc is unseen."""
         blob, u, v, w = found_blob
         if fit is None:
-            # The centroid only where an outline cannot be had and shading moves little: a
-            # disc of a few pixels, or one smeared into a streak (whose faint parts fall under
-            # the threshold); alone, and not bigger than a disc.
+            # Without an outline, the centroid of a blob that is the body's alone and of a
+            # disc's area (counted: shading can move it): a disc of a few pixels, one smeared
+            # into a streak (whose faint parts fall under the threshold), one whose outline is
+            # too faint. Neither a disc's outline nor its area: something else.
             small = plan.rays.radius < SMALL_DISC or blob.elongation > 4.0
-            if not alone or not small or not 0.3 <= blob.area / plan.expected <= 1.6:
-                return None  # neither a disc's outline nor a disc's area: something else
+            if not alone or not (0.3 if small else 0.5) <= blob.area / plan.expected <= 1.6:
+                return None
             colours = image[v.astype(np.intp), u.astype(np.intp)]
             look = self._look(i, blob.area, colours, w, mpp=plan.mpp)
             pose = plane_pose(u, v, w, self.cal)
-            return _Found(pose.xy, blob.centre, pose, look)
+            return _Found(pose.xy, blob.centre, pose, look, centroid=True)
         rf = fit.radius / plan.mpp
         near = (u - fit.uv[0]) ** 2 + (v - fit.uv[1]) ** 2
         area = float(w[near <= (rf + 1.0) ** 2].sum())
@@ -986,6 +997,7 @@ class Tracker:
             {s.body.name: list(s.out.spans) for s in self.states if s.out.spans},
             {s.body.name: s.rejected for s in self.states if s.rejected},
             {n: round(accuracy_px[n], 3) for n in names},
+            {s.body.name: s.centroids for s in self.states if s.centroids},
         )
         return TrackResult(recording, summary, pixels)
 
