@@ -133,7 +133,7 @@ def run_case(radius, colour, light, seed, *, blur, coded) -> dict:
         "wall": seed,
         "blur": blur,
         "coded": coded,
-        "frames": int(len(px)),
+        "frames": len(px),
         "centroid_frames": int(result.summary.centroids.get("ball", 0)),
         "bias_px": round(float(np.mean(err @ toward)), 4),
         "error_px": round(float(np.mean(np.hypot(*err.T))), 4),
