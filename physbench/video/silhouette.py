@@ -64,8 +64,8 @@ def _sample(image: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray
     """Bilinear samples (float32) of ``image`` ``(h, w)`` at fractional ``rows``, ``cols``
     (clamped to the image)."""
     h, w = image.shape
-    r = np.clip(rows, 0, h - 1.001, dtype=rows.dtype)
-    c = np.clip(cols, 0, w - 1.001, dtype=cols.dtype)
+    r = np.minimum(np.maximum(rows, 0), h - 1.001)
+    c = np.minimum(np.maximum(cols, 0), w - 1.001)
     r0, c0 = r.astype(np.intp), c.astype(np.intp)
     fr, fc = r - r0, c - c0
     flat = image.ravel()
@@ -310,7 +310,7 @@ def fit_discs(
     res = np.abs(np.hypot(*(xy - centre[own]).T) - r[own])
     # Least trimmed squares: the three quarters nearest the circle (a highlight's rim is a tight
     # cluster of edges inside the outline, which a fit to all of them leans to).
-    trim = g.rank(np.nan_to_num(res, nan=np.inf)) < np.maximum(6, 3 * g.sizes // 4)[own]
+    trim = g.rank(np.where(np.isnan(res), np.inf, res)) < np.maximum(6, 3 * g.sizes // 4)[own]
     centre, r = _circles(xy, weight * trim, g)
     dist = np.hypot(*(xy - centre[own]).T)
     res = dist - r[own]
