@@ -80,6 +80,18 @@ class Appearance:
             return f"{bright:.2f} times its brightness"
         return None
 
+    def matches(self, colours: np.ndarray) -> np.ndarray:
+        """Which of ``colours`` ``(n, 3)`` (in the background's light) have this body's hue and
+        brightness: its own pixels, in a blob shared with bodies or things of other colours."""
+        d = np.asarray(colours, dtype=float) + DARK
+        norm = np.linalg.norm(d, axis=1)
+        ref = _direction(self.colour)
+        hue = np.linalg.norm(d / norm[:, None] - ref, axis=1)
+        bright = norm / float(np.linalg.norm(self.colour + DARK))
+        return (hue <= max(HUE_TOLERANCE, 4 * self.hue_spread)) & (
+            (bright >= 1 / BRIGHTNESS_RATIO) & (bright <= BRIGHTNESS_RATIO)
+        )
+
     def update(self, look: Look) -> None:
         """Called by the tracker with each accepted detection's appearance."""
         hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))

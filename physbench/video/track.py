@@ -666,7 +666,7 @@ class Tracker:
                 continue
             owner, dist = self._assign(group, blobs, gates)
             plans = {
-                i: self._plan(i, blobs[c], alone=len(members) == 1)
+                i: self._plan(i, image, blobs[c], alone=len(members) == 1)
                 for c, members in owner.items()
                 for i in members
                 if self.states[i].disc
@@ -685,7 +685,11 @@ class Tracker:
                         if int(alt) in taken or dist[j, alt] > gates[i]:
                             continue
                         blob = blobs[int(alt)]
-                        plan = {i: self._plan(i, blob, alone=True)} if self.states[i].disc else {}
+                        plan = (
+                            {i: self._plan(i, image, blob, alone=True)}
+                            if self.states[i].disc
+                            else {}
+                        )
                         fit = self._fit_discs(image, plan, window)
                         again = self._members(image, blob, [i], window, plan, fit)
                         if i in again:
@@ -746,6 +750,10 @@ class Tracker:
             for i in members
             if i in plans
         }
+        for i, got in discs.items():
+            look = self.states[i].look
+            if shared and got is not None and look is not None and look.mismatch(got.look):
+                discs[i] = None  # an outline of another body: try the body's share of the blob
         if any(i not in discs or (discs[i] is None and shared) for i in members):
             diff, (r0, c0) = window
             rows, cols = v.astype(np.intp), u.astype(np.intp)
@@ -786,11 +794,12 @@ class Tracker:
             out[i] = got
         return out
 
-    def _plan(self, i: int, found_blob: tuple, *, alone: bool) -> _Plan:
+    def _plan(self, i: int, image: np.ndarray, found_blob: tuple, *, alone: bool) -> _Plan:
         """Where to look for disc ``i``'s outline on a blob: from the blob's centroid where the
         blob is its alone and of its size, else from a mean shift over the blob's pixels within
         its radius, from the pixel nearest its prediction (its own part of a blob shared with a
-        rod, a hand or another ball)."""
+        rod, a hand or another ball), over the pixels of its colour where it has one (a ball
+        struck into a rack of other colours)."""
         blob, u, v, w = found_blob
         s = self.states[i]
         pred = self.pred_uv[i]
@@ -800,6 +809,11 @@ class Tracker:
         if alone and 0.6 * expected <= blob.area <= 1.6 * expected:
             c = blob.centre
         else:
+            if s.look is not None:
+                raw = image[v.astype(np.intp), u.astype(np.intp)]
+                own = s.look.matches((raw - self.light.offset) / self.light.gain)
+                if w[own].sum() >= 0.2 * expected:
+                    u, v, w = u[own], v[own], w[own]
             c = self._shift(u, v, w, pred, r)
         return _Plan(Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0), mpp, expected, s.radius_m)
 
