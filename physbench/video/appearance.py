@@ -52,6 +52,14 @@ def _direction(c: np.ndarray) -> np.ndarray:
     return d / np.linalg.norm(d)
 
 
+def colour_directions(colours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions ``(n, 3)`` and lengths ``(n,)`` of pixel ``colours`` (in the background's
+    light, darkened by :data:`DARK` as a :class:`Look`'s), for :meth:`Appearance.matches`."""
+    d = np.asarray(colours, dtype=np.float64) + DARK
+    norms = np.sqrt(np.einsum("ij,ij->i", d, d))
+    return d / norms[:, None], norms
+
+
 @dataclass
 class Appearance:
     """A body's running appearance (see the module docstring)."""
@@ -80,15 +88,15 @@ class Appearance:
             return f"{bright:.2f} times its brightness"
         return None
 
-    def matches(self, colours: np.ndarray) -> np.ndarray:
-        """Which of ``colours`` ``(n, 3)`` (in the background's light) have this body's hue and
-        brightness: its own pixels, in a blob shared with bodies or things of other colours."""
-        d = np.asarray(colours, dtype=float) + DARK
-        norm = np.linalg.norm(d, axis=1)
-        ref = _direction(self.colour)
-        hue = np.linalg.norm(d / norm[:, None] - ref, axis=1)
-        bright = norm / float(np.linalg.norm(self.colour + DARK))
-        return (hue <= max(HUE_TOLERANCE, 4 * self.hue_spread)) & (
+    def matches(self, units: np.ndarray, norms: np.ndarray) -> np.ndarray:
+        """Which pixels of a blob have this body's hue and brightness (its own pixels, in a blob
+        shared with bodies or things of other colours), from their :func:`colour_directions`."""
+        tolerance = max(HUE_TOLERANCE, 4 * self.hue_spread)
+        ref = self.colour + DARK
+        size = float(np.linalg.norm(ref))
+        bright = norms / size
+        # |a - b| <= tol for unit vectors: a . b >= 1 - tol^2 / 2.
+        return (units @ (ref / size) >= 1 - 0.5 * tolerance**2) & (
             (bright >= 1 / BRIGHTNESS_RATIO) & (bright <= BRIGHTNESS_RATIO)
         )
 

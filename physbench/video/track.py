@@ -51,7 +51,7 @@ import numpy as np
 
 from physbench.errors import PhysbenchError, counted
 from physbench.scene import Box, Circle
-from physbench.video.appearance import Appearance, Look
+from physbench.video.appearance import Appearance, Look, colour_directions
 from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
     Outline,
@@ -665,12 +665,12 @@ class Tracker:
             if not blobs:
                 continue
             owner, dist = self._assign(group, blobs, gates)
-            plans = {
-                i: self._plan(i, image, blobs[c], alone=len(members) == 1)
-                for c, members in owner.items()
-                for i in members
-                if self.states[i].disc
-            }
+            plans = {}
+            for c, members in owner.items():
+                discs = [i for i in members if self.states[i].disc]
+                colours = self._colours(image, blobs[c]) if len(members) > 1 and discs else None
+                for i in discs:
+                    plans[i] = self._plan(i, blobs[c], alone=len(members) == 1, colours=colours)
             fits = self._fit_discs(image, plans, window)
             taken = set(owner)
             for c, members in owner.items():
@@ -794,12 +794,26 @@ class Tracker:
             out[i] = got
         return out
 
-    def _plan(self, i: int, image: np.ndarray, found_blob: tuple, *, alone: bool) -> _Plan:
+    def _colours(self, image: np.ndarray, found_blob: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """A blob's pixels' colours in the background's light, as directions and lengths
+        (:func:`~physbench.video.appearance.colour_directions`)."""
+        _, u, v, _ = found_blob
+        raw = image[v.astype(np.intp), u.astype(np.intp)]
+        return colour_directions((raw - self.light.offset) / self.light.gain)
+
+    def _plan(
+        self,
+        i: int,
+        found_blob: tuple,
+        *,
+        alone: bool,
+        colours: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> _Plan:
         """Where to look for disc ``i``'s outline on a blob: from the blob's centroid where the
         blob is its alone and of its size, else from a mean shift over the blob's pixels within
         its radius, from the pixel nearest its prediction (its own part of a blob shared with a
-        rod, a hand or another ball), over the pixels of its colour where it has one (a ball
-        struck into a rack of other colours)."""
+        rod, a hand or another ball), over the pixels of its colour (``colours`` of the blob's
+        pixels, for a shared blob) where it has one (a ball struck into a rack of others)."""
         blob, u, v, w = found_blob
         s = self.states[i]
         pred = self.pred_uv[i]
@@ -809,9 +823,8 @@ class Tracker:
         if alone and 0.6 * expected <= blob.area <= 1.6 * expected:
             c = blob.centre
         else:
-            if s.look is not None:
-                raw = image[v.astype(np.intp), u.astype(np.intp)]
-                own = s.look.matches((raw - self.light.offset) / self.light.gain)
+            if s.look is not None and colours is not None:
+                own = s.look.matches(*colours)
                 if w[own].sum() >= 0.2 * expected:
                     u, v, w = u[own], v[own], w[own]
             c = self._shift(u, v, w, pred, r)
