@@ -90,7 +90,7 @@ class Light:
             return difference(image, plate)
         if index is None:
             index = plate_index(plate)
-        return difference(image, self.lut.ravel()[index])
+        return difference(image, self.lut.ravel().take(index))
 
 
 def plate_index(plate: np.ndarray) -> np.ndarray:
@@ -110,47 +110,48 @@ class LightMeter:
         self.v = rows.ravel().astype(np.float64)
         self.u = cols.ravel().astype(np.float64)
         self.flat = (rows * w + cols).ravel()
-        self.bg = background.reshape(-1, 3)[self.flat].astype(np.float64)
+        self.bg = np.ascontiguousarray(background.reshape(-1, 3)[self.flat].T, dtype=np.float64)
         # Clipped background pixels say nothing of a gain.
-        self.usable = ((self.bg > 2) & (self.bg < 253)).all(axis=1)
+        self.usable = ((self.bg > 2) & (self.bg < 253)).all(axis=0)
 
     def measure(self, image: np.ndarray, avoid: Sequence[tuple[float, float, float]] = ()) -> Light:
         """Called by the tracker once per frame: the light of ``image`` (``(H, W, 3)`` uint8),
         leaving out the pixels within ``radius`` of each ``(u, v, radius)`` in ``avoid`` (the
         predicted bodies)."""
-        y = image.reshape(-1, 3)[self.flat]
-        keep = self.usable & (y.max(axis=1) < 254)
+        y = image.reshape(-1, 3)[self.flat].T  # (3, n): a channel a row
+        keep = self.usable & (np.maximum(np.maximum(y[0], y[1]), y[2]) < 254)
         if len(avoid):
             b = np.asarray(avoid, dtype=float)
             near = (self.u[:, None] - b[:, 0]) ** 2 + (self.v[:, None] - b[:, 1]) ** 2
             keep &= (near > b[:, 2] ** 2).all(axis=1)
         if keep.sum() < 30:
             return Light.unchanged()
-        return _fit(self.bg[keep], y[keep].astype(np.float64))
+        return _fit(self.bg[:, keep], y[:, keep].astype(np.float64))
 
 
 def _fit(x: np.ndarray, y: np.ndarray) -> Light:
-    """``y ≈ gain * x + offset`` per channel (columns of ``(n, 3)``), by iteratively reweighted
+    """``y ≈ gain * x + offset`` per channel (rows of ``(3, n)``), by iteratively reweighted
     least squares with Tukey's biweight from the median ratio (the scale from its residuals):
     foreground the meter did not know of (a hand, a shadow) gets weight 0."""
-    gain = np.median(y / np.maximum(x, 1.0), axis=0)
+    gain = np.median(y / np.maximum(x, 1.0), axis=1)[:, None]
     r = y - gain * x
-    scale = TUKEY * np.maximum(1.4826 * np.median(np.abs(r), axis=0), 0.5)
-    spread = x.std(axis=0) >= MIN_SPREAD
-    offset = np.zeros(3)
+    scale = TUKEY * np.maximum(1.4826 * np.median(np.abs(r), axis=1), 0.5)[:, None]
+    spread = x.std(axis=1) >= MIN_SPREAD
+    offset = np.zeros((3, 1))
     w = np.ones_like(x)
     for _ in range(2):
         z = r / scale
         w = np.clip(1 - z * z, 0.0, None) ** 2
         # Weighted sums of 1, x, y, xx and xy per channel, at once.
-        sw, sx, sy, sxx, sxy = np.einsum(
-            "nc,knc->kc", w, np.stack([np.ones_like(x), x, y, x * x, x * y])
-        )
+        wx = w * x
+        sw, sx, sy = w.sum(axis=1), wx.sum(axis=1), (w * y).sum(axis=1)
+        sxx, sxy = (wx * x).sum(axis=1), (wx * y).sum(axis=1)
         det = sw * sxx - sx * sx
         sloped = (sw * sxy - sx * sy) / np.maximum(det, 1e-9)
-        gain = np.where(spread, sloped, sxy / np.maximum(sxx, 1e-9))
-        offset = np.where(spread, (sy - gain * sx) / np.maximum(sw, 1e-9), 0.0)
+        g = np.where(spread, sloped, sxy / np.maximum(sxx, 1e-9))
+        o = np.where(spread, (sy - g * sx) / np.maximum(sw, 1e-9), 0.0)
+        gain, offset = g[:, None], o[:, None]
         r = y - gain * x - offset
     r = np.abs(r)
-    sigma = 1.4826 * float(np.median(np.maximum(np.maximum(r[:, 0], r[:, 1]), r[:, 2])))
-    return Light(gain, offset, sigma, int((w > 0).all(axis=1).sum()))
+    sigma = 1.4826 * float(np.median(np.maximum(np.maximum(r[0], r[1]), r[2])))
+    return Light(gain[:, 0], offset[:, 0], sigma, int((w > 0).all(axis=0).sum()))

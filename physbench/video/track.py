@@ -239,6 +239,7 @@ class _Plan:
     mpp: float
     expected: float
     known: float | None = None
+    pixels: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # its colour's, if shared
 
 
 @dataclass(frozen=True)
@@ -823,11 +824,14 @@ class Tracker:
         if alone and 0.6 * expected <= blob.area <= 1.6 * expected:
             c = blob.centre
         else:
+            pixels = None
             if s.look is not None and colours is not None:
                 own = s.look.matches(*colours)
                 if w[own].sum() >= 0.2 * expected:
-                    u, v, w = u[own], v[own], w[own]
+                    u, v, w = pixels = u[own], v[own], w[own]
             c = self._shift(u, v, w, pred, r)
+            rays = Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0)
+            return _Plan(rays, mpp, expected, s.radius_m, pixels)
         return _Plan(Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0), mpp, expected, s.radius_m)
 
     def _fit_discs(
@@ -908,6 +912,8 @@ class Tracker:
             pose = plane_pose(u, v, w, self.cal)
             return _Found(pose.xy, blob.centre, pose, look, centroid=True)
         rf = fit.radius / plan.mpp
+        if plan.pixels is not None:  # its own colour's pixels of a shared blob
+            u, v, w = plan.pixels
         near = (u - fit.uv[0]) ** 2 + (v - fit.uv[1]) ** 2
         area = float(w[near <= (rf + 1.0) ** 2].sum())
         inner = near <= (0.6 * rf) ** 2
