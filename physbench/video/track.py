@@ -90,6 +90,8 @@ NOISE_K = 2.0
 UNMODELLED = 0.5
 #: How far a body's first move may depart from the scene's initial velocity, as a share of it.
 VELOCITY_PRIOR = 0.5
+#: An edge may be this share of the foreground threshold faint.
+EDGE_SHARE = 0.75
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
 SMALL_DISC = 5.0
@@ -383,7 +385,7 @@ class Tracker:
         self.frames = 0
         self.t0: float | None = None
         self.t_last = 0.0
-        self.low = self.high = 0.0
+        self.low = self.high = self.edge_low = 0.0
         self.contrast = 0.0  # the bodies' median contrast in the first frame's light
         self.scale0 = 1.0  # the first frame's gain
         self.max_gate = 0.5 * max(self.h, self.w)
@@ -472,6 +474,10 @@ class Tracker:
         contrast = self.contrast * self.light.scale / self.scale0
         self.low = max(self.light.threshold(), 0.2 * contrast)
         self.high = max(self.low + 1.0, 0.5 * contrast)
+        # An edge is placed by its own half-way point, so it may be fainter than what makes a
+        # blob: half the threshold, above 3 robust noise deviations (a lit limb nearly as bright
+        # as the wall).
+        self.edge_low = max(EDGE_SHARE * self.low, 3.0 * self.light.sigma, 8.0)
 
     # ----------------------------------------------------------------- one frame
 
@@ -686,11 +692,7 @@ class Tracker:
                         if int(alt) in taken or dist[j, alt] > gates[i]:
                             continue
                         blob = blobs[int(alt)]
-                        plan = (
-                            {i: self._plan(i, image, blob, alone=True)}
-                            if self.states[i].disc
-                            else {}
-                        )
+                        plan = {i: self._plan(i, blob, alone=True)} if self.states[i].disc else {}
                         fit = self._fit_discs(image, plan, window)
                         again = self._members(image, blob, [i], window, plan, fit)
                         if i in again:
@@ -853,7 +855,7 @@ class Tracker:
             (inside if ok and c[0] + m <= c0 + w - 1 else outside).append(i)
         fits: dict[int, DiscFit | None] = {}
         if inside:
-            edges = edge_points(diff, (r0, c0), [plans[i].rays for i in inside], self.low)
+            edges = edge_points(diff, (r0, c0), [plans[i].rays for i in inside], self.edge_low)
             mine = [plans[i] for i in inside]
             got = fit_discs(
                 edges,
@@ -883,7 +885,7 @@ class Tracker:
         diff = self.light.difference(
             image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1], self.bg_index[r0:r1, c0:c1]
         )
-        edges = edge_points(diff, (r0, c0), [rays], self.low)
+        edges = edge_points(diff, (r0, c0), [rays], self.edge_low)
         return fit_disc(edges, rays.radius, self.cal, plan.mpp, plan.known)
 
     def _disc(
