@@ -25,9 +25,9 @@
    (:mod:`~physbench.video.appearance`).
 5. **Unseen**: a body not found in a frame where it is in view has no row for that frame (nothing
    is filled in); the summary says from when to when it was lost, and a body unseen in more than
-   :data:`LOST_SHARE` of the frames where it was in view fails the tracking
-   (:class:`TrackLostError`) unless gaps are allowed. A body whose prediction leaves the view near
-   where it was last seen is out of view, not lost.
+   :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view fails the
+   tracking (:class:`TrackLostError`) unless gaps are allowed. A body whose prediction leaves the
+   view near where it was last seen is out of view, not lost.
 6. **Accuracy**: each track's noise is measured from its fifth differences in time (a smooth
    motion's are near zero), and the recording states ``max(floor, 2 x noise)`` in metres
    (:data:`DISC_ACCURACY_PX` for discs, :data:`ACCURACY_PX` for other bodies) for discover's
@@ -49,8 +49,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.errors import PhysbenchError, counted
+from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
+from physbench.video.accuracy import stated_accuracy
 from physbench.video.appearance import Appearance, Look, colour_directions
 from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
@@ -62,6 +63,7 @@ from physbench.video.detect import (
     split_pixels,
 )
 from physbench.video.motion import Motion
+from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import Light, LightMeter, plate_index
 from physbench.video.silhouette import DiscFit, Rays, edge_points, fit_disc, fit_discs
 
@@ -73,18 +75,6 @@ if TYPE_CHECKING:
 
 #: Ratio of a body's principal second moments above which its long axis gives its angle.
 ELONGATED = 1.3
-#: A body unseen in more than this share of the frames where it was in view fails the tracking
-#: (:class:`TrackLostError`; ``allow_gaps`` keeps the recording with its gaps).
-LOST_SHARE = 0.1
-#: The systematic accuracy (px) of a disc's centre fitted to its outline: what shading, a
-#: highlight, lossy coding and motion blur leave in it (measured: ``benchmarks/track_shading.py``,
-#: ``results/track/shading.json``).
-DISC_ACCURACY_PX = 0.25
-#: ... of other bodies' centroids: the arc a turning body sweeps in one exposure (a swinging arm
-#: 0.4-0.5 px RMS along its length; ``tests/video/test_track.py``).
-ACCURACY_PX = 0.5
-#: A track's stated accuracy is at least this many times its measured noise.
-NOISE_K = 2.0
 #: The acceleration a prediction cannot know (friction, drag, a push, a swing), as a share of the
 #: scene's gravity: the gate allows for it over the time since the body was last seen.
 UNMODELLED = 0.5
@@ -106,8 +96,8 @@ class BodyNotFoundError(TrackError):
 
 
 class TrackLostError(TrackError):
-    """A body lost for more than :data:`LOST_SHARE` of the frames where it was in view; the
-    tracking's :class:`TrackResult` is ``result``."""
+    """A body lost for more than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where
+    it was in view; the tracking's :class:`TrackResult` is ``result``."""
 
     def __init__(self, message: str, result: TrackResult) -> None:
         super().__init__(message)
@@ -158,27 +148,6 @@ def _area_centroid(pts: np.ndarray) -> np.ndarray:
 
 
 @dataclass
-class _Runs:
-    """Runs of consecutive frames in one condition (unseen, out of view) as ``(first, last)``
-    frame times, and how many frames."""
-
-    spans: list[tuple[float, float]] = field(default_factory=list)
-    frames: int = 0
-    open: bool = False
-
-    def mark(self, t: float) -> None:
-        if self.open:
-            self.spans[-1] = (self.spans[-1][0], t)
-        else:
-            self.spans.append((t, t))
-        self.open = True
-        self.frames += 1
-
-    def close(self) -> None:
-        self.open = False
-
-
-@dataclass
 class _State:
     """What the tracker knows of one body."""
 
@@ -204,8 +173,8 @@ class _State:
     rejected: int = 0  # detections whose appearance was not the body's
     centroids: int = 0  # a disc's frames measured by their centroid (no outline fitted)
     in_view: int = 0
-    unseen: _Runs = field(default_factory=_Runs)
-    out: _Runs = field(default_factory=_Runs)
+    unseen: Spans = field(default_factory=Spans)
+    out: Spans = field(default_factory=Spans)
     rows: list[tuple[float, float, float, float]] = field(default_factory=list)
     uv_rows: list[tuple[float, float, float]] = field(default_factory=list)
 
@@ -242,93 +211,6 @@ class _Plan:
     expected: float
     known: float | None = None
     pixels: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # its colour's, if shared
-
-
-@dataclass(frozen=True)
-class TrackSummary:
-    """How tracking went: ``frames`` read over ``duration`` s; per body the ``detections``
-    (frames with a measurement), the frames where it was ``in_view``, the spans ``(first, last)``
-    (s) of frames where it was in view but ``lost``, and those where it was ``out_of_view``; the
-    calibration's reprojection error (px), the processing speed (frames/s), the samples left out
-    at collisions (``contacts``), the detections ``rejected`` for not looking like the body,
-    each track's stated accuracy (px, ``accuracy_px``), and a disc's frames measured by their
-    ``centroids`` for want of an outline."""
-
-    frames: int
-    duration: float
-    detections: dict[str, int]
-    in_view: dict[str, int]
-    lost: dict[str, list[tuple[float, float]]]
-    reprojection_error: float
-    fps: float = 0.0
-    #: Per body, the samples left out because their exposure spans a collision
-    #: (:mod:`physbench.video.contacts`).
-    contacts: dict[str, int] = field(default_factory=dict)
-    out_of_view: dict[str, list[tuple[float, float]]] = field(default_factory=dict)
-    rejected: dict[str, int] = field(default_factory=dict)
-    accuracy_px: dict[str, float] = field(default_factory=dict)
-    #: Per disc, the frames measured by their centroid (no outline could be fitted).
-    centroids: dict[str, int] = field(default_factory=dict)
-
-    def unseen(self, body: str) -> int:
-        """Frames where ``body`` was in view but not found."""
-        return self.in_view.get(body, 0) - self.detections.get(body, 0)
-
-    def failures(self, share: float = LOST_SHARE) -> list[str]:
-        """One sentence per body unseen in more than ``share`` of the frames where it was in
-        view."""
-        out = []
-        for name in self.detections:
-            n, unseen = self.in_view.get(name, 0), self.unseen(name)
-            if n and unseen > share * n:
-                out.append(
-                    f"body {name!r} was lost in {unseen} of the {n} frames where it was in view "
-                    f"({unseen / n:.0%}, more than {share:.0%}): lost "
-                    f"{_lost_words(self.lost.get(name, []))}"
-                )
-        return out
-
-    def format(self) -> str:
-        """A few lines for a person."""
-        lines = [
-            f"tracked {counted(len(self.detections), 'body')} over "
-            f"{counted(self.frames, 'frame')} "
-            f"({self.duration:.2f} s) at {self.fps:.0f} frames/s; calibration reprojection "
-            f"error {self.reprojection_error:.2f} px"
-        ]
-        for name, n in self.detections.items():
-            view = self.in_view.get(name, self.frames)
-            where = "" if view == self.frames else " in view"
-            parts = [f"seen in {n}/{view} frames{where}"]
-            if self.lost.get(name):
-                parts.append(f"lost {_lost_words(self.lost[name])}")
-            if self.out_of_view.get(name):
-                parts.append(f"out of view {_lost_words(self.out_of_view[name])}")
-            if self.rejected.get(name):
-                parts.append(
-                    f"{counted(self.rejected[name], 'detection')} rejected (not its size or colour)"
-                )
-            if self.centroids.get(name):
-                parts.append(
-                    f"{counted(self.centroids[name], 'frame')} by the centroid (no outline fitted)"
-                )
-            if self.contacts.get(name):
-                parts.append(
-                    f"{counted(self.contacts[name], 'collision frame')} left out (the exposure "
-                    "spans the collision)"
-                )
-            if name in self.accuracy_px:
-                parts.append(f"accuracy {self.accuracy_px[name]:.2f} px")
-            lines.append(f"  {name:>8}: " + "; ".join(parts))
-        return "\n".join(lines)
-
-
-def _lost_words(spans: list[tuple[float, float]]) -> str:
-    """``from 0.33 to 3.33 s, at 4.00 s``."""
-    words = []
-    for a, b in spans:
-        words.append(f"at {a:.2f} s" if b - a < 1e-9 else f"from {a:.2f} to {b:.2f} s")
-    return ", ".join(words)
 
 
 @dataclass(frozen=True)
@@ -994,7 +876,9 @@ class Tracker:
             if not s.rows:
                 raise BodyNotFoundError(self._never_seen(s))
         pixels = {s.body.name: np.array(s.uv_rows, dtype=float) for s in self.states}
-        accuracy_px = {s.body.name: self._accuracy_px(s, pixels[s.body.name]) for s in self.states}
+        accuracy_px = {
+            s.body.name: stated_accuracy(pixels[s.body.name], disc=s.disc) for s in self.states
+        }
         accuracy_m = {
             name: accuracy_px[name] * self._coarsest(pixels[name]) for name in accuracy_px
         }
@@ -1066,13 +950,6 @@ class Tracker:
             "and velocity, --seed, --start and the calibration"
         )
 
-    def _accuracy_px(self, s: _State, uv: np.ndarray) -> float:
-        """The accuracy (px) a track states: its floor, or :data:`NOISE_K` times its measured
-        noise where that is larger."""
-        floor = DISC_ACCURACY_PX if s.disc else ACCURACY_PX
-        noise = track_noise(uv)
-        return max(floor, NOISE_K * noise) if math.isfinite(noise) else floor
-
     def _coarsest(self, tuv: np.ndarray) -> float:
         """The largest metres per pixel along an image track ``(t, u, v)``."""
         uv = tuv[:, 1:][np.isfinite(tuv[:, 1:]).all(axis=1)]
@@ -1080,28 +957,6 @@ class Tracker:
         if not len(points):
             return 0.0
         return max(self.cal.metres_per_pixel(p) for p in points)
-
-
-def track_noise(tuv: np.ndarray) -> float:
-    """The noise (px, a robust standard deviation per coordinate) of an image track ``(t, u,
-    v)`` from the fifth differences of runs of six evenly spaced samples: a smooth motion's are
-    near zero (a swinging arm's at 20 frames/s: a few hundredths of a pixel, where its third
-    differences are most of one), noise's have a variance 252 times its own. NaN with fewer
-    than three such runs."""
-    order = 5
-    if len(tuv) < order + 3:
-        return math.nan
-    t, uv = tuv[:, 0], tuv[:, 1:]
-    dt = np.diff(t)
-    step = float(np.median(dt))
-    even = np.abs(dt - step) <= 0.25 * step
-    run = np.ones(len(dt) - order + 1, dtype=bool)
-    for k in range(order):
-        run &= even[k : len(even) - order + 1 + k]
-    d5 = np.diff(uv, n=order, axis=0)[run]
-    if len(d5) < 3:
-        return math.nan
-    return 1.4826 * float(np.median(np.abs(d5))) / math.sqrt(252.0)
 
 
 def track_frames(
@@ -1115,7 +970,8 @@ def track_frames(
     progress: bool = False,
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
-    the clip's median). A body lost in more than :data:`LOST_SHARE` of the frames where it was in
+    the clip's median). A body lost in more than :data:`~physbench.video.outcome.LOST_SHARE` of
+    the frames where it was in
     view raises :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
@@ -1158,7 +1014,8 @@ def track_video(
     part of the video to track (s; recording time 0 is the first frame at or after ``start``);
     ``background``: an image of the empty scene (array or file; default: the median of the
     clip, which costs a second pass over the video); ``allow_gaps``: keep a body lost for more
-    than :data:`LOST_SHARE` of the frames where it was in view (else :class:`TrackLostError`)."""
+    than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view (else
+    :class:`TrackLostError`)."""
     from physbench.video.background import load_plate, median_background
     from physbench.video.reader import VideoError, VideoReader
 
