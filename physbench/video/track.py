@@ -971,8 +971,7 @@ def track_frames(
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
     the clip's median). A body lost in more than :data:`~physbench.video.outcome.LOST_SHARE` of
-    the frames where it was in
-    view raises :class:`TrackLostError` unless ``allow_gaps``."""
+    the frames where it was in view raises :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
     tracker = Tracker(scene, calibration, background, median=median)
