@@ -12,9 +12,10 @@ threshold where that is higher) is an edge point. Edge points map into the plane
 not bias the centre) and a circle is fitted to them; points far off the circle are dropped and the
 circle fitted again. A ray that never leaves the foreground (a rod joined to a pendulum's bob,
 a touching ball, an occluder), that leaves the image, or whose edge is far off the circle adds
-nothing, so the fit holds where part of the outline is hidden. Motion blur stretches the disc
-into a stadium, symmetric about the disc's pose at mid-exposure: its edge points' circle has
-that centre.
+nothing, so the fit holds where part of the outline is hidden. Motion blur stretches a fast disc
+into a stadium, symmetric about the disc's pose at mid-exposure: where the circle does not fit
+its edges, a stadium along the disc's motion is fitted instead (a fast ball's centre errors: 95 %
+within 0.24 px, 0.59 px with the circle).
 """
 
 from __future__ import annotations
@@ -31,6 +32,11 @@ if TYPE_CHECKING:
 
 #: Radial sampling step along a ray (px).
 STEP = 0.5
+#: A smeared disc's outline is fitted as a stadium where its circle leaves this RMS (px) in its
+#: edges (a still disc's: 0.1-0.2 px).
+STADIUM_RMS = 0.25
+#: Samples of foreground in a row that make the body's rim (1.5 px).
+RUN = 3
 #: Rays are this far apart (px) along the disc's outline: 43 rays on a 27 px disc, whose centre
 #: they fix to a few hundredths of a pixel.
 SPACING = 4.0
@@ -152,8 +158,13 @@ def edge_points(
     )
     p = _sample(diff, rows_, cols_)  # (n, m)
     above = (p >= low) & (np.arange(m)[None] < steps[:, None])
-    last = m - 1 - np.argmax(above[:, ::-1], axis=1)
-    ok &= above.any(axis=1) & (last < steps - 1)
+    # The outermost run of foreground at least RUN samples long ends at the edge: a speck of the
+    # wall's texture the light does not quite match, a pixel or so past the rim, is not it.
+    run = above[:, RUN - 1 :].copy()
+    for k in range(1, RUN):
+        run &= above[:, RUN - 1 - k : m - k]
+    last = m - 1 - np.argmax(run[:, ::-1], axis=1)
+    ok &= run.any(axis=1) & (last < steps - 1)
     # The edge's inner level is where the profile stops falling steeply, walking in from its
     # steepest point near the threshold crossing: the rim's own brightness, not the shading
     # further in (a lit sphere brightens inwards from a limb as dark as the wall).
@@ -259,6 +270,43 @@ def _circle_of_radius(
     return c
 
 
+def _stadium(
+    xy: np.ndarray, weight: np.ndarray, start: np.ndarray, r: float, along: np.ndarray
+) -> tuple[np.ndarray, float, float, np.ndarray]:
+    """The stadium a disc of radius about ``r`` smears into moving along the unit vector
+    ``along``: its centre (the disc's pose at mid-exposure) and radius, fitted to
+    edge points ``xy`` by weighted least squares on their distance to it (Gauss-Newton from
+    ``start``, twice, dropping points off it by more than 3 robust deviations); the RMS distance
+    of the points kept from it; and the mask of them."""
+    c = np.asarray(start, dtype=float).copy()
+    h, rr = 0.25 * r, r
+    keep = np.ones(len(xy), dtype=bool)
+    for round_ in range(2):
+        for _ in range(8):
+            q = xy - c
+            t = q @ along
+            ends = np.abs(t) > h
+            nearest = c + np.clip(t, -h, h)[:, None] * along
+            off = xy - nearest
+            dist = np.maximum(np.hypot(off[:, 0], off[:, 1]), 1e-12)
+            unit = off / dist[:, None]
+            jac = np.empty((len(xy), 4))
+            jac[:, :2] = -unit
+            jac[:, 2] = np.where(ends, -np.sign(t) * (unit @ along), 0.0)
+            jac[:, 3] = -1.0
+            res = dist - rr
+            jw = jac * (weight * keep)[:, None]
+            step = np.linalg.lstsq(jw.T @ jac + 1e-12 * np.eye(4), -(jw.T @ res), rcond=None)[0]
+            c += step[:2]
+            h, rr = max(h + step[2], 0.0), rr + step[3]
+            if abs(step).max() < 1e-6 * r:
+                break
+        if round_ == 0:
+            scale = 1.4826 * float(np.median(np.abs(res[keep])))
+            keep = np.abs(res) <= max(3.0 * scale, 1e-9)
+    return c, rr, float(np.sqrt(np.mean(res[keep] ** 2))), keep
+
+
 def _arc_gaps(theta: np.ndarray, g: _Groups) -> np.ndarray:
     """Each group's largest angle (rad) between neighbouring rays ``theta`` (increasing within
     a group) round the circle; 2 pi for a group of fewer than two."""
@@ -278,13 +326,17 @@ def fit_discs(
     calibration: Calibration,
     mpp: Sequence[float],
     known: Sequence[float | None],
+    along: Sequence[np.ndarray | None] | None = None,
 ) -> list[DiscFit | None]:
     """Each disc's centre from its :class:`Edges` (``owner``: the index into ``radii``), fitted
     by a circle on the plane (see the module docstring), all discs at once; ``mpp``: metres per
     pixel at each. ``None`` for a disc whose outline is not a disc's of about its radius (px)
     (too few edges, too little of the outline, another radius). ``known``: a disc's radius on
     the plane (m) as fitted in earlier frames, for an outline seen over too little of its circle
-    to fit one freely (then fitted with that radius: ``fixed``).
+    to fit one freely (then fitted with that radius: ``fixed``). ``along``: for a disc moving
+    fast enough to be smeared by the exposure, the unit direction of its motion on the plane;
+    its outline is then fitted as the stadium the smear makes, whose centre is the disc's pose
+    at mid-exposure (a circle fitted to a stadium's edges leans to whichever end kept more).
 
     An edge nearer the rays' origin than half the radius, or nearer the fitted centre than 70 %
     of the radius, is not the outline (a highlight's rim, where the rest of a lit side is as
@@ -328,6 +380,14 @@ def fit_discs(
             r[d], fixed[d] = known[d], True
     res = np.hypot(*(xy - centre[own]).T) - r[own]
     rms = np.sqrt(g.total(np.where(keep, res * res, 0.0)) / np.maximum(kept, 1)) / mpp_
+    for d in range(count):
+        # A stadium where the circle does not fit its edges: a smear, not a still disc.
+        if along is None or along[d] is None or fixed[d] or kept[d] < 6 or rms[d] < STADIUM_RMS:
+            continue
+        mine = own == d
+        c, rd, spread, inner = _stadium(xy[mine], weight[mine], centre[d], r[d], along[d])
+        centre[d], r[d], rms[d] = c, rd, spread / mpp_[d]
+        kept[d] = inner.sum()
     good = (kept >= 6) & ((gaps <= MAX_ARC_GAP) | fixed) & np.isfinite(r)
     good &= (0.5 * radius * mpp_ <= r) & (r <= 2.5 * radius * mpp_)
     fits: list[DiscFit | None] = [None] * count

@@ -82,6 +82,9 @@ UNMODELLED = 0.5
 VELOCITY_PRIOR = 0.5
 #: An edge may be this share of the foreground threshold faint.
 EDGE_SHARE = 0.75
+#: A disc that moves more than this share of its radius in a frame interval is fitted as the
+#: stadium its motion blur makes.
+SMEAR = 0.2
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
 SMALL_DISC = 5.0
@@ -745,6 +748,7 @@ class Tracker:
                 self.cal,
                 [p.mpp for p in mine],
                 [p.known for p in mine],
+                [self._smeared(i) for i in inside],
             )
             fits.update(zip(inside, got, strict=True))
         for i in outside:
@@ -755,6 +759,16 @@ class Tracker:
                 again = replace(plans[i], rays=replace(rays, centre=fit.uv))
                 fits[i] = self._fit_one(image, again)
         return fits
+
+    def _smeared(self, i: int) -> np.ndarray | None:
+        """The unit direction of body ``i``'s motion on the plane where one frame interval of it
+        is more than :data:`SMEAR` of its radius (an exposure of half the interval smears it into
+        a stadium), else ``None``."""
+        s = self.states[i]
+        speed = float(np.hypot(*s.v))
+        if s.seen < 2 or speed / self.scene.fps < SMEAR * s.body.shape.extent():
+            return None
+        return s.v / speed
 
     def _fit_one(self, image: np.ndarray, plan: _Plan) -> DiscFit | None:
         """One disc's outline fit on a crop of its own."""
