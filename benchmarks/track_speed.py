@@ -39,6 +39,16 @@ def _timed(fn, *args, **kwargs) -> tuple[float, float]:
     return time.process_time() - c, time.perf_counter() - w
 
 
+def _track(path: Path, scene, cal, background):
+    """``track_video``, gaps allowed: a ball of this rack comes to rest for over half of the clip,
+    where the median background holds it (the tracker says so; the speed is what is measured)."""
+    import inspect
+
+    gaps = "allow_gaps" in inspect.signature(track_video).parameters  # older trackers had none
+    options = {"allow_gaps": True} if gaps else {}
+    return track_video(path, scene, cal, background=background, **options)
+
+
 def _decode(path: Path) -> None:
     for _ in VideoReader(path).frames():
         pass
@@ -64,10 +74,10 @@ def main() -> None:
                 bg = plate if background == "plate" else None
                 track, decode = [], []
                 for _ in range(args.repeats):
-                    track.append(_timed(track_video, path, scene, cal, background=bg))
+                    track.append(_timed(_track, path, scene, cal, bg))
                     decode.append(_timed(_decode, path))
                 tracemalloc.start()
-                res = track_video(path, scene, cal, background=bg)
+                res = _track(path, scene, cal, bg)
                 peak = tracemalloc.get_traced_memory()[1] / 2**20
                 tracemalloc.stop()
                 n = res.summary.frames

@@ -119,6 +119,20 @@ class Edges:
             self.owner[keep],
         )
 
+    @staticmethod
+    def join(parts: Sequence[Edges], discs: Sequence[int]) -> Edges:
+        """The edges of several calls of :func:`edge_points` (for ``discs[k]`` discs each) as
+        one, their discs numbered on in order."""
+        shift = np.concatenate([[0], np.cumsum(discs)[:-1]]).astype(np.intp)
+        return Edges(
+            np.concatenate([p.uv for p in parts]).reshape(-1, 2),
+            np.concatenate([p.theta for p in parts]),
+            np.concatenate([p.contrast for p in parts]),
+            np.concatenate([p.width for p in parts]),
+            np.concatenate([p.reach for p in parts]),
+            np.concatenate([p.owner + k for p, k in zip(parts, shift, strict=True)]),
+        )
+
     def of(self, disc: int) -> Edges:
         """The edges of disc ``disc``."""
         return self.select(self.owner == disc)

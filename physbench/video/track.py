@@ -65,7 +65,7 @@ from physbench.video.detect import (
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import Light, LightMeter, plate_index
-from physbench.video.silhouette import DiscFit, Rays, edge_points, fit_disc, fit_discs
+from physbench.video.silhouette import DiscFit, Edges, Rays, edge_points, fit_disc, fit_discs
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -80,6 +80,9 @@ ELONGATED = 1.3
 UNMODELLED = 0.5
 #: How far a body's first move may depart from the scene's initial velocity, as a share of it.
 VELOCITY_PRIOR = 0.5
+#: A body's appearance is learnt from detections within this factor of the size the scene gives
+#: it (until the first, no detection of it is judged by its looks).
+PLAUSIBLE = 1.8
 #: An edge may be this share of the foreground threshold faint.
 EDGE_SHARE = 0.75
 #: A disc that moves more than this share of its radius in a frame interval is fitted as the
@@ -443,10 +446,14 @@ class Tracker:
         s.xy, s.t, s.last_uv = xy, t, found.uv
         s.rows.append((t, float(xy[0]), float(xy[1]), math.nan if angle is None else angle))
         s.uv_rows.append((t, float(found.uv[0]), float(found.uv[1])))
-        if s.look is None:
-            s.look = Appearance.first(found.look)
-        else:
-            s.look.update(found.look)
+        # A body's looks are learnt only from detections of about the size the scene gives it:
+        # part of a body that a median background holds, or a body with a hand, would teach it
+        # a wrong colour too.
+        if 1 / PLAUSIBLE <= found.look.size <= PLAUSIBLE:
+            if s.look is None:
+                s.look = Appearance.first(found.look)
+            else:
+                s.look.update(found.look)
         s.centroids += found.centroid
         if found.radius is not None:
             s.radius_m = (
@@ -541,13 +548,15 @@ class Tracker:
         t: float,
         visible: list[bool],
     ) -> dict[int, _Found]:
-        found: dict[int, _Found] = {}
+        """Every visible body's measurement in this frame: blobs found in the windows around
+        the predictions, assigned to bodies, discs fitted to their outlines (all of the frame's
+        at once), each body measured on its blob."""
         ids = [i for i, v in enumerate(visible) if v]
+        windows, plans = [], {}
         for group, (r0, r1, c0, c1) in self._windows(ids, reach):
+            crop = (slice(r0, r1), slice(c0, c1))
             window = (
-                self.light.difference(
-                    image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1], self.bg_index[r0:r1, c0:c1]
-                ),
+                self.light.difference(image[crop], self.bg[crop], self.bg_index[crop]),
                 (r0, c0),
             )
             small = min(self.states[i].area for i in group)
@@ -557,16 +566,20 @@ class Tracker:
             if not blobs:
                 continue
             owner, dist = self._assign(group, blobs, gates)
-            plans = {}
             for c, members in owner.items():
                 discs = [i for i in members if self.states[i].disc]
                 colours = self._colours(image, blobs[c]) if len(members) > 1 and discs else None
                 for i in discs:
-                    plans[i] = self._plan(i, blobs[c], alone=len(members) == 1, colours=colours)
-            fits = self._fit_discs(image, plans, window)
+                    plan = self._plan(i, blobs[c], alone=len(members) == 1, colours=colours)
+                    plans[i] = (plan, window)
+            windows.append((group, window, blobs, owner, dist))
+        fits = self._fit_discs(image, plans)
+        found: dict[int, _Found] = {}
+        for group, window, blobs, owner, dist in windows:
+            mine = {i: p for i, (p, _) in plans.items() if i in group}
             taken = set(owner)
             for c, members in owner.items():
-                got = self._members(image, blobs[c], members, window, plans, fits)
+                got = self._members(image, blobs[c], members, window, mine, fits)
                 found.update(got)
                 for i in members:
                     if i in got:
@@ -578,7 +591,7 @@ class Tracker:
                             continue
                         blob = blobs[int(alt)]
                         plan = {i: self._plan(i, blob, alone=True)} if self.states[i].disc else {}
-                        fit = self._fit_discs(image, plan, window)
+                        fit = self._fit_discs(image, {k: (p, window) for k, p in plan.items()})
                         again = self._members(image, blob, [i], window, plan, fit)
                         if i in again:
                             found[i] = again[i]
@@ -724,39 +737,44 @@ class Tracker:
     def _fit_discs(
         self,
         image: np.ndarray,
-        plans: dict[int, _Plan],
-        window: tuple[np.ndarray, tuple[int, int]],
+        plans: dict[int, tuple[_Plan, tuple[np.ndarray, tuple[int, int]]]],
     ) -> dict[int, DiscFit | None]:
-        """Each planned disc fitted to its outline
-        (:func:`~physbench.video.silhouette.fit_disc`): the rays of those inside the search
-        window all at once on its difference, the others on crops of their own; a fit far
-        from where its rays started is fitted again from its centre."""
-        diff, (r0, c0) = window
-        h, w = diff.shape
-        inside, outside = [], []
-        for i, plan in plans.items():
+        """Each planned disc fitted to its outline (:func:`~physbench.video.silhouette.fit_discs`,
+        all at once): the rays of those inside their search window on its difference, the
+        others on crops of their own; a fit far from where its rays started is fitted again
+        from its centre."""
+        inside, outside, found = [], [], []
+        for i, (plan, (diff, (r0, c0))) in plans.items():
             c, m = plan.rays.centre, plan.rays.reach + 2.0
+            h, w = diff.shape
             ok = c[1] - m >= r0 and c[0] - m >= c0 and c[1] + m <= r0 + h - 1
             (inside if ok and c[0] + m <= c0 + w - 1 else outside).append(i)
+        by_window: dict[int, list[int]] = {}
+        for i in inside:
+            by_window.setdefault(id(plans[i][1][0]), []).append(i)
+        for members in by_window.values():
+            diff, origin = plans[members[0]][1]
+            rays = [plans[i][0].rays for i in members]
+            found.append(edge_points(diff, origin, rays, self.edge_low))
+        order = [i for members in by_window.values() for i in members]
         fits: dict[int, DiscFit | None] = {}
-        if inside:
-            edges = edge_points(diff, (r0, c0), [plans[i].rays for i in inside], self.edge_low)
-            mine = [plans[i] for i in inside]
+        if order:
+            mine = [plans[i][0] for i in order]
             got = fit_discs(
-                edges,
+                Edges.join(found, [len(members) for members in by_window.values()]),
                 [p.rays.radius for p in mine],
                 self.cal,
                 [p.mpp for p in mine],
                 [p.known for p in mine],
-                [self._smeared(i) for i in inside],
+                [self._smeared(i) for i in order],
             )
-            fits.update(zip(inside, got, strict=True))
+            fits.update(zip(order, got, strict=True))
         for i in outside:
-            fits[i] = self._fit_one(image, plans[i])
+            fits[i] = self._fit_one(image, plans[i][0])
         for i, fit in fits.items():
-            rays = plans[i].rays
+            rays = plans[i][0].rays
             if fit is not None and float(np.hypot(*(fit.uv - rays.centre))) > 0.25 * rays.radius:
-                again = replace(plans[i], rays=replace(rays, centre=fit.uv))
+                again = replace(plans[i][0], rays=replace(rays, centre=fit.uv))
                 fits[i] = self._fit_one(image, again)
         return fits
 
@@ -1000,10 +1018,16 @@ def track_frames(
     result = tracker.result(fps=fps)
     failures = result.summary.failures()
     if failures and not allow_gaps:
+        held = (
+            "; the background is the clip's median, which holds a body that stays put for over "
+            "half of the clip: film the empty scene and give it as --background"
+            if median
+            else ""
+        )
         raise TrackLostError(
             "; ".join(failures) + ". A track with such gaps is not the motion; find why in a "
             "--preview (an occluder, too little contrast, a body leaving the view), or pass "
-            "--allow-gaps (allow_gaps=True) to keep the recording with its gaps",
+            f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{held}",
             result,
         )
     return result
