@@ -57,7 +57,9 @@ class RunConfig:
     (and a simulated observation) simulates besides the scene's physics, each
     ``NAME[:KEY=NUMBER,...]`` (:func:`~physbench.components.make_effect`), whose parameters
     ``params`` may name by key (``linear_drag.c``) besides gravity and the camera's
-    (:func:`~physbench.unknowns.scene_parameters`)."""
+    (:func:`~physbench.unknowns.scene_parameters`); ``allow_gaps``: keep a video's
+    tracks where a body was lost for more than the tracker's share of the clip (else that is an
+    error)."""
 
     scene: str | None = DEFAULT_SCENE
     params: tuple[str, ...] = ("mass",)
@@ -83,6 +85,7 @@ class RunConfig:
     video_start: float | None = None
     video_end: float | None = None
     effects: tuple[str, ...] = ()
+    allow_gaps: bool = False
 
     def __post_init__(self) -> None:
         """Refuse a numeric setting outside its range (:mod:`physbench.numeric`), NaN and the
@@ -149,6 +152,7 @@ _LATER = (
     "video_start",
     "video_end",
     "effects",
+    "allow_gaps",
 )
 
 
@@ -176,6 +180,7 @@ def _check_observation(config: RunConfig) -> None:
         "--background": config.background,
         "--start": config.video_start,
         "--end": config.video_end,
+        "--allow-gaps": config.allow_gaps or None,
     }
     if config.observer_options and not config.observer:
         raise PhysbenchError(
@@ -356,6 +361,7 @@ def make_observation(
             start=config.video_start,
             end=config.video_end,
             marked=marked,
+            allow_gaps=config.allow_gaps,
         )
     simulator = create("simulator", config.observer_engine)
     if config.observer:

@@ -339,7 +339,8 @@ def make_renderer_from(args: argparse.Namespace) -> Any:
 
 def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
     """The flags that say how to read a camera's video: ``--calibration``, ``--background``,
-    ``--start``, ``--end`` (the same in ``track``, ``run --video`` and ``discover VIDEO``)."""
+    ``--start``, ``--end``, ``--allow-gaps`` (the same in ``track``, ``run --video`` and
+    ``discover VIDEO``)."""
     group.add_argument(
         "--calibration",
         default=None,
@@ -365,4 +366,10 @@ def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
         default=None,
         metavar="S",
         help="stop at S seconds into the video",
+    )
+    group.add_argument(
+        "--allow-gaps",
+        action="store_true",
+        help="keep the tracks of a body lost in more than a tenth of the frames where it was in "
+        "view (default: that is an error, which says from when to when it was lost)",
     )

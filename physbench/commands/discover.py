@@ -228,6 +228,7 @@ def _runs(args: argparse.Namespace) -> list[Any]:
         start=args.start,
         end=args.end,
         track_out=args.track_out,
+        allow_gaps=args.allow_gaps,
         progress=show_progress(args),
     )
     if args.track_out:

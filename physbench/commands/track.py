@@ -41,7 +41,7 @@ def main(args: argparse.Namespace) -> int:
     from physbench.recording import write_recordings
     from physbench.scenes import resolve_scene
     from physbench.video.overlay import OVERLAY_SUFFIXES, write_overlay
-    from physbench.video.track import track_video
+    from physbench.video.track import TrackLostError, track_video
 
     video = Path(args.video)
     for flag, value in (("--out", args.out), ("--preview", args.preview)):
@@ -55,15 +55,25 @@ def main(args: argparse.Namespace) -> int:
         )
     scene = resolve_scene(args.scene, args.seed).validate()
     calibration = load_calibration(args.calibration) if args.calibration else None
-    result = track_video(
-        video,
-        scene,
-        calibration,
-        start=args.start,
-        end=args.end,
-        background=args.background,
-        progress=show_progress(args),
-    )
+    try:
+        result = track_video(
+            video,
+            scene,
+            calibration,
+            start=args.start,
+            end=args.end,
+            background=args.background,
+            allow_gaps=args.allow_gaps,
+            progress=show_progress(args),
+        )
+    except TrackLostError as exc:
+        # A failure: no recording; the summary and a preview, if asked, show what was lost.
+        if not args.quiet:
+            print(exc.result.summary.format())
+        if args.preview:
+            write_overlay(args.preview, video, exc.result.pixels, start=args.start, end=args.end)
+            wrote(args.preview)
+        raise
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     write_recordings(args.out, result.recording)
     if not args.quiet:

@@ -95,14 +95,16 @@ def load_runs(
     start: float | None = None,
     end: float | None = None,
     track_out: str | Path | None = None,
+    allow_gaps: bool = False,
     progress: bool = False,
 ) -> list[Run]:
     """Runs from a recording file (``.csv``: tracked trajectories, one run per ``run`` label;
     ``.npz``: observed frames under key ``frames``; a video file or a folder of images: tracked
     first, see :func:`~physbench.video.track.track_video`) and a scene (object or ``.toml`` file)
     that every run shares. ``run`` keeps one run of a multi-run CSV. ``calibration``,
-    ``background``, ``start`` and ``end`` apply to a video only; ``track_out`` writes its tracks as
-    a recording CSV."""
+    ``background``, ``start``, ``end`` and ``allow_gaps`` apply to a video only (a body lost in
+    more than the tracker's share of its frames is an error unless ``allow_gaps``);
+    ``track_out`` writes its tracks as a recording CSV."""
     from physbench.scene_toml import load_scene
     from physbench.video.reader import VIDEO_SUFFIXES, is_video
 
@@ -121,6 +123,7 @@ def load_runs(
         "start": start,
         "end": end,
         "track_out": track_out,
+        "allow_gaps": allow_gaps or None,
     }
     stray_given = [k for k, v in stray.items() if v is not None]
     if stray_given and not video:
@@ -130,7 +133,17 @@ def load_runs(
         )
     if video:
         return [
-            _video_run(path, sc, calibration, background, start, end, track_out, progress=progress)
+            _video_run(
+                path,
+                sc,
+                calibration,
+                background,
+                start,
+                end,
+                track_out,
+                allow_gaps=allow_gaps,
+                progress=progress,
+            )
         ]
     suffix = path.suffix.lower()
     if suffix == ".csv":
@@ -166,6 +179,7 @@ def _video_run(
     end: float | None,
     track_out: str | Path | None,
     *,
+    allow_gaps: bool,
     progress: bool,
 ) -> Run:
     """Track the scene's bodies through a video into one run; the summary goes to stderr."""
@@ -177,7 +191,14 @@ def _video_run(
 
     cal = load_calibration(calibration) if isinstance(calibration, str | Path) else calibration
     tracked = track_video(
-        path, scene, cal, start=start, end=end, background=background, progress=progress
+        path,
+        scene,
+        cal,
+        start=start,
+        end=end,
+        background=background,
+        allow_gaps=allow_gaps,
+        progress=progress,
     )
     if progress:
         print(tracked.summary.format(), file=sys.stderr)

@@ -1,9 +1,11 @@
-"""How well a tracker followed a known motion: centre errors in pixels and identity swaps, against
-a camera renderer's projection of the simulated positions. Used by the tracking tests and
-``benchmarks/track_accuracy.py``."""
+"""How accurate a track is: what the tracker states from its own measurements
+(:func:`stated_accuracy`, from a track's noise), and, where the motion is known, its centre
+errors in pixels and identity swaps against a camera renderer's projection of the simulated
+positions (used by the tracking tests and ``benchmarks/track_accuracy.py``)."""
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -42,3 +44,45 @@ def pixel_errors(
                 theirs = true_pixels(scene, traj, camera, other, rows[:, 0])
                 swaps += int(np.count_nonzero(np.hypot(*(rows[:, 1:] - theirs).T) < mine))
     return np.concatenate(errors), swaps
+
+
+#: The systematic accuracy (px) of a disc's centre fitted to its outline: what shading, a
+#: highlight, lossy coding and motion blur leave in it (measured: ``benchmarks/track_shading.py``,
+#: ``results/track/shading.json``).
+DISC_ACCURACY_PX = 0.25
+#: ... of other bodies' centroids: the arc a turning body sweeps in one exposure (a swinging arm
+#: 0.4-0.5 px RMS along its length; ``tests/video/test_track.py``).
+ACCURACY_PX = 0.5
+#: A track's stated accuracy is at least this many times its measured noise.
+NOISE_K = 2.0
+
+
+def stated_accuracy(tuv: np.ndarray, *, disc: bool) -> float:
+    """The accuracy (px) the tracker states for an image track ``(t, u, v)``: its floor
+    (:data:`DISC_ACCURACY_PX` for a disc, :data:`ACCURACY_PX` otherwise), or :data:`NOISE_K`
+    times its measured noise (:func:`track_noise`) where that is larger."""
+    floor = DISC_ACCURACY_PX if disc else ACCURACY_PX
+    noise = track_noise(tuv)
+    return max(floor, NOISE_K * noise) if math.isfinite(noise) else floor
+
+
+def track_noise(tuv: np.ndarray) -> float:
+    """The noise (px, a robust standard deviation per coordinate) of an image track ``(t, u,
+    v)`` from the fifth differences of runs of six evenly spaced samples: a smooth motion's are
+    near zero (a swinging arm's at 20 frames/s: a few hundredths of a pixel, where its third
+    differences are most of one), noise's have a variance 252 times its own. NaN with fewer
+    than three such runs."""
+    order = 5
+    if len(tuv) < order + 3:
+        return math.nan
+    t, uv = tuv[:, 0], tuv[:, 1:]
+    dt = np.diff(t)
+    step = float(np.median(dt))
+    even = np.abs(dt - step) <= 0.25 * step
+    run = np.ones(len(dt) - order + 1, dtype=bool)
+    for k in range(order):
+        run &= even[k : len(even) - order + 1 + k]
+    d5 = np.diff(uv, n=order, axis=0)[run]
+    if len(d5) < 3:
+        return math.nan
+    return 1.4826 * float(np.median(np.abs(d5))) / math.sqrt(252.0)

@@ -4,8 +4,9 @@ A frame exposed while a ball bounces averages two motions into one blurred V, wh
 neither pose; fitted as a position, it pulls the restitution and every extrapolation after it (a
 filmed bouncing ball without any hidden effect was fitted 4x better on held-out frames with an
 invented velocity-dependent restitution until its four contact frames were left out). Such a
-sample is where the track's acceleration departs from gravity by more than free flight and
-tracking noise allow: a collision changes the velocity within one frame interval.
+sample is where the track's acceleration departs from what the scene explains (gravity, and the
+forces the scene applies) by more than free flight and tracking noise allow: a collision changes
+the velocity within one frame interval.
 """
 
 from __future__ import annotations
@@ -21,12 +22,18 @@ COLLISION_SIGMA = 6.0
 
 
 def contact_samples(
-    t: np.ndarray, xy: np.ndarray, gravity: np.ndarray, accuracy: float
+    t: np.ndarray,
+    xy: np.ndarray,
+    gravity: np.ndarray,
+    accuracy: float,
+    expected: np.ndarray | None = None,
 ) -> np.ndarray:
     """Called by the tracker on each free body's track when it writes the recording: a mask of
     the samples ``(t, xy)`` (s, m) at a collision, given the scene's ``gravity`` (m/s², a
-    vector) and the sensor's ``accuracy`` (m). One sample per collision, the one nearest it (the
-    largest departure among its neighbours); the first and last samples are never marked."""
+    vector), the sensor's ``accuracy`` (m) and the accelerations the scene explains at each
+    inner sample (``expected``, ``(n - 2, 2)`` m/s²: gravity and the scene's forces; default
+    gravity alone). One sample per collision, the one nearest it (the largest departure among its
+    neighbours); the first and last samples are never marked."""
     n = len(t)
     mask = np.zeros(n, dtype=bool)
     if n < 3:
@@ -34,7 +41,8 @@ def contact_samples(
     dt = np.diff(t)
     v = np.diff(xy, axis=0) / dt[:, None]
     a = 2 * np.diff(v, axis=0) / (dt[1:] + dt[:-1])[:, None]
-    excess = np.hypot(*(a - np.asarray(gravity, dtype=float)).T)
+    known = np.asarray(gravity, dtype=float) if expected is None else expected
+    excess = np.hypot(*(a - known).T)
     noise = accuracy * math.sqrt(6.0) / (dt[1:] * dt[:-1])
     limit = np.maximum(COLLISION_G * float(np.hypot(*gravity)), COLLISION_SIGMA * noise)
     over = excess > limit

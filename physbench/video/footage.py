@@ -91,22 +91,19 @@ def video_observation(
     start: float | None = None,
     end: float | None = None,
     marked: Iterable[str] = (),
+    allow_gaps: bool = False,
 ) -> Observation:
     """The observation of a video file in ``renderer``'s frames (see the module docstring).
     ``calibration``: a :class:`~physbench.calibration.Calibration` or a TOML file (default:
     ``scene.bounds`` fill the frame); ``background``: an image of the empty scene (array or file;
-    default: the video's median)."""
+    default: the video's median); ``allow_gaps``: keep tracks where a body was lost for more
+    than the tracker's share of the clip (else :class:`~physbench.video.track.TrackLostError`)."""
     from physbench.calibration import load_calibration
     from physbench.observation import Observation
     from physbench.video.background import load_plate, median_background
+    from physbench.video.photometry import LightMeter
     from physbench.video.reader import VideoReader
-    from physbench.video.segment import (
-        Segmenter,
-        body_threshold,
-        difference,
-        fill_holes,
-        noise_threshold,
-    )
+    from physbench.video.segment import Segmenter, body_threshold, fill_holes
     from physbench.video.track import bounds_calibration, track_video
 
     reader = VideoReader(path, start=start, end=end, fps=scene.fps)
@@ -117,7 +114,15 @@ def video_observation(
         calibration = bounds_calibration(scene, (info.height, info.width))
     if isinstance(background, str | Path):
         background = load_plate(background)
-    tracked = track_video(path, scene, calibration, start=start, end=end, background=background)
+    tracked = track_video(
+        path,
+        scene,
+        calibration,
+        start=start,
+        end=end,
+        background=background,
+        allow_gaps=allow_gaps,
+    )
     recording = tracked.recording
     if background is None:
         background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
@@ -139,14 +144,20 @@ def video_observation(
     views: dict[str | None, np.ndarray] = {
         b: np.zeros(expected, np.float32) for b in (None, *marked)
     }
-    floor = None
     hole = _largest_hole(scene, calibration)
+    # Each frame in its own light (a drifting light, a median background): see
+    # physbench.video.photometry.
+    meter = LightMeter(background)
+    reach = [2 * b.shape.extent() for b in scene.bodies]
     for k, fr, t in scene_frames(reader.frames(), times, what=str(path)):
-        if floor is None:
-            floor = noise_threshold(fr.image, background)
         poses = poses_at(recording, scene, t)
-        diff = difference(fr.image, background)
-        threshold = body_threshold(diff, calibration.to_image(poses[:, :2]), floor)
+        uv = calibration.to_image(poses[:, :2])
+        mpp = calibration.metres_per_pixel(uv[0])
+        light = meter.measure(
+            fr.image, [(u, v, r / mpp + 5) for (u, v), r in zip(uv, reach, strict=True)]
+        )
+        diff = light.difference(fr.image, background)
+        threshold = body_threshold(diff, uv, light.threshold())
         cov = seg.coverage(fill_holes(diff > threshold, hole).astype(np.float32), poses)
         for b, arr in views.items():
             arr[k] = seg.frame(cov, b)

@@ -13,7 +13,7 @@ memory whole; ``start`` and ``end`` (seconds) trim it.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -143,20 +143,26 @@ class VideoReader:
 
     # ----------------------------------------------------------------- frames
 
-    def frames(self) -> Iterator[Frame]:
+    def frames(self, select: Callable[[int], bool] | None = None) -> Iterator[Frame]:
         """The frames inside ``[start, end]``, decoded one at a time, with their times (s from the
-        first frame of the file). Raises :class:`VideoError` for a file that cannot be decoded,
-        and when no frame lies inside the trim."""
+        first frame of the file). ``select(index)``: yield only the frames it accepts (the others
+        are still decoded, as a video's later frames need them, but not converted to images).
+        Raises :class:`VideoError` for a file that cannot be decoded, and when no frame lies
+        inside the trim."""
         count = 0
-        for frame in self._images() if self.images else self._decode():
+
+        def chosen(k: int) -> bool:
+            nonlocal count
             count += 1
-            yield frame
+            return select is None or select(k)
+
+        yield from self._images(chosen) if self.images else self._decode(chosen)
         if count == 0:
             span = f" between {self.start:g} and {self.end:g} s" if self.end else ""
             after = f" after {self.start:g} s" if self.start and not self.end else ""
             raise VideoError(f"video {str(self.path)!r} has no frames{span}{after}")
 
-    def _images(self) -> Iterator[Frame]:
+    def _images(self, select: Callable[[int], bool]) -> Iterator[Frame]:
         assert self.fps is not None
         k = 0
         for i, p in enumerate(self.images):
@@ -165,7 +171,8 @@ class VideoReader:
                 continue
             if self.end is not None and t > self.end + 1e-9:
                 break
-            yield Frame(k, t, self._image(p))
+            if select(k):
+                yield Frame(k, t, self._image(p))
             k += 1
 
     def _image(self, p: Path) -> np.ndarray:
@@ -194,7 +201,7 @@ class VideoReader:
             raise VideoError(f"{str(self.path)!r}: its video codec is not supported")
         return stream
 
-    def _decode(self) -> Iterator[Frame]:
+    def _decode(self, select: Callable[[int], bool]) -> Iterator[Frame]:
         av = load_av()
         with self._open() as container:
             stream = self._stream(container)
@@ -215,7 +222,8 @@ class VideoReader:
                         continue
                     if self.end is not None and t > self.end + 1e-9:
                         break
-                    yield Frame(k, t, frame.to_ndarray(format="rgb24"))
+                    if select(k):
+                        yield Frame(k, t, frame.to_ndarray(format="rgb24"))
                     k += 1
             except av.error.FFmpegError as exc:
                 raise VideoError(

@@ -2,19 +2,36 @@
 
 1. **Background**: a plate of the empty scene, or the median of the clip
    (:mod:`~physbench.video.background`).
-2. **Start**: the scene's initial body positions, projected into the first frame through the
-   calibration, say where to look; each body takes the blob found near its projection (a body with
-   none is a :class:`TrackError` that names it and the pixel where it was expected). The bodies'
-   contrast there sets the thresholds (:mod:`~physbench.video.detect`).
-3. **Each frame**: a :class:`Tracker` predicts every body (constant velocity plus the scene's
-   gravity for a free body, in scene metres), looks only in a window around each prediction (one
-   window for bodies whose windows overlap), gates candidates by a radius that grows with the
-   body's size and speed, and assigns blobs to bodies optimally
-   (:func:`scipy.optimize.linear_sum_assignment`). A body left without a blob whose neighbour's blob
-   is too big for one body shares that blob (:func:`~physbench.video.detect.split_blob`).
-4. **Gaps**: a body not seen in a frame has no row for that frame (the gap is left, not filled);
-   its prediction coasts and its window widens. A body unseen for longer than ``max_gap`` seconds
-   is reported as lost in the :class:`TrackSummary`.
+2. **Light**: each frame's gain and offset against the background are measured away from the
+   bodies (:mod:`~physbench.video.photometry`), and the difference to the background is taken in
+   that frame's light; the noise threshold is that frame's, and the bodies' contrast (from the
+   first frame) follows the gain. A light that drifts, or a first frame brighter than a median
+   background, moves no threshold.
+3. **Start**: the scene's initial body positions, projected into the first frame through the
+   calibration, say where to look; each body in view takes the blob found near its projection. A
+   body in view with none is a :class:`BodyNotFoundError` that names the measured cause (too
+   little contrast, a blob of its size elsewhere, nothing there) and the fix for it. A body the
+   scene puts outside the view may come in later.
+4. **Each frame**: every body is predicted from the scene (:mod:`~physbench.video.motion`: gravity
+   and the scene's forces for a free body, sliding along the static geometry it touches), searched
+   in a window around the prediction within a gate that grows with the body's size and speed and
+   with what the prediction cannot know (an unmodelled acceleration over the time since the body
+   was last seen: large at low frame rates), and blobs are assigned to bodies optimally
+   (:func:`scipy.optimize.linear_sum_assignment`). A body left without a blob whose neighbour's
+   blob is too big for one body shares that blob. A disc's centre is fitted to its outline
+   (:mod:`~physbench.video.silhouette`: shading and highlights do not move it, nor a rod, a
+   shadow or a hand joined to its blob); other bodies are measured by their pixels' centroid on
+   the plane. A detection whose size or colour is not the body's is rejected
+   (:mod:`~physbench.video.appearance`).
+5. **Unseen**: a body not found in a frame where it is in view has no row for that frame (nothing
+   is filled in); the summary says from when to when it was lost, and a body unseen in more than
+   :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view fails the
+   tracking (:class:`TrackLostError`) unless gaps are allowed. A body whose prediction leaves the
+   view near where it was last seen is out of view, not lost.
+6. **Accuracy**: each track's noise is measured from its fifth differences in time (a smooth
+   motion's are near zero), and the recording states ``max(floor, 2 x noise)`` in metres
+   (:data:`DISC_ACCURACY_PX` for discs, :data:`ACCURACY_PX` for other bodies) for discover's
+   significance floor.
 
 Angles are measured for bodies whose outline shows them (boxes, elongated polygons, a pendulum's
 arm), not for discs; a square's angle is known modulo 90 degrees and an elongated body's modulo
@@ -25,18 +42,19 @@ from __future__ import annotations
 
 import math
 import time as _time
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.errors import PhysbenchError, counted
+from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
+from physbench.video.accuracy import stated_accuracy
+from physbench.video.appearance import Appearance, Look, colour_directions
 from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
-    Blob,
     Outline,
     PlanePose,
     blob_from_pixels,
@@ -44,7 +62,10 @@ from physbench.video.detect import (
     plane_pose,
     split_pixels,
 )
-from physbench.video.segment import difference, noise_threshold
+from physbench.video.motion import Motion
+from physbench.video.outcome import Spans, TrackSummary
+from physbench.video.photometry import Light, LightMeter, plate_index
+from physbench.video.silhouette import DiscFit, Edges, Rays, edge_points, fit_disc, fit_discs
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -54,13 +75,22 @@ if TYPE_CHECKING:
 
 #: Ratio of a body's principal second moments above which its long axis gives its angle.
 ELONGATED = 1.3
-#: Seconds a body may go unseen before it is reported lost (default of :func:`track_video`).
-MAX_GAP = 0.5
-#: The tracker's systematic accuracy (px), stated on its recordings in metres: what lighting,
-#: lossy coding and the arc a turning body sweeps in one exposure leave in a centre (measured:
-#: 95 % of ball centres within 0.3 px, a swinging arm 0.4-0.5 px RMS along its length;
-#: ``benchmarks/track_accuracy.py``, ``tests/video/test_track.py``).
-ACCURACY_PX = 0.5
+#: The acceleration a prediction cannot know (friction, drag, a push, a swing), as a share of the
+#: scene's gravity: the gate allows for it over the time since the body was last seen.
+UNMODELLED = 0.5
+#: How far a body's first move may depart from the scene's initial velocity, as a share of it.
+VELOCITY_PRIOR = 0.5
+#: A body's appearance is learnt from detections within this factor of the size the scene gives
+#: it (until the first, no detection of it is judged by its looks).
+PLAUSIBLE = 1.8
+#: An edge may be this share of the foreground threshold faint.
+EDGE_SHARE = 0.75
+#: A disc that moves more than this share of its radius in a frame interval is fitted as the
+#: stadium its motion blur makes.
+SMEAR = 0.2
+#: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
+#: taken where no outline fits.
+SMALL_DISC = 5.0
 
 
 class TrackError(PhysbenchError, ValueError):
@@ -69,6 +99,15 @@ class TrackError(PhysbenchError, ValueError):
 
 class BodyNotFoundError(TrackError):
     """A scene body with no blob near where the scene says it starts."""
+
+
+class TrackLostError(TrackError):
+    """A body lost for more than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where
+    it was in view; the tracking's :class:`TrackResult` is ``result``."""
+
+    def __init__(self, message: str, result: TrackResult) -> None:
+        super().__init__(message)
+        self.result = result
 
 
 def bounds_calibration(scene: Scene, image_shape: tuple[int, int]) -> Calibration:
@@ -131,53 +170,53 @@ class _State:
     omega: float = 0.0
     contrast: float = 0.0  # grey levels against the background, from the first frame
     step: float = 0.0  # px moved in the last frame interval
-    missed: int = 0
-    gap_start: float | None = None
+    missed: int = 0  # frames since it was last seen
+    seen: int = 0
+    last_uv: np.ndarray | None = None
+    contact: np.ndarray | None = None  # normal of the static its prediction touches
+    look: Appearance | None = None
+    radius_m: float | None = None  # a disc's radius on the plane, from its outlines so far
+    rejected: int = 0  # detections whose appearance was not the body's
+    centroids: int = 0  # a disc's frames measured by their centroid (no outline fitted)
+    in_view: int = 0
+    unseen: Spans = field(default_factory=Spans)
+    out: Spans = field(default_factory=Spans)
     rows: list[tuple[float, float, float, float]] = field(default_factory=list)
     uv_rows: list[tuple[float, float, float]] = field(default_factory=list)
-    gaps: int = 0
-    lost: list[tuple[float, float]] = field(default_factory=list)
+
+    @property
+    def disc(self) -> bool:
+        return isinstance(self.body.shape, Circle)
+
+    @property
+    def mpp0(self) -> float:
+        """Metres per pixel where the body starts."""
+        return self.body.shape.extent() / self.radius
 
 
 @dataclass(frozen=True)
-class TrackSummary:
-    """How tracking went: ``frames`` read over ``duration`` s, per body the ``detections``
-    (frames with a measurement), ``gaps`` (runs of frames without one) and ``lost`` (gaps longer
-    than the limit, as ``(from, to)`` s), the calibration's reprojection error (px) and the
-    processing speed (frames/s)."""
+class _Found:
+    """One body's measurement in one frame: centre ``xy`` (m) and ``uv`` (px), the pose for its
+    angle, what it looks like, and a disc's radius where its outline gave one."""
 
-    frames: int
-    duration: float
-    detections: dict[str, int]
-    gaps: dict[str, int]
-    lost: dict[str, list[tuple[float, float]]]
-    reprojection_error: float
-    fps: float = 0.0
-    #: Per body, the samples left out because their exposure spans a collision
-    #: (:mod:`physbench.video.contacts`).
-    contacts: dict[str, int] = field(default_factory=dict)
+    xy: np.ndarray
+    uv: np.ndarray
+    pose: PlanePose
+    look: Look
+    radius: float | None = None  # m, a disc's radius fitted freely to its outline
+    centroid: bool = False  # a disc measured by its centroid, without an outline
 
-    def format(self) -> str:
-        """A few lines for a person."""
-        lines = [
-            f"tracked {counted(len(self.detections), 'body')} over "
-            f"{counted(self.frames, 'frame')} "
-            f"({self.duration:.2f} s) at {self.fps:.0f} frames/s; calibration reprojection "
-            f"error {self.reprojection_error:.2f} px"
-        ]
-        for name, n in self.detections.items():
-            gone = self.lost.get(name, [])
-            tail = "; lost " + ", ".join(f"{a:.2f}-{b:.2f} s" for a, b in gone) if gone else ""
-            if self.contacts.get(name):
-                tail += (
-                    f"; {counted(self.contacts[name], 'collision frame')} left out (the exposure "
-                    "spans the collision)"
-                )
-            lines.append(
-                f"  {name:>8}: seen in {n}/{self.frames} frames, "
-                f"{counted(self.gaps[name], 'gap')}{tail}"
-            )
-        return "\n".join(lines)
+
+@dataclass(frozen=True)
+class _Plan:
+    """Where to look for a disc's outline in one frame (its rays), the metres per pixel there and
+    the area (px) the scene gives it there."""
+
+    rays: Rays
+    mpp: float
+    expected: float
+    known: float | None = None
+    pixels: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # its colour's, if shared
 
 
 @dataclass(frozen=True)
@@ -192,7 +231,8 @@ class TrackResult:
 
 class Tracker:
     """Frame-by-frame tracking of ``scene``'s bodies against ``background`` (see the module
-    docstring). Call :meth:`update` with each frame in order, then :meth:`result`."""
+    docstring). Call :meth:`update` with each frame in order, then :meth:`result`. ``median``:
+    the background is the median of the clip (a first-frame failure says what that implies)."""
 
     def __init__(
         self,
@@ -200,18 +240,20 @@ class Tracker:
         calibration: Calibration,
         background: np.ndarray,
         *,
-        max_gap: float = MAX_GAP,
+        median: bool = False,
     ) -> None:
         self.scene, self.cal, self.bg = scene, calibration, background
+        self.bg_index = plate_index(background)  # once: each window's difference reads it
         self.h, self.w = background.shape[:2]
         self.g = np.asarray(scene.gravity, dtype=float)
-        self.max_gap = max_gap
-        jointed = {j.a for j in scene.joints} | {j.b for j in scene.joints if j.b}
+        self.motion = Motion(scene)
+        self.meter = LightMeter(background)
+        self.light = Light.unchanged()
+        self.median = median
         self.states: list[_State] = []
         for body in scene.bodies:
             xy = np.asarray(body.position, dtype=float)
-            uv = calibration.to_image(xy)
-            mpp = calibration.metres_per_pixel(uv)
+            mpp = calibration.metres_per_pixel(calibration.to_image(xy))
             k, offset = _symmetry(body)
             self.states.append(
                 _State(
@@ -220,7 +262,7 @@ class Tracker:
                     body.shape.area() / mpp**2,
                     k,
                     offset,
-                    body.name not in jointed,
+                    self.motion.free[body.name],
                     xy,
                     np.asarray(body.velocity, dtype=float),
                     0.0,
@@ -231,33 +273,99 @@ class Tracker:
         self.frames = 0
         self.t0: float | None = None
         self.t_last = 0.0
-        self.low = self.high = 0.0
+        self.low = self.high = self.edge_low = 0.0
+        self.contrast = 0.0  # the bodies' median contrast in the first frame's light
+        self.scale0 = 1.0  # the first frame's gain
+        self.max_gate = 0.5 * max(self.h, self.w)
+        self.pred_xy = np.zeros((len(self.states), 2))
+        self.pred_uv = np.zeros((len(self.states), 2))
+        self.t_next = 0.0  # the time of the frame being tracked
+        self._mpp_cells: dict[tuple[int, int], float] = {}
 
     # ----------------------------------------------------------------- prediction
 
-    def _predict(self, s: _State, t: float) -> np.ndarray:
-        dt = t - s.t
-        a = self.g if s.free else 0.0
-        return s.xy + s.v * dt + 0.5 * a * dt * dt
+    def _predict(self, t: float) -> None:
+        """Every body's predicted position at ``t`` (scene metres and pixels), and the static
+        each prediction touches."""
+        for i, s in enumerate(self.states):
+            dt = t - s.t
+            kick = self.motion.kick(s.body.name, s.t, dt)
+            angle = s.angle if s.angle is not None else s.body.angle
+            xy, s.contact = self.motion.slide(s.body, angle, s.xy, s.v * dt + kick.dx)
+            self.pred_xy[i] = xy
+        self.pred_uv = self.cal.to_image(self.pred_xy)
 
-    def _thresholds(self, image: np.ndarray, preds: np.ndarray) -> None:
-        """Noise floor and the bodies' contrast from the first frame."""
-        floor = noise_threshold(image, self.bg)
-        diff = difference(image, self.bg)
+    def _in_view(self, s: _State, uv: np.ndarray) -> bool:
+        """Whether to look for ``s`` at its prediction ``uv``: it is there (its centre at least
+        half its radius inside the image), or it was last seen away from the image's edges (a
+        prediction may leave the view while the body is hidden in it)."""
+        m = 0.5 * s.radius
+        if m - 0.5 <= uv[0] <= self.w - 0.5 - m and m - 0.5 <= uv[1] <= self.h - 0.5 - m:
+            return True
+        if s.last_uv is None:
+            return False
+        edge = s.radius + 2 * s.step + 3
+        u, v = s.last_uv
+        return min(u, v, self.w - 1 - u, self.h - 1 - v) > edge
+
+    def _gates(self, t: float, first: bool) -> tuple[np.ndarray, np.ndarray]:
+        """Per body the gate (px: how far from its prediction a detection may be) and the reach
+        of its search window (px)."""
+        gates = np.empty(len(self.states))
+        reach = np.empty(len(self.states))
+        g = float(np.hypot(*self.g))
+        for i, s in enumerate(self.states):
+            if first:
+                gates[i] = max(2.0 * s.radius, 12.0)
+            else:
+                dt = t - s.t
+                unknown = UNMODELLED * g * dt * dt / 2  # metres
+                if s.seen < 2:  # its velocity is the scene's guess until measured
+                    unknown += VELOCITY_PRIOR * float(np.hypot(*s.v)) * dt
+                gates[i] = (
+                    0.75 * s.radius
+                    + 3.0
+                    + 1.5 * s.step
+                    + s.missed * (s.radius + s.step)
+                    + unknown / s.mpp0
+                )
+                if s.seen == 0:
+                    gates[i] += max(2.0 * s.radius, 12.0)
+            gates[i] = min(gates[i], self.max_gate)
+            reach[i] = s.radius + gates[i] + 0.5 * s.step + 3.0
+        return gates, reach
+
+    # ----------------------------------------------------------------- light and thresholds
+
+    def _first_contrast(self, image: np.ndarray, visible: list[bool]) -> None:
+        """The bodies' contrast in the first frame: the 90th percentile of the difference near
+        each prediction (a thin body, an arm, covers little of the square)."""
         values = []
-        for (u, v), s in zip(preds, self.states, strict=True):
+        for i, s in enumerate(self.states):
+            if not visible[i]:
+                continue
             r = max(1, int(0.4 * s.radius))
-            iu, iv = round(u), round(v)
+            iu, iv = (round(c) for c in self.pred_uv[i])
             if r <= iu < self.w - r and r <= iv < self.h - r:
-                # The 90th percentile: a thin body (an arm) covers little of the square.
-                patch = diff[iv - r : iv + r + 1, iu - r : iu + r + 1]
+                box = (slice(iv - r, iv + r + 1), slice(iu - r, iu + r + 1))
+                patch = self.light.difference(image[box], self.bg[box], self.bg_index[box])
                 s.contrast = float(np.percentile(patch, 90))
                 values.append(s.contrast)
-        contrast = float(np.median(values)) if values else 4 * floor
+        self.contrast = float(np.median(values)) if values else 4 * self.light.threshold()
         for s in self.states:
-            s.contrast = s.contrast or contrast
-        self.low = max(floor, 0.2 * contrast)
+            s.contrast = s.contrast or self.contrast
+        self.scale0 = max(self.light.scale, 1e-3)
+
+    def _thresholds(self) -> None:
+        """This frame's thresholds: above its noise, and a share of the bodies' contrast in its
+        light."""
+        contrast = self.contrast * self.light.scale / self.scale0
+        self.low = max(self.light.threshold(), 0.2 * contrast)
         self.high = max(self.low + 1.0, 0.5 * contrast)
+        # An edge is placed by its own half-way point, so it may be fainter than what makes a
+        # blob: half the threshold, above 3 robust noise deviations (a lit limb nearly as bright
+        # as the wall).
+        self.edge_low = max(EDGE_SHARE * self.low, 3.0 * self.light.sigma, 8.0)
 
     # ----------------------------------------------------------------- one frame
 
@@ -272,56 +380,85 @@ class Tracker:
         if first:
             self.t0 = t
         t = t - self.t0  # type: ignore[operator]
-        preds_xy = np.array([self._predict(s, t) for s in self.states])
-        preds = self.cal.to_image(preds_xy)
+        self.t_next = t
+        self._predict(t)
+        visible = [self._in_view(s, self.pred_uv[i]) for i, s in enumerate(self.states)]
+        gates, reach = self._gates(t, first)
+        avoid = [(u, v, r) for (u, v), r in zip(self.pred_uv, reach, strict=True)]
+        self.light = self.meter.measure(image, avoid)
         if first:
-            self._thresholds(image, preds)
-        gates = np.empty(len(self.states))
-        reach = np.empty(len(self.states))
+            if not any(visible):
+                raise BodyNotFoundError(self._none_in_view())
+            self._first_contrast(image, visible)
+        self._thresholds()
+        found = self._measure(image, gates, reach, t, visible)
         for i, s in enumerate(self.states):
-            if first:
-                gates[i] = max(2.0 * s.radius, 12.0)
-            else:
-                gates[i] = 0.75 * s.radius + 3.0 + 1.5 * s.step + s.missed * (s.radius + s.step)
-            reach[i] = s.radius + gates[i] + 0.5 * s.step + 3.0
-        found = self._measure(image, preds, gates, reach, t)
-        for i, s in enumerate(self.states):
-            blob = found.get(i)
-            if blob is None:
-                if first:
-                    u, v = preds[i]
-                    raise BodyNotFoundError(
-                        f"body {s.body.name!r} is not in the first frame: expected near pixel "
-                        f"(u={u:.0f}, v={v:.0f}) of the {self.w}x{self.h} image (its initial "
-                        f"position {tuple(round(c, 3) for c in s.body.position)} m through the "
-                        "calibration); check the scene, --seed, --start and the calibration"
-                    )
-                if s.missed == 0:
-                    s.gap_start = s.t
-                s.missed += 1
+            if i in found:
+                s.in_view += 1
+                s.unseen.close()
+                s.out.close()
+                self._accept(s, found[i], t)
                 continue
-            self._accept(s, *blob, t)
+            if first and visible[i]:
+                raise BodyNotFoundError(self._not_found(i, image))
+            s.missed += 1
+            if visible[i]:
+                s.in_view += 1
+                s.unseen.mark(t)
+                s.out.close()
+            else:
+                s.out.mark(t)
+                s.unseen.close()
         self.frames += 1
         self.t_last = t
 
-    def _accept(self, s: _State, blob: Blob, pose: PlanePose, t: float) -> None:
-        xy = pose.xy
+    def _not_found(self, i: int, image: np.ndarray) -> str:
+        from physbench.video.diagnosis import Missing, not_found
+
+        s = self.states[i]
+        missing = Missing(s.body.name, self.pred_uv[i], s.radius, s.area, s.body.position)
+        return not_found(missing, image, self.bg, self.light, self.low, median=self.median)
+
+    def _none_in_view(self) -> str:
+        where = ", ".join(
+            f"{s.body.name!r} at pixel (u={u:.0f}, v={v:.0f})"
+            for s, (u, v) in zip(self.states, self.pred_uv, strict=True)
+        )
+        return (
+            f"no body of the scene is in the first frame: the scene's initial positions put "
+            f"{where}, all outside the {self.w}x{self.h} image; check the calibration (its origin "
+            "and scale), the scene's positions, --seed and --start"
+        )
+
+    def _accept(self, s: _State, found: _Found, t: float) -> None:
+        xy = found.xy
         dt = t - s.t
-        if s.rows and dt > 0:
-            a = self.g if s.free else 0.0
-            s.v = (xy - s.xy) / dt + 0.5 * a * dt
-            s.step = float(np.hypot(*(blob.centre - self.cal.to_image(s.xy)))) / max(
-                1, s.missed + 1
-            )
-        angle = self._angle(s, pose, t) if s.k else None
-        if s.missed:
-            s.gaps += 1
-            if s.gap_start is not None and t - s.gap_start > self.max_gap:
-                s.lost.append((s.gap_start, t))
-        s.missed, s.gap_start = 0, None
-        s.xy, s.t = xy, t
+        if s.seen and dt > 0:
+            kick = self.motion.kick(s.body.name, s.t, dt)
+            s.v = (xy - s.xy) / dt + kick.dv - kick.dx / dt
+            if s.contact is not None and float(s.v @ s.contact) < 0:
+                s.v = s.v - float(s.v @ s.contact) * s.contact  # it stays on the surface
+            assert s.last_uv is not None
+            s.step = float(np.hypot(*(found.uv - s.last_uv))) / (s.missed + 1)
+        angle = self._angle(s, found.pose, t) if s.k else None
+        s.missed = 0
+        s.seen += 1
+        s.xy, s.t, s.last_uv = xy, t, found.uv
         s.rows.append((t, float(xy[0]), float(xy[1]), math.nan if angle is None else angle))
-        s.uv_rows.append((t, blob.u, blob.v))
+        s.uv_rows.append((t, float(found.uv[0]), float(found.uv[1])))
+        # A body's looks are learnt only from detections of about the size the scene gives it:
+        # part of a body that a median background holds, or a body with a hand, would teach it
+        # a wrong colour too.
+        if 1 / PLAUSIBLE <= found.look.size <= PLAUSIBLE:
+            if s.look is None:
+                s.look = Appearance.first(found.look)
+            else:
+                s.look.update(found.look)
+        s.centroids += found.centroid
+        if found.radius is not None:
+            s.radius_m = (
+                found.radius if s.radius_m is None else 0.8 * s.radius_m + 0.2 * found.radius
+            )
 
     def _angle(self, s: _State, pose: PlanePose, t: float) -> float | None:
         assert s.angle is not None
@@ -339,20 +476,21 @@ class Tracker:
         s.angle = angle
         return angle
 
-    def _windows(self, preds: np.ndarray, reach: np.ndarray) -> list[tuple[list[int], tuple]]:
-        """Bodies grouped by overlapping search windows, with each group's window
+    def _windows(self, ids: list[int], reach: np.ndarray) -> list[tuple[list[int], tuple]]:
+        """Bodies ``ids`` grouped by overlapping search windows, with each group's window
         ``(r0, r1, c0, c1)``."""
-        boxes = []
-        for (u, v), r in zip(preds, reach, strict=True):
-            boxes.append(
-                [
-                    max(0, math.floor(v - r)),
-                    min(self.h, math.ceil(v + r) + 1),
-                    max(0, math.floor(u - r)),
-                    min(self.w, math.ceil(u + r) + 1),
-                ]
-            )
-        groups = [([i], b) for i, b in enumerate(boxes) if b[0] < b[1] and b[2] < b[3]]
+        groups = []
+        for i in ids:
+            u, v = self.pred_uv[i]
+            r = reach[i]
+            box = [
+                max(0, math.floor(v - r)),
+                min(self.h, math.ceil(v + r) + 1),
+                max(0, math.floor(u - r)),
+                min(self.w, math.ceil(u + r) + 1),
+            ]
+            if box[0] < box[1] and box[2] < box[3]:
+                groups.append(([i], box))
         merged = True
         while merged:
             merged = False
@@ -378,147 +516,479 @@ class Tracker:
         colour: np.ndarray,
         behind: np.ndarray,
     ) -> np.ndarray:
-        """Pixel weights for body ``i``'s pose. A disc keeps its coverage (saturated from half
-        its contrast up, so its shading does not pull the centre). A body that turns is weighed
-        by the share of the exposure each pixel saw it (:func:`_alpha`): a turning body's motion
-        blur is lopsided (its far end sweeps more), and only that weight keeps its centre at the
-        exposure's middle (a swinging arm: 1 cm off with the coverage)."""
+        """Pixel weights for body ``i``'s centroid. A body without an angle keeps its coverage.
+        A body that turns is weighed by the share of the exposure each pixel saw it
+        (:func:`_alpha`): a turning body's motion blur is lopsided (its far end sweeps more), and
+        only that weight keeps its centre at the exposure's middle (a swinging arm: 1 cm off with
+        the coverage)."""
         if not self.states[i].k:
             return coverage
-        return _alpha(colour, behind, diff)
+        return _alpha(colour, behind * self.light.gain + self.light.offset, diff)
 
-    def _outline(self, i: int, uv: np.ndarray, t: float) -> Outline:
-        """Body ``i``'s outline in the image at its prediction ``uv`` (px) for time ``t``: its
-        polygon at the predicted angle through the calibration, or a disc."""
+    def _outline(self, i: int) -> Outline:
+        """Body ``i``'s outline in the image at its prediction (px, about the predicted pixel):
+        its polygon at the predicted angle through the calibration, or a disc."""
         s = self.states[i]
         if s.angle is None or not hasattr(s.body.shape, "vertices"):
             return Outline(s.radius)
         pts = np.asarray(s.body.shape.vertices(), dtype=float)
         pts = pts - _area_centroid(pts)
-        a = s.angle + s.omega * (t - s.t)
+        a = s.angle + s.omega * (self.t_next - s.t)
         rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
-        xy = self._predict(s, t)
-        return Outline(s.radius, self.cal.to_image(xy + pts @ rot.T) - uv)
+        xy = self.pred_xy[i]
+        return Outline(s.radius, self.cal.to_image(xy + pts @ rot.T) - self.pred_uv[i])
+
+    # ----------------------------------------------------------------- measuring
 
     def _measure(
         self,
         image: np.ndarray,
-        preds: np.ndarray,
         gates: np.ndarray,
         reach: np.ndarray,
         t: float,
-    ) -> dict[int, tuple[Blob, PlanePose]]:
-        from scipy.optimize import linear_sum_assignment
-
-        found: dict[int, tuple[Blob, PlanePose]] = {}
-        for ids, (r0, r1, c0, c1) in self._windows(preds, reach):
-            diff = difference(image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1])
-            small = min(self.states[i].area for i in ids)
-            blobs = find_blobs(diff, self.low, self.high, offset=(r0, c0), min_area=0.15 * small)
+        visible: list[bool],
+    ) -> dict[int, _Found]:
+        """Every visible body's measurement in this frame: blobs found in the windows around
+        the predictions, assigned to bodies, discs fitted to their outlines (all of the frame's
+        at once), each body measured on its blob."""
+        ids = [i for i, v in enumerate(visible) if v]
+        windows, plans = [], {}
+        for group, (r0, r1, c0, c1) in self._windows(ids, reach):
+            crop = (slice(r0, r1), slice(c0, c1))
+            window = (
+                self.light.difference(image[crop], self.bg[crop], self.bg_index[crop]),
+                (r0, c0),
+            )
+            small = min(self.states[i].area for i in group)
+            blobs = find_blobs(
+                window[0], self.low, self.high, offset=(r0, c0), min_area=0.15 * small
+            )
             if not blobs:
                 continue
-            centres = np.array([b[0].centre for b in blobs])
-            dist = np.hypot(*(preds[ids][:, None, :] - centres[None]).transpose(2, 0, 1))
-            big = 1e9
-            cost = np.where(dist <= gates[ids][:, None], dist, big)
-            rows, cols = linear_sum_assignment(cost)
-            owner: dict[int, list[int]] = {}
-            for r, c in zip(rows, cols, strict=True):
-                if cost[r, c] < big:
-                    owner.setdefault(int(c), []).append(ids[r])
-            # A body left out whose nearest blob holds more than one body's area shares it.
-            for j, i in enumerate(ids):
-                if any(i in v for v in owner.values()):
-                    continue
-                for c in np.argsort(dist[j]):
-                    _, u, v, _ = blobs[c]
-                    if np.hypot(u - preds[i, 0], v - preds[i, 1]).min() > gates[i]:
-                        continue  # the prediction is not on this blob
-                    taken = owner.get(int(c), [])
-                    expected = sum(self.states[k].area for k in taken) + self.states[i].area
-                    if blobs[c][0].area > 0.6 * expected:
-                        owner.setdefault(int(c), []).append(i)
-                        break
+            owner, dist = self._assign(group, blobs, gates)
             for c, members in owner.items():
-                blob, u, v, w = blobs[c]
-                rows, cols = v.astype(np.intp), u.astype(np.intp)
-                d = diff[rows - r0, cols - c0]
-                img, bg = image[rows, cols], self.bg[rows, cols]
-                if len(members) == 1:
-                    i = members[0]
-                    found[i] = (
-                        blob,
-                        plane_pose(u, v, self._weights(i, w, d, img, bg), self.cal),
-                    )
-                    continue
-                outlines = [self._outline(i, preds[i], t) for i in members]
-                centres, owner, inside = split_pixels(u, v, w, preds[members], outlines)
-                for j, i in enumerate(members):
-                    mine = owner == j
-                    part = blob_from_pixels(u[mine], v[mine], w[mine])
-                    fit = mine & inside
-                    if part is None or not fit.any():
+                discs = [i for i in members if self.states[i].disc]
+                colours = self._colours(image, blobs[c]) if len(members) > 1 and discs else None
+                for i in discs:
+                    plan = self._plan(i, blobs[c], alone=len(members) == 1, colours=colours)
+                    plans[i] = (plan, window)
+            windows.append((group, window, blobs, owner, dist))
+        fits = self._fit_discs(image, plans)
+        found: dict[int, _Found] = {}
+        for group, window, blobs, owner, dist in windows:
+            mine = {i: p for i, (p, _) in plans.items() if i in group}
+            taken = set(owner)
+            for c, members in owner.items():
+                got = self._members(image, blobs[c], members, window, mine, fits)
+                found.update(got)
+                for i in members:
+                    if i in got:
                         continue
-                    part = replace(part, u=float(centres[j, 0]), v=float(centres[j, 1]))
-                    # Centre from the pixels inside the outline, axes from all the body owns.
-                    # Weighed over its own pixels only: a shared blob holds other bodies'
-                    # colours, which would spoil the hue a turning body is unmixed with.
-                    wi = np.zeros_like(w)
-                    wi[mine] = self._weights(i, w[mine], d[mine], img[mine], bg[mine])
-                    centre = plane_pose(u[fit], v[fit], wi[fit], self.cal)
-                    axes = plane_pose(u[mine], v[mine], wi[mine], self.cal)
-                    found[i] = (part, replace(axes, xy=centre.xy))
+                    # Rejected: the next blob within its gate that no one took, if any.
+                    j = group.index(i)
+                    for alt in np.argsort(dist[j]):
+                        if int(alt) in taken or dist[j, alt] > gates[i]:
+                            continue
+                        blob = blobs[int(alt)]
+                        plan = {i: self._plan(i, blob, alone=True)} if self.states[i].disc else {}
+                        fit = self._fit_discs(image, {k: (p, window) for k, p in plan.items()})
+                        again = self._members(image, blob, [i], window, plan, fit)
+                        if i in again:
+                            found[i] = again[i]
+                            taken.add(int(alt))
+                            break
         return found
+
+    def _assign(
+        self, ids: list[int], blobs: list, gates: np.ndarray
+    ) -> tuple[dict[int, list[int]], np.ndarray]:
+        """Blobs to bodies ``ids``: each blob's owners, and the distance of each body's prediction
+        to each blob's centre (px)."""
+        from scipy.optimize import linear_sum_assignment
+
+        preds = self.pred_uv[ids]
+        centres = np.array([b[0].centre for b in blobs])
+        dist = np.hypot(*(preds[:, None, :] - centres[None]).transpose(2, 0, 1))
+        big = 1e9
+        cost = np.where(dist <= gates[ids][:, None], dist, big)
+        rows, cols = linear_sum_assignment(cost)
+        owner: dict[int, list[int]] = {}
+        for r, c in zip(rows, cols, strict=True):
+            if cost[r, c] < big:
+                owner.setdefault(int(c), []).append(ids[r])
+        # A body left out whose nearest blob holds more than one body's area shares it.
+        for j, i in enumerate(ids):
+            if any(i in v for v in owner.values()):
+                continue
+            for c in np.argsort(dist[j]):
+                _, u, v, _ = blobs[c]
+                if np.hypot(u - preds[j, 0], v - preds[j, 1]).min() > gates[i]:
+                    continue  # the prediction is not on this blob
+                taken = owner.get(int(c), [])
+                expected = sum(self.states[k].area for k in taken) + self.states[i].area
+                if blobs[c][0].area > 0.6 * expected:
+                    owner.setdefault(int(c), []).append(i)
+                    break
+        return owner, dist
+
+    def _members(
+        self,
+        image: np.ndarray,
+        found_blob: tuple,
+        members: list[int],
+        window: tuple[np.ndarray, tuple[int, int]],
+        plans: dict[int, _Plan],
+        fits: dict[int, DiscFit | None],
+    ) -> dict[int, _Found]:
+        """Measure ``members`` on one blob (pixels ``u``, ``v``, coverage ``w``): a disc by its
+        outline (``fits``), a body alone by its centroid, bodies sharing the blob by its pixels
+        split along their predicted outlines; each kept only if it looks like its body."""
+        blob, u, v, w = found_blob
+        out: dict[int, _Found] = {}
+        shared = len(members) > 1
+        discs = {
+            i: self._disc(i, image, found_blob, plans[i], fits.get(i), alone=not shared)
+            for i in members
+            if i in plans
+        }
+        for i, got in discs.items():
+            look = self.states[i].look
+            if shared and got is not None and look is not None and look.mismatch(got.look):
+                discs[i] = None  # an outline of another body: try the body's share of the blob
+        if any(i not in discs or (discs[i] is None and shared) for i in members):
+            diff, (r0, c0) = window
+            rows, cols = v.astype(np.intp), u.astype(np.intp)
+            d = diff[rows - r0, cols - c0]
+            img, bg = image[rows, cols], self.bg[rows, cols]
+            if shared:
+                outlines = [self._outline(i) for i in members]
+                centres, own, inside = split_pixels(u, v, w, self.pred_uv[members], outlines)
+        for j, i in enumerate(members):
+            s = self.states[i]
+            if i in discs and (discs[i] is not None or not shared):
+                got = discs[i]
+            elif not shared:
+                pose = plane_pose(u, v, self._weights(i, w, d, img, bg), self.cal)
+                got = _Found(pose.xy, blob.centre, pose, self._look(i, blob.area, img, w))
+            else:
+                # A disc whose outline is hidden by its neighbours, or another body: its share
+                # of the blob's pixels.
+                mine = own == j
+                part = blob_from_pixels(u[mine], v[mine], w[mine])
+                fit = mine & inside
+                if part is None or not fit.any():
+                    continue
+                # Centre from the pixels inside the outline, axes from all the body owns.
+                # Weighed over its own pixels only: a shared blob holds other bodies'
+                # colours, which would spoil the hue a turning body is unmixed with.
+                wi = np.zeros_like(w)
+                wi[mine] = self._weights(i, w[mine], d[mine], img[mine], bg[mine])
+                centre = plane_pose(u[fit], v[fit], wi[fit], self.cal)
+                axes = plane_pose(u[mine], v[mine], wi[mine], self.cal)
+                look = self._look(i, part.area, img[mine], w[mine], at=part.centre)
+                got = _Found(centre.xy, centres[j], replace(axes, xy=centre.xy), look)
+            if got is None:
+                continue
+            if s.look is not None and s.look.mismatch(got.look) is not None:
+                s.rejected += 1
+                continue
+            out[i] = got
+        return out
+
+    def _colours(self, image: np.ndarray, found_blob: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """A blob's pixels' colours in the background's light, as directions and lengths
+        (:func:`~physbench.video.appearance.colour_directions`)."""
+        _, u, v, _ = found_blob
+        raw = image[v.astype(np.intp), u.astype(np.intp)]
+        return colour_directions((raw - self.light.offset) / self.light.gain)
+
+    def _plan(
+        self,
+        i: int,
+        found_blob: tuple,
+        *,
+        alone: bool,
+        colours: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> _Plan:
+        """Where to look for disc ``i``'s outline on a blob: from the blob's centroid where the
+        blob is its alone and of its size, else from a mean shift over the blob's pixels within
+        its radius, from the pixel nearest its prediction (its own part of a blob shared with a
+        rod, a hand or another ball), over the pixels of its colour (``colours`` of the blob's
+        pixels, for a shared blob) where it has one (a ball struck into a rack of others)."""
+        blob, u, v, w = found_blob
+        s = self.states[i]
+        pred = self.pred_uv[i]
+        mpp = self._mpp(pred)
+        r = s.body.shape.extent() / mpp
+        expected = s.body.shape.area() / mpp**2
+        if alone and 0.6 * expected <= blob.area <= 1.6 * expected:
+            c = blob.centre
+        else:
+            pixels = None
+            if s.look is not None and colours is not None:
+                own = s.look.matches(*colours)
+                if w[own].sum() >= 0.2 * expected:
+                    u, v, w = pixels = u[own], v[own], w[own]
+            c = self._shift(u, v, w, pred, r)
+            rays = Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0)
+            return _Plan(rays, mpp, expected, s.radius_m, pixels)
+        return _Plan(Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0), mpp, expected, s.radius_m)
+
+    def _fit_discs(
+        self,
+        image: np.ndarray,
+        plans: dict[int, tuple[_Plan, tuple[np.ndarray, tuple[int, int]]]],
+    ) -> dict[int, DiscFit | None]:
+        """Each planned disc fitted to its outline (:func:`~physbench.video.silhouette.fit_discs`,
+        all at once): the rays of those inside their search window on its difference, the
+        others on crops of their own; a fit far from where its rays started is fitted again
+        from its centre."""
+        inside, outside, found = [], [], []
+        for i, (plan, (diff, (r0, c0))) in plans.items():
+            c, m = plan.rays.centre, plan.rays.reach + 2.0
+            h, w = diff.shape
+            ok = c[1] - m >= r0 and c[0] - m >= c0 and c[1] + m <= r0 + h - 1
+            (inside if ok and c[0] + m <= c0 + w - 1 else outside).append(i)
+        by_window: dict[int, list[int]] = {}
+        for i in inside:
+            by_window.setdefault(id(plans[i][1][0]), []).append(i)
+        for members in by_window.values():
+            diff, origin = plans[members[0]][1]
+            rays = [plans[i][0].rays for i in members]
+            found.append(edge_points(diff, origin, rays, self.edge_low))
+        order = [i for members in by_window.values() for i in members]
+        fits: dict[int, DiscFit | None] = {}
+        if order:
+            mine = [plans[i][0] for i in order]
+            got = fit_discs(
+                Edges.join(found, [len(members) for members in by_window.values()]),
+                [p.rays.radius for p in mine],
+                self.cal,
+                [p.mpp for p in mine],
+                [p.known for p in mine],
+                [self._smeared(i) for i in order],
+            )
+            fits.update(zip(order, got, strict=True))
+        for i in outside:
+            fits[i] = self._fit_one(image, plans[i][0])
+        for i, fit in fits.items():
+            rays = plans[i][0].rays
+            if fit is not None and float(np.hypot(*(fit.uv - rays.centre))) > 0.25 * rays.radius:
+                again = replace(plans[i][0], rays=replace(rays, centre=fit.uv))
+                fits[i] = self._fit_one(image, again)
+        return fits
+
+    def _smeared(self, i: int) -> np.ndarray | None:
+        """The unit direction of body ``i``'s motion on the plane where one frame interval of it
+        is more than :data:`SMEAR` of its radius (an exposure of half the interval smears it into
+        a stadium), else ``None``."""
+        s = self.states[i]
+        speed = float(np.hypot(*s.v))
+        if s.seen < 2 or speed / self.scene.fps < SMEAR * s.body.shape.extent():
+            return None
+        return s.v / speed
+
+    def _fit_one(self, image: np.ndarray, plan: _Plan) -> DiscFit | None:
+        """One disc's outline fit on a crop of its own."""
+        rays = plan.rays
+        c, m = rays.centre, rays.reach + 2.0
+        r0, r1 = max(0, math.floor(c[1] - m)), min(self.h, math.ceil(c[1] + m) + 1)
+        c0, c1 = max(0, math.floor(c[0] - m)), min(self.w, math.ceil(c[0] + m) + 1)
+        if r1 - r0 < 3 or c1 - c0 < 3:
+            return None
+        diff = self.light.difference(
+            image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1], self.bg_index[r0:r1, c0:c1]
+        )
+        edges = edge_points(diff, (r0, c0), [rays], self.edge_low)
+        return fit_disc(edges, rays.radius, self.cal, plan.mpp, plan.known)
+
+    def _disc(
+        self,
+        i: int,
+        image: np.ndarray,
+        found_blob: tuple,
+        plan: _Plan,
+        fit: DiscFit | None,
+        *,
+        alone: bool,
+    ) -> _Found | None:
+        """Disc ``i``'s measurement on a blob from its outline ``fit``. Without one, a blob that
+        is the body's alone and of its size gives its centroid; otherwise the disc is unseen."""
+        blob, u, v, w = found_blob
+        if fit is None:
+            # Without an outline, the centroid of a blob that is the body's alone and of a
+            # disc's area (counted: shading can move it): a disc of a few pixels, one smeared
+            # into a streak (whose faint parts fall under the threshold), one whose outline is
+            # too faint. Neither a disc's outline nor its area: something else.
+            small = plan.rays.radius < SMALL_DISC or blob.elongation > 4.0
+            if not alone or not (0.3 if small else 0.5) <= blob.area / plan.expected <= 1.6:
+                return None
+            colours = image[v.astype(np.intp), u.astype(np.intp)]
+            look = self._look(i, blob.area, colours, w, mpp=plan.mpp)
+            pose = plane_pose(u, v, w, self.cal)
+            return _Found(pose.xy, blob.centre, pose, look, centroid=True)
+        rf = fit.radius / plan.mpp
+        if plan.pixels is not None:  # its own colour's pixels of a shared blob
+            u, v, w = plan.pixels
+        near = (u - fit.uv[0]) ** 2 + (v - fit.uv[1]) ** 2
+        area = float(w[near <= (rf + 1.0) ** 2].sum())
+        inner = near <= (0.6 * rf) ** 2
+        colours = image[v[inner].astype(np.intp), u[inner].astype(np.intp)]
+        look = self._look(i, area, colours, None, mpp=plan.mpp)
+        radius = None if fit.fixed else fit.radius
+        return _Found(fit.xy, fit.uv, PlanePose(fit.xy, 0.0, 1.0, 0.0), look, radius)
+
+    @staticmethod
+    def _shift(
+        u: np.ndarray, v: np.ndarray, w: np.ndarray, pred: np.ndarray, r: float
+    ) -> np.ndarray:
+        """The middle of the disc of radius ``r`` (px) nearest ``pred`` among pixels ``(u, v)``
+        of coverage ``w``: a mean shift from the pixel nearest ``pred``."""
+        d2 = (u - pred[0]) ** 2 + (v - pred[1]) ** 2
+        k = int(np.argmin(d2))
+        c = pred.copy() if d2[k] <= r * r else np.array([u[k], v[k]])
+        for _ in range(6):
+            sel = (u - c[0]) ** 2 + (v - c[1]) ** 2 <= r * r
+            ws = w[sel]
+            total = ws.sum()
+            if total <= 0:
+                break
+            new = np.array([ws @ u[sel], ws @ v[sel]]) / total
+            moved = float(np.hypot(*(new - c)))
+            c = new
+            if moved < 0.1:
+                break
+        return c
+
+    def _mpp(self, uv: np.ndarray) -> float:
+        """Metres per pixel near ``uv``, from a cache of 16 px cells."""
+        key = (int(uv[0]) >> 4, int(uv[1]) >> 4)
+        mpp = self._mpp_cells.get(key)
+        if mpp is None:
+            cell = (np.array(key, dtype=float) + 0.5) * 16
+            mpp = self._mpp_cells[key] = self.cal.metres_per_pixel(cell)
+        return mpp
+
+    def _look(
+        self,
+        i: int,
+        area: float,
+        colours: np.ndarray,
+        weights: np.ndarray | None,
+        *,
+        mpp: float | None = None,
+        at: np.ndarray | None = None,
+    ) -> Look:
+        """What body ``i``'s detection looks like: its covered ``area`` (px) over the scene's
+        area for the body (``mpp`` metres per pixel, or at pixel ``at``, or at its prediction),
+        and the median colour of ``colours`` (``(n, 3)``; with ``weights``, of the best covered
+        quarter, which motion blur mixes least with the wall; every 4th of many) in the
+        background's light."""
+        if mpp is None:
+            mpp = self._mpp(self.pred_uv[i] if at is None else at)
+        expected = self.states[i].body.shape.area() / mpp**2
+        if weights is not None and len(colours) > 3:
+            colours = colours[weights >= np.percentile(weights, 75)]
+        if len(colours) > 64:
+            colours = colours[::4]
+        raw = np.median(colours, axis=0).astype(float) if len(colours) else np.zeros(3)
+        colour = (raw - self.light.offset) / np.maximum(self.light.gain, 1e-3)
+        return Look(area / max(expected, 1e-9), colour, expected)
 
     # ----------------------------------------------------------------- result
 
     def result(self, calibration_error: float | None = None, fps: float = 0.0) -> TrackResult:
-        """The recording, summary and image tracks of the frames seen so far."""
+        """The recording, summary and image tracks of the frames seen so far. A body never found
+        is a :class:`TrackError` that says where the scene put it."""
         from physbench.recording import Recording, Track
 
         if self.frames == 0:
             raise TrackError("no frames were tracked: the video (or its --start/--end) is empty")
-        tracks, pixels = {}, {}
-        lost: dict[str, list[tuple[float, float]]] = {}
         for s in self.states:
-            pixels[s.body.name] = np.array(s.uv_rows, dtype=float)
-        accuracy = self._accuracy(pixels)
+            if not s.rows:
+                raise BodyNotFoundError(self._never_seen(s))
+        pixels = {s.body.name: np.array(s.uv_rows, dtype=float) for s in self.states}
+        accuracy_px = {
+            s.body.name: stated_accuracy(pixels[s.body.name], disc=s.disc) for s in self.states
+        }
+        accuracy_m = {
+            name: accuracy_px[name] * self._coarsest(pixels[name]) for name in accuracy_px
+        }
+        tracks = {}
         contacts: dict[str, int] = {}
         for s in self.states:
             rows = np.array(s.rows, dtype=float)
             if s.free:
-                hit = contact_samples(rows[:, 0], rows[:, 1:3], self.g, accuracy)
+                hit = contact_samples(
+                    rows[:, 0],
+                    rows[:, 1:3],
+                    self.g,
+                    accuracy_m[s.body.name],
+                    self._explained(s.body.name, rows[:, 0]),
+                )
                 if hit.any():
                     contacts[s.body.name] = int(hit.sum())
                     rows = rows[~hit]
             angle = rows[:, 3] if s.k and not np.isnan(rows[:, 3]).any() else None
             tracks[s.body.name] = Track(rows[:, 0], rows[:, 1], rows[:, 2], angle)
-            gone = list(s.lost)
-            if s.missed and s.gap_start is not None and self.t_last - s.gap_start > self.max_gap:
-                gone.append((s.gap_start, self.t_last))
-            if gone:
-                lost[s.body.name] = gone
         fields = ("x", "y", "angle") if any(t.angle is not None for t in tracks.values()) else None
-        recording = Recording(tracks, fields=fields, source="video", meta={}, accuracy=accuracy)
+        recording = Recording(
+            tracks, fields=fields, source="video", meta={}, accuracy=max(accuracy_m.values())
+        )
+        names = [s.body.name for s in self.states]
         summary = TrackSummary(
             self.frames,
             self.t_last,
-            {s.body.name: len(s.rows) for s in self.states},
-            {s.body.name: s.gaps + (1 if s.missed else 0) for s in self.states},
-            lost,
+            {s.body.name: s.seen for s in self.states},
+            {s.body.name: s.in_view for s in self.states},
+            {s.body.name: list(s.unseen.spans) for s in self.states if s.unseen.spans},
             self.cal.reprojection_error if calibration_error is None else calibration_error,
             fps,
             contacts,
+            {s.body.name: list(s.out.spans) for s in self.states if s.out.spans},
+            {s.body.name: s.rejected for s in self.states if s.rejected},
+            {n: round(accuracy_px[n], 3) for n in names},
+            {s.body.name: s.centroids for s in self.states if s.centroids},
         )
         return TrackResult(recording, summary, pixels)
 
-    def _accuracy(self, pixels: Mapping[str, np.ndarray]) -> float:
-        """:data:`ACCURACY_PX` in metres where the scene's scale is coarsest along the tracks."""
-        seen = [tuv[:, 1:][np.isfinite(tuv[:, 1:]).all(axis=1)] for tuv in pixels.values()]
-        points = np.concatenate([uv[:: max(1, len(uv) // 16)] for uv in seen if len(uv)])
+    def _explained(self, body: str, t: np.ndarray) -> np.ndarray | None:
+        """The second differences' accelerations (m/s², ``(n - 2, 2)``) that the scene's
+        gravity and forces explain at samples ``t`` of ``body``: None without forces on it."""
+        if body not in self.motion.forces or len(t) < 3:
+            return None
+        out = np.empty((len(t) - 2, 2))
+        for k in range(1, len(t) - 1):
+            d1, d2 = t[k] - t[k - 1], t[k + 1] - t[k]
+            x1 = self.motion.kick(body, t[k - 1], d1).dx
+            x2 = self.motion.kick(body, t[k - 1], d1 + d2).dx
+            out[k - 1] = 2 * ((x2 - x1) / d2 - x1 / d1) / (d1 + d2)
+        return out
+
+    def _never_seen(self, s: _State) -> str:
+        u, v = self.cal.to_image(np.asarray(s.body.position, dtype=float))
+        if not s.in_view:
+            return (
+                f"body {s.body.name!r} was never in view: the scene puts it at pixel (u={u:.0f}, "
+                f"v={v:.0f}) at t = 0, outside the {self.w}x{self.h} image, and its predicted "
+                "path never came into it; check the scene's initial position and velocity, "
+                "--seed, --start and the calibration"
+            )
+        first = s.unseen.spans[0][0] if s.unseen.spans else 0.0
+        return (
+            f"body {s.body.name!r} was not found in any of the {s.in_view} frames where the "
+            f"scene puts it in view (from t = {first:.2f} s); its predicted path enters the image "
+            "but nothing of its size and colour was there: check the scene's initial position "
+            "and velocity, --seed, --start and the calibration"
+        )
+
+    def _coarsest(self, tuv: np.ndarray) -> float:
+        """The largest metres per pixel along an image track ``(t, u, v)``."""
+        uv = tuv[:, 1:][np.isfinite(tuv[:, 1:]).all(axis=1)]
+        points = uv[:: max(1, len(uv) // 16)]
         if not len(points):
             return 0.0
-        return ACCURACY_PX * max(self.cal.metres_per_pixel(p) for p in points)
+        return max(self.cal.metres_per_pixel(p) for p in points)
 
 
 def track_frames(
@@ -527,13 +997,16 @@ def track_frames(
     calibration: Calibration,
     background: np.ndarray,
     *,
-    max_gap: float = MAX_GAP,
+    median: bool = False,
+    allow_gaps: bool = False,
     progress: bool = False,
 ) -> TrackResult:
-    """Track ``scene``'s bodies through decoded ``frames`` against ``background``."""
+    """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
+    the clip's median). A body lost in more than :data:`~physbench.video.outcome.LOST_SHARE` of
+    the frames where it was in view raises :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
-    tracker = Tracker(scene, calibration, background, max_gap=max_gap)
+    tracker = Tracker(scene, calibration, background, median=median)
     tic = _time.perf_counter()
     for fr in frames:
         tracker.update(fr.image, fr.time)
@@ -542,7 +1015,22 @@ def track_frames(
     if progress:
         print(file=sys.stderr)
     fps = tracker.frames / max(_time.perf_counter() - tic, 1e-9)
-    return tracker.result(fps=fps)
+    result = tracker.result(fps=fps)
+    failures = result.summary.failures()
+    if failures and not allow_gaps:
+        held = (
+            "; the background is the clip's median, which holds a body that stays put for over "
+            "half of the clip: film the empty scene and give it as --background"
+            if median
+            else ""
+        )
+        raise TrackLostError(
+            "; ".join(failures) + ". A track with such gaps is not the motion; find why in a "
+            "--preview (an occluder, too little contrast, a body leaving the view), or pass "
+            f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{held}",
+            result,
+        )
+    return result
 
 
 def track_video(
@@ -553,7 +1041,7 @@ def track_video(
     start: float | None = None,
     end: float | None = None,
     background: np.ndarray | str | Path | None = None,
-    max_gap: float = MAX_GAP,
+    allow_gaps: bool = False,
     progress: bool = False,
 ) -> TrackResult:
     """Track ``scene``'s bodies through the video at ``path`` (see the module docstring).
@@ -562,7 +1050,9 @@ def track_video(
     ``calibration``: pixels to metres (default :func:`bounds_calibration`); ``start``/``end``: the
     part of the video to track (s; recording time 0 is the first frame at or after ``start``);
     ``background``: an image of the empty scene (array or file; default: the median of the
-    clip, which costs a second pass over the video)."""
+    clip, which costs a second pass over the video); ``allow_gaps``: keep a body lost for more
+    than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view (else
+    :class:`TrackLostError`)."""
     from physbench.video.background import load_plate, median_background
     from physbench.video.reader import VideoError, VideoReader
 
@@ -574,11 +1064,9 @@ def track_video(
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
             background = load_plate(background)
-        median = None
+        median = background is None
         if background is None:
-            background = median = median_background(
-                VideoReader(path, start=start, end=end, fps=scene.fps)
-            )
+            background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
         background = np.asarray(background)
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise TrackError(
@@ -591,17 +1079,15 @@ def track_video(
                 f"{str(path)!r} is {info.width}x{info.height} px: give a plate of this camera's "
                 "view"
             )
-        try:
-            return track_frames(
-                reader.frames(), scene, calibration, background, max_gap=max_gap, progress=progress
-            )
-        except BodyNotFoundError as exc:
-            if median is None:
-                raise
-            raise BodyNotFoundError(
-                f"{exc}; the background is the median of the clip, which holds a body that stays "
-                "put for most of it: film the empty scene and give it as the background"
-            ) from None
+        return track_frames(
+            reader.frames(),
+            scene,
+            calibration,
+            background,
+            median=median,
+            allow_gaps=allow_gaps,
+            progress=progress,
+        )
     except VideoError as exc:
         raise TrackError(str(exc)) from None
 

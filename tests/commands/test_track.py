@@ -76,3 +76,50 @@ def test_bad_input_gets_a_clear_error(clip, capsys) -> None:
         err = capsys.readouterr().err
         assert err.startswith("physbench track: error:") and message in err, err
     assert digest(tmp / "clip.mp4") == before
+
+
+@pytest.fixture(scope="module")
+def hidden(clip):
+    """The clip as a folder of images in which the test ball is hidden from frame 8 on: the
+    plate shows where it is."""
+    from physbench.video.reader import VideoReader
+
+    tmp, scene, traj = clip
+    folder = tmp / "hidden"
+    folder.mkdir(exist_ok=True)
+    cam = CameraRenderer(640, bitrate=1_500_000, seed=4)
+    plate = np.array(Image.open(tmp / "plate.png"))
+    for fr in VideoReader(tmp / "clip.mp4").frames():
+        img = fr.image.copy()
+        if fr.index >= 8:
+            u, v = cam.image_points(scene, traj.states[fr.index, :1, :2])[0].astype(int)
+            img[v - 40 : v + 40, u - 40 : u + 40] = plate[v - 40 : v + 40, u - 40 : u + 40]
+        Image.fromarray(img).save(folder / f"f{fr.index:03d}.png")
+    return folder
+
+
+def test_a_lost_body_fails_the_command_and_says_when(clip, hidden, capsys) -> None:
+    tmp, scene, _ = clip
+    args = ["track", str(hidden), "--scene", "bouncing_balls", "--seed", "4"]
+    args += ["--calibration", str(tmp / "cal.toml"), "--background", str(tmp / "plate.png")]
+    out_csv = tmp / "lost" / "rec.csv"
+    assert main([*args, "--out", str(out_csv)]) == 2
+    out, err = capsys.readouterr()
+    assert "test: seen in 8/30 frames; lost from 0.27 to 0.97 s" in out  # never "1 gap"
+    assert "gap" not in out.replace("--allow-gaps", "")
+    assert err.startswith("physbench track: error: body 'test' was lost in 22 of the 30 frames")
+    assert "--allow-gaps" in err and not out_csv.exists()
+    assert main([*args, "--out", str(out_csv), "--allow-gaps"]) == 0
+    assert len(read_recording(out_csv, bodies=scene).track("test")) <= 8
+    # The same words wherever a video feeds a run.
+    common = ["--scene", "bouncing_balls", "--seed", "4", "--calibration", str(tmp / "cal.toml")]
+    common += ["--background", str(tmp / "plate.png")]
+    assert main(["discover", str(hidden), *common]) == 2
+    assert "body 'test' was lost in 22 of the 30 frames" in capsys.readouterr().err
+    assert main(["run", "--video", str(hidden), *common, "--iterations", "2"]) == 2
+    assert "body 'test' was lost in 22 of the 30 frames" in capsys.readouterr().err
+    from physbench.discover import load_runs
+
+    (run,) = load_runs(hidden, scene, calibration=tmp / "cal.toml", background=tmp / "plate.png",
+                       allow_gaps=True)  # fmt: skip
+    assert run.recording is not None and len(run.recording.track("test")) <= 8

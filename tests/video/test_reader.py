@@ -96,3 +96,15 @@ def test_unusable_files_are_named_and_left_untouched(tmp_path: Path) -> None:
         write_video(tmp_path / "none.mp4", [], fps=10)
     with pytest.raises(VideoError, match="strictly increasing"):
         write_video(tmp_path / "t.mp4", [frame(0), frame(1)], fps=10, times=[0.1, 0.1])
+
+
+def test_frames_can_be_selected_without_converting_the_others(tmp_path: Path) -> None:
+    # A median background keeps every k-th frame: the others are decoded (a video needs them)
+    # but not yielded, with the same indices and times as without a selection.
+    clip = write_video(tmp_path / "c.mp4", (frame(i) for i in range(9)), fps=30)
+    every = list(VideoReader(clip).frames())
+    some = list(VideoReader(clip).frames(lambda k: k % 3 == 0))
+    assert [f.index for f in some] == [0, 3, 6]
+    assert [f.time for f in some] == [every[k].time for k in (0, 3, 6)]
+    np.testing.assert_array_equal(some[1].image, every[3].image)
+    assert list(VideoReader(clip).frames(lambda k: False)) == []  # decoded, none wanted: no error

@@ -9,11 +9,12 @@ import pytest
 
 from physbench.calibration import Calibration
 from physbench.components import create
-from physbench.scene import Body, Box, Circle, Scene
+from physbench.scene import Body, Box, Circle, Scene, Segment
 from physbench.scenes import bouncing_balls
 from physbench.video.reader import Frame, VideoReader
 from physbench.video.track import (
     TrackError,
+    TrackLostError,
     TrackSummary,
     bounds_calibration,
     track_frames,
@@ -33,13 +34,15 @@ def test_centres_are_sub_pixel_on_realistic_footage(film, engine: str) -> None:
     # The recording is in metres: the true positions, to the pixel's size.
     rec = result.recording
     assert rec.bodies == clip.scene.body_names and rec.track("test").angle is None
-    true = clip.traj.states[:, clip.scene.body_index("b0"), :2]
-    got = np.column_stack([rec.track("b0").x, rec.track("b0").y])
-    assert np.abs(got - true).max() < 0.02
-    assert result.summary.gaps == dict.fromkeys(clip.scene.body_names, 0)
-    # It states its accuracy (half a pixel) in metres, for discover's measurement floor.
+    b0 = rec.track("b0")  # without the frame of its collision
+    true = clip.traj.states[np.round(b0.t * clip.scene.fps).astype(int), 1, :2]
+    assert np.abs(np.column_stack([b0.x, b0.y]) - true).max() < 0.02
+    assert not result.summary.lost and not result.summary.failures()
+    # It states its accuracy in metres, for discover's measurement floor: the disc floor or
+    # twice the noise it measured on each track, whichever is larger.
     mpp = cal.metres_per_pixel((320.0, 240.0))
-    assert 0.4 * mpp < rec.accuracy < 0.7 * mpp
+    assert min(result.summary.accuracy_px.values()) >= 0.25
+    assert 0.2 * mpp < rec.accuracy < 0.7 * mpp
 
 
 @pytest.mark.parametrize("seed,n", [(0, 2), (1, 3), (2, 4), (3, 5), (4, 6)])
@@ -115,11 +118,28 @@ def test_occlusions_are_gaps_and_a_long_one_is_lost(film) -> None:
     assert 1 <= result.summary.contacts["test"] <= 3
     assert len(tr) == len(frames) - 3 - result.summary.contacts["test"]
     assert not np.isin(np.round(tr.t * clip.scene.fps), list(hidden)).any()
-    assert result.summary.gaps["test"] == 1 and not result.summary.lost
+    # Said with its times; 3 of 30 frames is not more than a tenth of the clip: no failure. (The
+    # patch hides part of a rack ball too: a disc seen over too little of its outline is unseen
+    # rather than measured off centre.)
+    lost = result.summary.lost
+    assert lost["test"] == [(8 / 30, 10 / 30)]
+    assert all(8 / 30 <= a <= b <= 10 / 30 for spans in lost.values() for a, b in spans)
+    assert "test: seen in 27/30 frames; lost from 0.27 to 0.33 s" in result.summary.format()
+    assert not result.summary.failures()
     errors, swaps = clip.errors(result.pixels)
     assert swaps == 0 and np.percentile(errors, 95) <= 1.5  # found again after the gap
-    lost = track_frames(occluded(frames, set(range(8, 30))), clip.scene, cal, plate, max_gap=0.3)
-    assert "test" in lost.summary.lost and "lost" in lost.summary.format()
+    # Lost for most of the clip: a failure, unless gaps are allowed.
+    with pytest.raises(
+        TrackLostError,
+        match=r"'test' was lost in 22 of the 30 frames .* from "
+        r"0\.27 to 0\.97 s.*--allow-gaps",
+    ) as caught:
+        track_frames(occluded(frames, set(range(8, 30))), clip.scene, cal, plate)
+    assert "lost from 0.27 to 0.97 s" in caught.value.result.summary.format()
+    kept = track_frames(
+        occluded(frames, set(range(8, 30))), clip.scene, cal, plate, allow_gaps=True
+    )
+    assert len(kept.recording.track("test")) <= 8
 
 
 def test_bounds_calibration_fills_the_image_keeping_the_aspect() -> None:
@@ -167,8 +187,12 @@ def test_a_folder_of_images_is_tracked_at_the_scenes_frame_rate(tmp_path) -> Non
         Image.fromarray(image).save(tmp_path / f"frame{k:04d}.png")
     result = track_video(tmp_path, scene, cam.calibration(scene), background=cam.plate(scene))
     tr = result.recording.track("test")
-    np.testing.assert_allclose(tr.t, np.arange(scene.frames) / scene.fps)
-    np.testing.assert_allclose(tr.x, traj.states[:, 0, 0], atol=0.02)
+    # Every frame's time at the scene's rate, but those whose exposure spans a collision.
+    assert result.summary.detections["test"] == scene.frames
+    frame = np.round(tr.t * scene.fps).astype(int)
+    np.testing.assert_allclose(tr.t, frame / scene.fps, atol=1e-9)
+    assert len(frame) == scene.frames - result.summary.contacts.get("test", 0) >= 27
+    np.testing.assert_allclose(tr.x, traj.states[frame, 0, 0], atol=0.02)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -217,14 +241,210 @@ def test_two_arms_joined_at_an_elbow_keep_their_own_angles() -> None:
         assert np.sqrt(np.mean(err**2)) < 0.01, (name, np.sqrt(np.mean(err**2)))
 
 
-def test_the_summary_counts_in_words_that_agree() -> None:
-    one = TrackSummary(1, 0.1, {"ball": 1}, {"ball": 1}, {}, 0.25, fps=30.0)
+def test_the_summary_says_when_a_body_was_lost_never_how_many_gaps() -> None:
+    one = TrackSummary(11, 3.33, {"ball": 1}, {"ball": 11}, {"ball": [(0.33, 3.33)]}, 0.25, 30.0)
     assert one.format().splitlines() == [
-        "tracked 1 body over 1 frame (0.10 s) at 30 frames/s; calibration reprojection error "
+        "tracked 1 body over 11 frames (3.33 s) at 30 frames/s; calibration reprojection error "
         "0.25 px",
-        "      ball: seen in 1/1 frames, 1 gap",
+        "      ball: seen in 1/11 frames; lost from 0.33 to 3.33 s",
     ]
-    two = TrackSummary(5, 0.2, {"a": 5, "b": 3}, {"a": 0, "b": 2}, {}, 0.25)
-    assert "tracked 2 bodies over 5 frames" in two.format() and "b: seen in 3/5 frames, 2 gaps" in (
-        two.format()
+    assert "gap" not in one.format()
+    (why,) = one.failures()
+    assert why == (
+        "body 'ball' was lost in 10 of the 11 frames where it was in view (91%, more than 10%): "
+        "lost from 0.33 to 3.33 s"
     )
+    # Out of view is not lost: a body that leaves the view is seen in all the frames it is in.
+    two = TrackSummary(
+        5, 0.2, {"a": 5, "b": 3}, {"a": 5, "b": 3}, {}, 0.25, out_of_view={"b": [(0.15, 0.2)]}
+    )
+    assert "b: seen in 3/3 frames in view; out of view from 0.15 to 0.20 s" in two.format()
+    assert "tracked 2 bodies over 5 frames" in two.format() and not two.failures()
+
+
+# ------------------------------------------------------------------ light
+
+
+@pytest.fixture(scope="module")
+def toss(tmp_path_factory):
+    """``film(gains)``: two balls tossed across a wall, filmed at 320x240 (tilted, no flicker of
+    its own) with each frame's light scaled by ``gains``, H.264 at CRF 23, tracked against the
+    clip's median; returns the centre errors (px) and the result."""
+    from physbench.render.camera import CameraRenderer
+    from physbench.video.accuracy import pixel_errors
+    from physbench.video.writer import write_video
+
+    ball = Body("ball", Circle(0.08), (0.6, 0.8), velocity=(2.0, 5.0))
+    puck = Body("puck", Circle(0.1), (3.3, 1.0), velocity=(-1.2, 4.5))
+    scene = Scene("toss", (ball, puck), bounds=(0.0, 0.0, 4.0, 3.0), frames=30).validate()
+    traj = create("simulator", "pymunk").simulate(scene)
+    cam = CameraRenderer(320, flicker=0.0, noise=0.01, seed=3, tilt=10.0)
+    exposed = cam.exposure(scene, traj).astype(np.float32)
+    tmp = tmp_path_factory.mktemp("toss")
+
+    def film(gains: np.ndarray):
+        frames = np.rint(exposed * np.asarray(gains, np.float32)[:, None, None, None])
+        path = write_video(
+            tmp / "clip.mp4", np.clip(frames, 0, 255).astype(np.uint8), fps=30.0, crf=23
+        )
+        result = track_video(path, scene, cam.calibration(scene))  # the median background
+        return pixel_errors(scene, traj, cam, result.pixels)[0], result
+
+    return film
+
+
+_K = np.arange(30)
+LIGHT = {
+    "drifting by 10 %": 1 + 0.1 * np.sin(2 * np.pi * _K / 30),
+    "rising from -10 % to +10 %": 0.9 + 0.2 * _K / 29,
+    "frame 0 5 % brighter": np.r_[1.05, np.ones(29)],
+    "frame 0 5 % darker": np.r_[0.95, np.ones(29)],
+}
+
+
+@pytest.mark.parametrize("light", LIGHT)
+def test_changing_light_tracks_as_well_as_constant_light(toss, light: str) -> None:
+    # Before the light was measured per frame: a light rising over the clip put frame 0 10 %
+    # under the median background, and its threshold from the difference's spread above the
+    # ball ("not in the first frame ... film the empty scene"); a 5 % step at frame 0 made the
+    # centres 50 % worse (median 0.23 against 0.15 px).
+    still, _ = toss(np.ones(30))
+    errors, result = toss(LIGHT[light])
+    assert errors.size == still.size == 60  # both bodies in every frame
+    assert not result.summary.lost
+    assert np.median(errors) <= np.median(still) + 0.05  # measured within 0.03 px
+    assert np.percentile(errors, 95) <= 1.25 * np.percentile(still, 95) + 0.05
+
+
+# ------------------------------------------------------------------ first-frame failures
+
+
+def _painted(spheres, *, gain: float = 1.0, n: int = 4, seed: int = 0):
+    """``n`` still 240x320 frames of a textured wall with lit ``spheres`` ``(Sphere, (u, v))``,
+    the first in light ``gain``; and the wall's plate."""
+    from physbench.video.spheres import expose, paint, wall
+
+    rng = np.random.default_rng(seed)
+    plate = wall((240, 320), seed)
+    img = plate.astype(np.float64)
+    for sphere, centre in spheres:
+        paint(img, sphere, [centre])
+    frames = [Frame(k, k / 30, expose(img, rng, gain=gain if k == 0 else 1.0)) for k in range(n)]
+    return frames, expose(plate.astype(np.float64), rng, noise=0.0)
+
+
+def _still(name: str, uv: tuple[float, float], radius_px: float) -> tuple[Scene, Calibration]:
+    """A scene of one still disc at pixel ``uv`` through a 1 cm per pixel calibration."""
+    cal = Calibration.from_scale(0.01, (0.0, 239.0))
+    x, y = cal.to_scene(uv)
+    body = Body(name, Circle(0.01 * radius_px), (float(x), float(y)))
+    scene = Scene("s", (body,), bounds=(-2.0, -2.0, 6.0, 5.0), gravity=(0.0, 0.0)).validate()
+    return scene, cal
+
+
+def test_a_first_frame_failure_names_the_measured_cause_and_its_fix() -> None:
+    from physbench.video.spheres import Sphere
+
+    red = Sphere(12.0, (0.85, 0.15, 0.1))
+    frames, plate = _painted([(red, (160.0, 120.0))])
+    # The scene puts the ball 40 px off: a blob of its size is there.
+    scene, cal = _still("ball", (200.0, 120.0), 12.0)
+    with pytest.raises(TrackError, match=r"a blob of its size is 40 px away, at pixel \(u=160"):
+        track_frames(frames, scene, cal, plate)
+    # Nothing there: against a plate, the scene or the calibration is off; against the clip's
+    # median, the body may also be held by it: both fixes, with what was measured.
+    scene, cal = _still("ball", (300.0, 20.0), 12.0)
+    with pytest.raises(TrackError, match=r"nothing there differs .* check the scene's initial"):
+        track_frames(frames, scene, cal, plate)
+    with pytest.raises(TrackError, match=r"Either the body is elsewhere .* film the empty scene"):
+        track_frames(frames, scene, cal, plate, median=True)
+    # A grey ball a few grey levels off the wall: too little contrast, not "film the empty scene".
+    wall_colour = tuple(float(c) / 255 for c in plate[120, 160])
+    dim = Sphere(12.0, wall_colour, ambient=0.97, specular=0.0)
+    frames, plate = _painted([(dim, (160.0, 120.0))])
+    scene, cal = _still("ball", (160.0, 120.0), 12.0)
+    with pytest.raises(TrackError, match=r"too little contrast") as caught:
+        track_frames(frames, scene, cal, plate, median=True)
+    assert "film the empty scene and give it" not in str(caught.value)
+    # A first frame 20 % brighter than the background is measured and compensated: found.
+    frames, plate = _painted([(red, (160.0, 120.0))], gain=1.2)
+    result = track_frames(frames, scene, cal, plate)
+    assert result.summary.detections == {"ball": 4}
+    # With the body missing as well, the message says the light was not the cause.
+    scene, cal = _still("ball", (300.0, 20.0), 12.0)
+    with pytest.raises(TrackError, match=r"frame 0 is 20% brighter .* \(not the cause\)"):
+        track_frames(frames, scene, cal, plate)
+    # A scene that puts every body outside the view: the calibration or the scene is off.
+    scene, cal = _still("ball", (400.0, 120.0), 12.0)
+    with pytest.raises(TrackError, match=r"no body of the scene is in the first frame: .*'ball' "):
+        track_frames(frames, scene, cal, plate)
+
+
+# ------------------------------------------------------------------ resting bodies, occluders
+
+
+def _rolling(fps: float, frames: int) -> Scene:
+    """A ball rolling at 0.7 m/s along a level floor, from 1 m of a 3 m wide view."""
+    r, v = 0.06, 0.7
+    ball = Body(
+        "ball", Circle(r), (1.0, 0.1 + r), velocity=(v, 0.0), angular_velocity=-v / r, friction=0.8
+    )
+    floor = Segment((-1.0, 0.1), (6.0, 0.1), friction=0.8)
+    return Scene(
+        "roll", (ball,), bounds=(0.0, 0.0, 4.0, 1.2), fps=fps, frames=frames, statics=(floor,)
+    ).validate()
+
+
+def _film_rolling(tmp_path, scene: Scene, shutter: float, paint=None):
+    """Film ``scene`` (``paint(frames, true pixels)`` draws on the frames) as H.264; returns a
+    function that tracks it (options of :func:`track_video`) into the result and its centre
+    errors (px)."""
+    from physbench.render.camera import CameraRenderer
+    from physbench.video.accuracy import pixel_errors
+    from physbench.video.writer import write_video
+
+    traj = create("simulator", "pymunk").simulate(scene)
+    cam = CameraRenderer(640, view=[0.0, 0.0, 3.0, 1.2], shutter=shutter, seed=2, tilt=8.0)
+    frames = cam.exposure(scene, traj).copy()
+    if paint is not None:
+        paint(frames, cam.image_points(scene, traj.states[:, 0, :2]))
+    path = write_video(tmp_path / "roll.mp4", frames, fps=scene.fps, crf=23)
+
+    def track(**options):
+        result = track_video(
+            path, scene, cam.calibration(scene), background=cam.plate(scene), **options
+        )
+        return result, pixel_errors(scene, traj, cam, result.pixels)[0]
+
+    return track
+
+
+def test_a_ball_rolling_on_a_floor_at_3_fps_is_tracked_wherever_it_is_in_view(tmp_path) -> None:
+    # The issue's steel ball on a rail at 3 frames/s: predicted in free fall, the prediction was
+    # 143 px under it and the ball "seen in 1/11 frames, 1 gap" (here: 1/12). Predicted along
+    # the floor it is found in every frame where it is in view, and leaving the view at the
+    # right is no failure.
+    result, errors = _film_rolling(tmp_path, _rolling(3.0, 12), shutter=0.1)()
+    summary = result.summary
+    assert summary.detections == summary.in_view == {"ball": 10}
+    assert summary.out_of_view == {"ball": [(10 / 3, 11 / 3)]} and not summary.lost
+    assert errors.max() < 1.0  # measured 0.44 px
+
+
+def test_an_occluder_of_another_colour_is_not_taken_for_the_ball(tmp_path) -> None:
+    # A hand, bigger than the ball and of skin colour, comes down across its path and leaves.
+    # Before: the hand was followed as the ball, up to 146 px off. Now: the frames where it hides
+    # or joins the ball are lost (said, with their times: a failure, as 7 of 30 frames is more
+    # than a tenth), and no sample is off the ball.
+    def hand(frames: np.ndarray, truth: np.ndarray) -> None:
+        u, v = truth[15]
+        for k in range(len(frames)):
+            top, bottom = np.clip(np.array([v - 35, v + 35]) + (k - 15) * 10, 0, 480).astype(int)
+            frames[k, top:bottom, int(u - 22) : int(u + 22)] = (205, 160, 130)
+
+    track = _film_rolling(tmp_path, _rolling(30.0, 30), shutter=0.3, paint=hand)
+    with pytest.raises(TrackLostError, match=r"'ball' was lost in 7 of the 30 frames .* from 0"):
+        track()
+    result, errors = track(allow_gaps=True)
+    assert result.summary.lost == {"ball": [(12 / 30, 18 / 30)]}
+    assert errors.size == 23 and errors.max() < 1.0  # measured 0.30 px

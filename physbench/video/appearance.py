@@ -1,0 +1,109 @@
+"""What a tracked body looks like, and whether a detection looks like it.
+
+A detection near a body's prediction is not always the body: a hand that reaches in, a shadow, an
+occluder crossing in front, a rod joined to a pendulum's bob. Each body keeps its
+:class:`Appearance` from the frames where it was found: its size (covered area over the area the
+scene and the calibration give it there) and its colour (the median of its inner pixels, taken
+back to the background's light by the frame's gain and offset). A detection whose size or colour
+departs from the body's by more than the body's own spread allows is rejected, so the body is
+unseen in that frame rather than recorded where something else is.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: The covered area may be this many times smaller or larger than the scene's: motion blur keeps
+#: the area, a threshold or a partly hidden edge changes it by tens of per cent.
+SIZE_RATIO = 2.2
+#: Largest change of a colour's direction (distance between unit RGB vectors) from the body's:
+#: shading and uneven light keep the direction, motion blur mixes in some of the wall's (up to
+#: 0.2 measured on a swinging arm's best covered pixels); another material departs further (a
+#: red ball and a hand: 0.48, red and blue: 1.2).
+HUE_TOLERANCE = 0.25
+#: The colour's brightness may be this many times darker or brighter than the body's (shading
+#: and uneven light across the view).
+BRIGHTNESS_RATIO = 1.8
+#: Added to each channel (grey levels) before a colour's direction is taken: a dark body's
+#: direction is noise.
+DARK = 16.0
+#: Below this area (px) a body's measured size is loose: the size ratio allowed grows as the
+#: root of this over its area.
+SMALL = 50.0
+#: Weight of a new detection in the running appearance.
+RATE = 0.1
+
+
+@dataclass(frozen=True)
+class Look:
+    """One detection's appearance: ``size`` (covered area over the area the scene gives the
+    body there, ``pixels``) and ``colour`` ``(3,)`` (grey levels in the background's light)."""
+
+    size: float
+    colour: np.ndarray
+    pixels: float = math.inf
+
+
+def _direction(c: np.ndarray) -> np.ndarray:
+    d = np.asarray(c, dtype=float) + DARK
+    return d / np.linalg.norm(d)
+
+
+def colour_directions(colours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions ``(n, 3)`` and lengths ``(n,)`` of pixel ``colours`` (in the background's
+    light, darkened by :data:`DARK` as a :class:`Look`'s), for :meth:`Appearance.matches`."""
+    d = np.asarray(colours, dtype=np.float64) + DARK
+    norms = np.sqrt(np.einsum("ij,ij->i", d, d))
+    return d / norms[:, None], norms
+
+
+@dataclass
+class Appearance:
+    """A body's running appearance (see the module docstring)."""
+
+    size: float
+    colour: np.ndarray
+    hue_spread: float = 0.0
+    seen: int = 1
+
+    @classmethod
+    def first(cls, look: Look) -> Appearance:
+        return cls(look.size, np.asarray(look.colour, dtype=float))
+
+    def mismatch(self, look: Look) -> str | None:
+        """Why ``look`` is not this body (a few words with the measured values), or ``None``."""
+        ratio = look.size / max(self.size, 1e-9)
+        # A body of a few pixels has a size of a few pixels, give or take most of them.
+        allowed = SIZE_RATIO * max(1.0, math.sqrt(SMALL / max(look.pixels, 1e-9)))
+        if not 1 / allowed <= ratio <= allowed:
+            return f"{ratio:.2f} times its size"
+        hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
+        if hue > max(HUE_TOLERANCE, 4 * self.hue_spread):
+            return f"another colour (hue {hue:.2f} off)"
+        bright = (float(np.sum(look.colour)) + 3 * DARK) / (float(np.sum(self.colour)) + 3 * DARK)
+        if not 1 / BRIGHTNESS_RATIO <= bright <= BRIGHTNESS_RATIO:
+            return f"{bright:.2f} times its brightness"
+        return None
+
+    def matches(self, units: np.ndarray, norms: np.ndarray) -> np.ndarray:
+        """Which pixels of a blob have this body's hue and brightness (its own pixels, in a blob
+        shared with bodies or things of other colours), from their :func:`colour_directions`."""
+        tolerance = max(HUE_TOLERANCE, 4 * self.hue_spread)
+        ref = self.colour + DARK
+        size = float(np.linalg.norm(ref))
+        bright = norms / size
+        # |a - b| <= tol for unit vectors: a . b >= 1 - tol^2 / 2.
+        return (units @ (ref / size) >= 1 - 0.5 * tolerance**2) & (
+            (bright >= 1 / BRIGHTNESS_RATIO) & (bright <= BRIGHTNESS_RATIO)
+        )
+
+    def update(self, look: Look) -> None:
+        """Called by the tracker with each accepted detection's appearance."""
+        hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
+        self.hue_spread += RATE * (hue - self.hue_spread)
+        self.size += RATE * (look.size - self.size)
+        self.colour = self.colour + RATE * (np.asarray(look.colour, dtype=float) - self.colour)
+        self.seen += 1

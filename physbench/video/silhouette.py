@@ -1,0 +1,426 @@
+"""A disc's centre from its silhouette: edge points found along rays, fitted by a circle on the
+scene's plane.
+
+The centroid of a lit sphere's pixels is not its centre: the highlight and the shaded side
+differ from the wall by different amounts, so any weighting by the difference leans away from
+the highlight (measured: 0.7-1.1 px on 13-22 px spheres; up to 4 px for a light grey ball on a
+wall of its brightness). The outline does not depend on the shading. From a first guess of the
+centre, rays go out in every direction; along each, the outermost point where the difference
+falls below half of its level just inside (the edge's half-way point, or the foreground
+threshold where that is higher) is an edge point. Edge points map into the plane
+(:meth:`~physbench.calibration.Calibration.to_scene`, so an oblique view's foreshortening does
+not bias the centre) and a circle is fitted to them; points far off the circle are dropped and the
+circle fitted again. A ray that never leaves the foreground (a rod joined to a pendulum's bob,
+a touching ball, an occluder), that leaves the image, or whose edge is far off the circle adds
+nothing, so the fit holds where part of the outline is hidden. Motion blur stretches a fast disc
+into a stadium, symmetric about the disc's pose at mid-exposure: where the circle does not fit
+its edges, a stadium along the disc's motion is fitted instead (a fast ball's centre errors: 95 %
+within 0.24 px, 0.59 px with the circle).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from physbench.calibration import Calibration
+
+#: Radial sampling step along a ray (px).
+STEP = 0.5
+#: A smeared disc's outline is fitted as a stadium where its circle leaves this RMS (px) in its
+#: edges (a still disc's: 0.1-0.2 px).
+STADIUM_RMS = 0.25
+#: Samples of foreground in a row that make the body's rim (1.5 px).
+RUN = 3
+#: Rays are this far apart (px) along the disc's outline: 43 rays on a 27 px disc, whose centre
+#: they fix to a few hundredths of a pixel.
+SPACING = 4.0
+#: How far inside an edge its inner level is searched for (px, at most half the radius): past
+#: an anti-aliased, coded or blurred edge, short of a highlight.
+INNER = 4.0
+#: The largest angle (rad) between two neighbouring edge points that a fit accepts: a disc seen
+#: over less than ~210 degrees of its outline is too little of it.
+MAX_ARC_GAP = math.radians(150.0)
+#: With the disc's radius known from earlier frames, this much of its outline (rad) fixes its
+#: centre.
+MIN_ARC = math.radians(120.0)
+
+
+@dataclass(frozen=True)
+class DiscFit:
+    """A disc fitted to its outline: centre ``xy`` (m) and ``uv`` (px), ``radius`` (m), the
+    share of rays whose edge was kept, the RMS distance (px) of the kept edge points from the
+    circle, and whether the radius was the one known from earlier frames (``fixed``: too little
+    of the outline to fit it)."""
+
+    xy: np.ndarray
+    uv: np.ndarray
+    radius: float
+    kept: float
+    rms_px: float
+    fixed: bool = False
+
+
+def _sample(image: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Bilinear samples (float32) of ``image`` ``(h, w)`` at fractional ``rows``, ``cols``
+    (clamped to the image)."""
+    h, w = image.shape
+    r = np.minimum(np.maximum(rows, 0), h - 1.001)
+    c = np.minimum(np.maximum(cols, 0), w - 1.001)
+    r0, c0 = r.astype(np.intp), c.astype(np.intp)
+    fr, fc = r - r0, c - c0
+    flat = image.ravel()
+    i = r0 * w + c0
+    a, b = flat[i].astype(np.float32), flat[i + 1].astype(np.float32)
+    top = a + (b - a) * fc
+    a, b = flat[i + w].astype(np.float32), flat[i + w + 1].astype(np.float32)
+    bottom = a + (b - a) * fc
+    return top + (bottom - top) * fr
+
+
+@dataclass(frozen=True)
+class Rays:
+    """Where rays look for one disc's edge: from ``centre`` (frame px) for a disc of about
+    ``radius`` px, out to ``reach`` px."""
+
+    centre: np.ndarray
+    radius: float
+    reach: float
+
+
+@dataclass(frozen=True)
+class Edges:
+    """Edge points found along rays: ``uv`` ``(n, 2)`` (frame px), the rays' angles ``theta``,
+    each edge's ``contrast`` (grey levels, its inner level over the outside) and ``width`` (px
+    from where it rises out of the noise to its half-way point: a sharp edge's is about a
+    pixel), its distance from the rays' origin (``reach``, px), and the index of the disc each
+    belongs to (``owner``)."""
+
+    uv: np.ndarray
+    theta: np.ndarray
+    contrast: np.ndarray
+    width: np.ndarray
+    reach: np.ndarray
+    owner: np.ndarray
+
+    def select(self, keep: np.ndarray) -> Edges:
+        """The edges where ``keep`` (a mask or indices)."""
+        return Edges(
+            self.uv[keep],
+            self.theta[keep],
+            self.contrast[keep],
+            self.width[keep],
+            self.reach[keep],
+            self.owner[keep],
+        )
+
+    @staticmethod
+    def join(parts: Sequence[Edges], discs: Sequence[int]) -> Edges:
+        """The edges of several calls of :func:`edge_points` (for ``discs[k]`` discs each) as
+        one, their discs numbered on in order."""
+        shift = np.concatenate([[0], np.cumsum(discs)[:-1]]).astype(np.intp)
+        return Edges(
+            np.concatenate([p.uv for p in parts]).reshape(-1, 2),
+            np.concatenate([p.theta for p in parts]),
+            np.concatenate([p.contrast for p in parts]),
+            np.concatenate([p.width for p in parts]),
+            np.concatenate([p.reach for p in parts]),
+            np.concatenate([p.owner + k for p, k in zip(parts, shift, strict=True)]),
+        )
+
+    def of(self, disc: int) -> Edges:
+        """The edges of disc ``disc``."""
+        return self.select(self.owner == disc)
+
+
+def edge_points(
+    diff: np.ndarray, offset: tuple[int, int], rays: Sequence[Rays], low: float
+) -> Edges:
+    """Edge points of several discs in one difference image ``diff`` (a crop whose top-left
+    pixel is ``offset = (row, col)``), all rays at once: for each of ``rays``, rays every
+    :data:`SPACING` px of its outline (16-64), searched from 70 % of its radius less
+    :data:`INNER` out to its reach;
+    ``low`` is the foreground threshold. Rays that leave the crop, or find no edge, are left
+    out."""
+    counts = [int(np.clip(round(2 * math.pi * r.radius / SPACING), 16, 64)) for r in rays]
+    owner = np.repeat(np.arange(len(rays)), counts)
+    theta = np.concatenate([np.arange(n) * (2 * math.pi / n) for n in counts])
+    radius = np.array([r.radius for r in rays])[owner]
+    start = np.maximum(0.0, 0.7 * radius - INNER)
+    length = np.array([r.reach for r in rays])[owner] - start
+    m = int(np.ceil(length.max() / STEP)) + 1
+    steps = np.minimum(np.floor(length / STEP).astype(np.intp) + 1, m)  # samples per ray
+    s = (start[:, None] + STEP * np.arange(m)[None]).astype(np.float32)  # (n, m)
+    du, dv = np.cos(theta), np.sin(theta)
+    centres = np.array([r.centre for r in rays], dtype=float)[owner]
+    cu, cv = centres[:, 0] - offset[1], centres[:, 1] - offset[0]
+    h, w = diff.shape
+    # Rays are straight: inside the crop where both their ends are.
+    ok = np.ones(len(theta), dtype=bool)
+    for far in (start, start + STEP * (steps - 1)):
+        eu, ev = cu + du * far, cv + dv * far
+        ok &= (eu >= 0) & (eu <= w - 1) & (ev >= 0) & (ev <= h - 1)
+    f32 = np.float32
+    rows_, cols_ = (
+        cv.astype(f32)[:, None] + dv.astype(f32)[:, None] * s,
+        cu.astype(f32)[:, None] + du.astype(f32)[:, None] * s,
+    )
+    p = _sample(diff, rows_, cols_)  # (n, m)
+    above = (p >= low) & (np.arange(m)[None] < steps[:, None])
+    # The outermost run of foreground at least RUN samples long ends at the edge: a speck of the
+    # wall's texture the light does not quite match, a pixel or so past the rim, is not it.
+    run = above[:, RUN - 1 :].copy()
+    for k in range(1, RUN):
+        run &= above[:, RUN - 1 - k : m - k]
+    last = m - 1 - np.argmax(run[:, ::-1], axis=1)
+    ok &= run.any(axis=1) & (last < steps - 1)
+    # The edge's inner level is where the profile stops falling steeply, walking in from its
+    # steepest point near the threshold crossing: the rim's own brightness, not the shading
+    # further in (a lit sphere brightens inwards from a limb as dark as the wall).
+    k = max(2, round(min(INNER, 0.5 * float(radius.min())) / STEP))
+    rows = np.arange(len(theta))
+    idx = np.clip(last[:, None] + np.arange(-k, 2), 0, m - 1)  # (n, k + 2): inside out
+    near = p[rows[:, None], idx]
+    slope = near[:, :-1] - near[:, 1:]  # (n, k + 1): the fall over each step outwards
+    outer = max(1, round(2.0 / STEP))
+    steep = k + 1 - outer + np.argmax(slope[:, -outer:], axis=1)
+    flat = (slope < 0.3 * slope[rows, steep][:, None]) & (np.arange(k + 1) < steep[:, None])
+    shoulder = np.where(flat.any(axis=1), k - np.argmax(flat[:, ::-1], axis=1), 0)
+    inner = near[rows, shoulder]
+    outside = near[:, -1]
+    contrast = inner - outside
+    # An edge whose inner level is under the threshold over the outside is placed by the
+    # threshold, not by its half-way point (inwards by up to a pixel): it adds nothing.
+    ok &= contrast >= low
+    level = 0.5 * (inner + outside)
+    # The outermost sample at or above the level, and the next one out (below it).
+    at = near[:, :-1] >= level[:, None]
+    j = k - np.argmax(at[:, ::-1], axis=1)
+    pj, pn = near[rows, j], near[rows, j + 1]
+    frac = np.clip((pj - level) / np.maximum(pj - pn, 1e-6), 0.0, 1.0)
+    dist = s[rows, idx[rows, j]] + STEP * frac
+    uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
+    width = s[rows, last] + 0.5 * STEP - dist
+    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok])
+
+
+@dataclass(frozen=True)
+class _Groups:
+    """Points in ``count`` contiguous groups (``owner`` increasing): each group's ``sizes`` and
+    the index of its first point (``starts``)."""
+
+    owner: np.ndarray
+    count: int
+    sizes: np.ndarray
+    starts: np.ndarray
+
+    @classmethod
+    def of(cls, owner: np.ndarray, count: int) -> _Groups:
+        sizes = np.bincount(owner, minlength=count)
+        return cls(owner, count, sizes, np.cumsum(sizes) - sizes)
+
+    def rank(self, values: np.ndarray) -> np.ndarray:
+        """Each value's rank (0: smallest) within its group."""
+        order = np.lexsort((values, self.owner))
+        rank = np.empty(len(values), dtype=np.intp)
+        rank[order] = np.arange(len(values)) - self.starts[self.owner[order]]
+        return rank
+
+    def median(self, values: np.ndarray) -> np.ndarray:
+        """Each group's (lower) median of ``values`` (inf values sort last); 0 if empty."""
+        order = np.lexsort((values, self.owner))
+        at = np.clip(self.starts + (self.sizes - 1) // 2, 0, len(values) - 1)
+        return np.where(self.sizes > 0, values[order][at], 0.0)
+
+    def total(self, values: np.ndarray) -> np.ndarray:
+        return np.bincount(self.owner, values, self.count)
+
+
+def _circles(xy: np.ndarray, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray, np.ndarray]:
+    """Each group's weighted least-squares circle through its points ``xy`` (algebraic: Kasa, by
+    its normal equations), as centres ``(count, 2)`` and radii ``(count,)``; NaN for a group
+    without three weighted points."""
+    some = g.sizes > 0
+    mean = np.zeros((g.count, 2))
+    mean[some] = np.add.reduceat(xy, g.starts[some], axis=0) / g.sizes[some, None]
+    a = np.ones((len(xy), 4))
+    a[:, :2] = xy - mean[g.owner]
+    a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
+    outer = (a[:, :3] * weight[:, None])[:, :, None] * a[:, None, :]  # (n, 3, 4)
+    m = np.zeros((g.count, 3, 4))
+    m[some] = np.add.reduceat(outer, g.starts[some], axis=0)
+    sol = np.full((g.count, 3), np.nan)
+    ok = g.total(weight > 0) >= 3
+    if ok.any():
+        lhs = m[ok, :, :3]
+        lhs += 1e-12 * np.trace(lhs, axis1=1, axis2=2)[:, None, None] * np.eye(3)
+        sol[ok] = np.linalg.solve(lhs, m[ok, :, 3:])[:, :, 0]
+    c = sol[:, :2] / 2
+    r = np.sqrt(np.maximum(sol[:, 2] + (c * c).sum(axis=1), 0.0))
+    return c + mean, r
+
+
+def _circle_of_radius(
+    xy: np.ndarray, weight: np.ndarray, start: np.ndarray, r: float
+) -> np.ndarray:
+    """The centre of the circle of radius ``r`` through ``xy`` (weighted least squares on the
+    distances to it, Gauss-Newton from ``start``)."""
+    c = np.asarray(start, dtype=float).copy()
+    for _ in range(8):
+        d = xy - c
+        dist = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-12)
+        jac = -d / dist[:, None]
+        res = dist - r
+        jw = jac * weight[:, None]
+        step = np.linalg.solve(jw.T @ jac + 1e-12 * np.eye(2), -(jw.T @ res))
+        c += step
+        if float(np.hypot(*step)) < 1e-6 * r:
+            break
+    return c
+
+
+def _stadium(
+    xy: np.ndarray, weight: np.ndarray, start: np.ndarray, r: float, along: np.ndarray
+) -> tuple[np.ndarray, float, float, np.ndarray]:
+    """The stadium a disc of radius about ``r`` smears into moving along the unit vector
+    ``along``: its centre (the disc's pose at mid-exposure) and radius, fitted to
+    edge points ``xy`` by weighted least squares on their distance to it (Gauss-Newton from
+    ``start``, twice, dropping points off it by more than 3 robust deviations); the RMS distance
+    of the points kept from it; and the mask of them."""
+    c = np.asarray(start, dtype=float).copy()
+    h, rr = 0.25 * r, r
+    keep = np.ones(len(xy), dtype=bool)
+    for round_ in range(2):
+        for _ in range(8):
+            q = xy - c
+            t = q @ along
+            ends = np.abs(t) > h
+            nearest = c + np.clip(t, -h, h)[:, None] * along
+            off = xy - nearest
+            dist = np.maximum(np.hypot(off[:, 0], off[:, 1]), 1e-12)
+            unit = off / dist[:, None]
+            jac = np.empty((len(xy), 4))
+            jac[:, :2] = -unit
+            jac[:, 2] = np.where(ends, -np.sign(t) * (unit @ along), 0.0)
+            jac[:, 3] = -1.0
+            res = dist - rr
+            jw = jac * (weight * keep)[:, None]
+            step = np.linalg.lstsq(jw.T @ jac + 1e-12 * np.eye(4), -(jw.T @ res), rcond=None)[0]
+            c += step[:2]
+            h, rr = max(h + step[2], 0.0), rr + step[3]
+            if abs(step).max() < 1e-6 * r:
+                break
+        if round_ == 0:
+            scale = 1.4826 * float(np.median(np.abs(res[keep])))
+            keep = np.abs(res) <= max(3.0 * scale, 1e-9)
+    return c, rr, float(np.sqrt(np.mean(res[keep] ** 2))), keep
+
+
+def _arc_gaps(theta: np.ndarray, g: _Groups) -> np.ndarray:
+    """Each group's largest angle (rad) between neighbouring rays ``theta`` (increasing within
+    a group) round the circle; 2 pi for a group of fewer than two."""
+    gaps = np.full(g.count, 2 * math.pi)
+    full = g.sizes >= 2
+    if full.any():
+        ends = g.starts + g.sizes - 1
+        gaps[full] = theta[g.starts[full]] + 2 * math.pi - theta[ends[full]]
+        same = g.owner[1:] == g.owner[:-1]
+        np.maximum.at(gaps, g.owner[1:][same], np.diff(theta)[same])
+    return gaps
+
+
+def fit_discs(
+    edges: Edges,
+    radii: Sequence[float],
+    calibration: Calibration,
+    mpp: Sequence[float],
+    known: Sequence[float | None],
+    along: Sequence[np.ndarray | None] | None = None,
+) -> list[DiscFit | None]:
+    """Each disc's centre from its :class:`Edges` (``owner``: the index into ``radii``), fitted
+    by a circle on the plane (see the module docstring), all discs at once; ``mpp``: metres per
+    pixel at each. ``None`` for a disc whose outline is not a disc's of about its radius (px)
+    (too few edges, too little of the outline, another radius). ``known``: a disc's radius on
+    the plane (m) as fitted in earlier frames, for an outline seen over too little of its circle
+    to fit one freely (then fitted with that radius: ``fixed``). ``along``: for a disc moving
+    fast enough to be smeared by the exposure, the unit direction of its motion on the plane;
+    its outline is then fitted as the stadium the smear makes, whose centre is the disc's pose
+    at mid-exposure (a circle fitted to a stadium's edges leans to whichever end kept more).
+
+    An edge nearer the rays' origin than half the radius, or nearer the fitted centre than 70 %
+    of the radius, is not the outline (a highlight's rim, where the rest of a lit side is as
+    bright as the wall). Edges count by how surely they are placed: one of little contrast, or
+    one that rises out of the noise slowly (a lit limb shows only where the sphere brightens
+    inwards, inside the true outline), counts for less than a sharp one. The fit is robust: from
+    the circle of the three quarters of a disc's edges that fit it best, edges further than 3
+    robust standard deviations (at least 0.75 px) off it are dropped and the circle refitted."""
+    count = len(radii)
+    radius = np.asarray(radii, dtype=float)
+    mpp_ = np.asarray(mpp, dtype=float)
+    e = edges.select(edges.reach >= 0.5 * radius[edges.owner])
+    if not len(e.owner):
+        return [None] * count
+    g = _Groups.of(e.owner, count)
+    own = e.owner
+    xy = calibration.to_scene(e.uv)
+    top = np.zeros(count)
+    np.maximum.at(top, own, e.contrast)
+    sharp = np.minimum(1.0, g.median(e.width)[own] / np.maximum(e.width, 1e-3))
+    weight = (np.minimum(1.0, e.contrast / (0.5 * top[own])) * sharp) ** 2
+    centre, r = _circles(xy, weight, g)
+    res = np.abs(np.hypot(*(xy - centre[own]).T) - r[own])
+    # Least trimmed squares: the three quarters nearest the circle (a highlight's rim is a tight
+    # cluster of edges inside the outline, which a fit to all of them leans to).
+    trim = g.rank(np.where(np.isnan(res), np.inf, res)) < np.maximum(6, 3 * g.sizes // 4)[own]
+    centre, r = _circles(xy, weight * trim, g)
+    dist = np.hypot(*(xy - centre[own]).T)
+    res = dist - r[own]
+    scale = 1.4826 * g.median(np.where(trim, np.abs(res), np.inf))
+    bound = np.maximum(3.0 * scale, 0.75 * mpp_)
+    keep = (np.abs(res) <= bound[own]) & (dist >= 0.7 * np.maximum(r, radius * mpp_)[own])
+    centre, r = _circles(xy, weight * keep, g)
+    kept = g.total(keep)
+    gaps = _arc_gaps(e.theta[keep], _Groups.of(own[keep], count))
+    fixed = np.zeros(count, dtype=bool)
+    for d in np.nonzero((gaps > MAX_ARC_GAP) & (kept >= 6))[0]:
+        if known[d] is not None and gaps[d] <= 2 * math.pi - MIN_ARC:
+            mine = keep & (own == d)
+            centre[d] = _circle_of_radius(xy[mine], weight[mine], centre[d], known[d])
+            r[d], fixed[d] = known[d], True
+    res = np.hypot(*(xy - centre[own]).T) - r[own]
+    rms = np.sqrt(g.total(np.where(keep, res * res, 0.0)) / np.maximum(kept, 1)) / mpp_
+    for d in range(count):
+        # A stadium where the circle does not fit its edges: a smear, not a still disc.
+        if along is None or along[d] is None or fixed[d] or kept[d] < 6 or rms[d] < STADIUM_RMS:
+            continue
+        mine = own == d
+        c, rd, spread, inner = _stadium(xy[mine], weight[mine], centre[d], r[d], along[d])
+        centre[d], r[d], rms[d] = c, rd, spread / mpp_[d]
+        kept[d] = inner.sum()
+    good = (kept >= 6) & ((gaps <= MAX_ARC_GAP) | fixed) & np.isfinite(r)
+    good &= (0.5 * radius * mpp_ <= r) & (r <= 2.5 * radius * mpp_)
+    fits: list[DiscFit | None] = [None] * count
+    if good.any():
+        uv = calibration.to_image(centre[good])
+        for k, d in enumerate(np.nonzero(good)[0]):
+            share = float(kept[d] / g.sizes[d])
+            fits[d] = DiscFit(centre[d], uv[k], float(r[d]), share, float(rms[d]), bool(fixed[d]))
+    return fits
+
+
+def fit_disc(
+    edges: Edges,
+    radius: float,
+    calibration: Calibration,
+    mpp: float,
+    known: float | None = None,
+) -> DiscFit | None:
+    """:func:`fit_discs` for the edges of one disc."""
+    one = Edges(edges.uv, edges.theta, edges.contrast, edges.width, edges.reach,
+                np.zeros(len(edges.uv), dtype=np.intp))  # fmt: skip
+    return fit_discs(one, [radius], calibration, [mpp], [known])[0]

@@ -1,0 +1,23 @@
+"""The accuracy a track states: its floor, or twice the noise its fifth differences measure."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from physbench.video.accuracy import ACCURACY_PX, DISC_ACCURACY_PX, stated_accuracy, track_noise
+
+
+def test_a_tracks_noise_is_measured_and_its_smooth_motion_is_not() -> None:
+    rng = np.random.default_rng(0)
+    t = np.arange(80) / 20.0  # a swing at 20 frames/s: its third differences are most of a pixel
+    swing = np.column_stack([t, 320 + 90 * np.sin(2 * np.pi * t / 1.5), 240 + 30 * np.cos(t)])
+    assert track_noise(swing) < 0.02
+    noisy = swing.copy()
+    noisy[:, 1:] += rng.normal(0.0, 0.3, (80, 2))
+    assert abs(track_noise(noisy) / 0.3 - 1) < 0.25
+    # A gap breaks the runs of evenly spaced samples, not the estimate.
+    assert abs(track_noise(np.delete(noisy, [30, 31, 50], axis=0)) / 0.3 - 1) < 0.25
+    assert np.isnan(track_noise(noisy[:6]))
+    assert stated_accuracy(swing, disc=True) == DISC_ACCURACY_PX
+    assert stated_accuracy(swing, disc=False) == ACCURACY_PX
+    assert abs(stated_accuracy(noisy, disc=True) / 0.6 - 1) < 0.25  # twice the noise
