@@ -1,14 +1,27 @@
-"""Discovery from video, end to end: physbench's hidden-effect runs filmed by the ``camera``
-renderer as H.264 video, tracked, and discovered, next to the same runs' clean tracks.
+"""Discovery from video, end to end: physbench's hidden-effect runs filmed as H.264 video,
+tracked, and discovered, next to the same runs' clean tracks.
 
 For every effect and its scenes (``physbench.discover.synthetic.EFFECT_SCENES``), both engines and
 the given seeds, plus the controls (every synthetic scene without an effect): the run's true motion
-is filmed at 640x480 (oblique view, motion blur, sensor noise, flickering light, 2 Mbit/s H.264),
-tracked with a four-point calibration, and handed to ``discover``; the clean synthetic tracks
-(Gaussian tracking noise) go through ``discover`` too. Writes ``results.json`` (one row per case)
-and ``table.md`` (per effect: named first, magnitude error, for clean and filmed) into ``--out``.
+is filmed at 640x480, tracked with a four-point calibration, and handed to ``discover``; the clean
+synthetic tracks (Gaussian tracking noise) go through ``discover`` too. Writes ``results.json``
+(one row per case) and ``table.md`` (per effect: named first, magnitude error, for clean and
+filmed) into ``--out``.
+
+``--camera camera`` (default) films with physbench's ``camera`` renderer (oblique view, motion
+blur, sensor noise, flickering light, 2 Mbit/s H.264). ``--camera field`` films with the second,
+independent camera (:mod:`physbench.testing.field_camera`), each clip in its own domain drawn
+from the case (light drift of 3-10 %, shaded spheres with a highlight, bricks, planks or plaster,
+0-25 degrees off square-on, lens distortion, vignetting, shot noise, CRF 18-30, motion blur); its
+rows also hold the drawn domain and what the tracker made of the clip (frames seen, centre errors
+in px against the camera's projection of the true motion). ``--clean-from`` takes the clean
+discoveries from an earlier results file (they do not depend on the camera), and ``--compare``
+adds another camera's filmed column to the table.
 
     python benchmarks/video_discover.py --seeds 0 1 2 --out results/video_discover
+    python benchmarks/video_discover.py --camera field --seeds 0 1 2 \\
+        --clean-from results/video_discover/results.json \\
+        --compare results/video_discover/results.json --out results/video_discover_field
 """
 
 from __future__ import annotations
@@ -17,6 +30,7 @@ import argparse
 import json
 import sys
 import time
+import zlib
 from collections import defaultdict
 from pathlib import Path
 
@@ -27,6 +41,7 @@ from physbench.discover.synthetic import (
     EFFECT_SCENES,
     FILM,
     SCENES,
+    SyntheticRun,
     filmed_run,
     magnitude_error,
     make_case,
@@ -36,6 +51,7 @@ from physbench.simulators.pymunk_sim import PymunkSimulator
 
 ENGINES = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}
 TOLERANCE = 0.15
+CAMERAS = ("camera", "field")
 
 
 def cases(seeds: list[int]) -> list[tuple[str | None, str, str, int]]:
@@ -48,6 +64,10 @@ def cases(seeds: list[int]) -> list[tuple[str | None, str, str, int]]:
     ]
     controls = [(None, sc, eng, s) for sc in sorted(SCENES) for eng in ENGINES for s in seeds]
     return hidden + controls
+
+
+def key(row: dict) -> tuple:
+    return (row["effect"], row["scene"], row["engine"], row["seed"])
 
 
 def body_px(effect: str | None, scene: str, engine: str, seed: int) -> float:
@@ -64,6 +84,78 @@ def body_px(effect: str | None, scene: str, engine: str, seed: int) -> float:
     return round(min(b.shape.extent() for b in sc.bodies) / cal.metres_per_pixel(centre), 2)
 
 
+def camera_seed(effect: str | None, scene: str, engine: str, seed: int) -> int:
+    """The field camera's seed for one case: every clip draws its own domain."""
+    return zlib.crc32(f"{effect or 'control'}/{scene}/{engine}/{seed}".encode())
+
+
+def film_field(case: SyntheticRun, cam_seed: int) -> tuple:
+    """``case``'s run as the field camera films it and the tracker follows it: the run with the
+    tracked recording, and a dict of what happened (domain, frames seen, centre errors)."""
+    import tempfile
+    from dataclasses import replace
+
+    from physbench.calibration import Calibration
+    from physbench.testing.field_camera import FieldCamera
+    from physbench.video.footage import frame_trajectory, motion_view
+    from physbench.video.track import track_video
+    from physbench.video.writer import write_clip
+
+    run, rec = case.run, case.run.recording
+    assert case.trajectory is not None and rec is not None
+    sc = run.scene
+    traj = frame_trajectory(case.trajectory, np.arange(sc.frames) / sc.fps)
+    cam = FieldCamera(seed=cam_seed, view=motion_view(sc, traj))
+    x0, y0, x1, y1 = cam.view
+    corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    cal = Calibration.from_points(
+        cam.image_points(sc, corners), corners, lens=cam.calibration(sc).lens
+    )
+    info: dict = {"domain": cam.describe()}
+    info["body_px"] = round(
+        min(
+            b.shape.extent() / cal.metres_per_pixel(cal.to_image(np.asarray(b.position)))
+            for b in sc.bodies
+        ),
+        2,
+    )
+    with tempfile.TemporaryDirectory(prefix="physbench-field-") as tmp:
+        clip = Path(tmp) / "run.mp4"
+        write_clip(cam, clip, sc, traj)
+        try:
+            result = track_video(clip, sc, cal, background=cam.plate(sc))
+        except Exception as exc:  # a refused clip is a result to report
+            info["failure"] = f"{type(exc).__name__}: {exc}"
+            return None, info
+    summary = result.summary
+    info["frames"] = summary.frames
+    info["seen"] = dict(summary.detections)
+    info["lost"] = {b: [list(p) for p in v] for b, v in summary.lost.items()}
+    info["contacts"] = dict(summary.contacts)
+    info["centre_px"] = centre_errors(cam, sc, traj, result.pixels)
+    filmed = replace(result.recording, fields=rec.fields, run=rec.run, source="field camera")
+    return replace(run, recording=filmed, source="filmed"), info
+
+
+def centre_errors(cam, scene, traj, pixels: dict) -> dict:
+    """Per body: median, 95th percentile and largest distance (px) between the tracked centre
+    and the camera's projection of the true centre at that time."""
+    out = {}
+    times = np.asarray(traj.times)
+    for i, name in enumerate(scene.body_names):
+        tuv = pixels.get(name)
+        if tuv is None or not len(tuv):
+            continue
+        xy = np.column_stack([np.interp(tuv[:, 0], times, traj.states[:, i, c]) for c in (0, 1)])
+        d = np.hypot(*(cam.image_points(scene, xy) - tuv[:, 1:3]).T)
+        out[name] = {
+            "median": round(float(np.median(d)), 3),
+            "p95": round(float(np.percentile(d, 95)), 3),
+            "max": round(float(d.max()), 3),
+        }
+    return out
+
+
 def evaluate(effect, disc, truth) -> dict:
     found = disc.cause_results[0] if effect is not None and disc.causes[:1] == [effect] else None
     err = magnitude_error(effect, truth, found.params) if found is not None else None
@@ -75,11 +167,58 @@ def evaluate(effect, disc, truth) -> dict:
     return {"causes": disc.causes, "error": err, "gain": disc.gain, "ok": bool(ok)}
 
 
+FAILED = {"causes": None, "error": None, "gain": None, "ok": False}
+
+
+def run_case(
+    effect: str | None, scene: str, engine: str, seed: int, camera: str, clean: dict | None
+) -> dict:
+    sim = ENGINES[engine]()
+    case = make_case(effect, scene, seed, sim)
+    row: dict = {"effect": effect, "scene": scene, "engine": engine, "seed": seed}
+    row["truth"] = case.truth
+    row["clean"] = (
+        clean
+        if clean is not None
+        else evaluate(effect, discover([case.run], sim, diagnose=False), case.truth)
+    )
+    if camera == "camera":
+        row["body_px"] = body_px(effect, scene, engine, seed)
+        try:
+            filmed = filmed_run(case, seed)
+        except Exception as exc:  # a failed track is a result to report
+            row["filmed"] = dict(FAILED)
+            row["filmed_failure"] = f"{type(exc).__name__}: {exc}"
+        else:
+            row["filmed"] = evaluate(effect, discover([filmed], sim, diagnose=False), case.truth)
+        return row
+    filmed, info = film_field(case, camera_seed(effect, scene, engine, seed))
+    row["body_px"] = info.pop("body_px")
+    row["field"] = info
+    if filmed is None:
+        row["filmed"] = dict(FAILED)
+        row["filmed_failure"] = info["failure"]
+    else:
+        row["filmed"] = evaluate(effect, discover([filmed], sim, diagnose=False), case.truth)
+    return row
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
-    p.add_argument("--out", default="results/video_discover")
+    p.add_argument("--camera", choices=CAMERAS, default="camera", help="which camera films")
+    p.add_argument("--out", default=None, help="default results/video_discover[_field]")
     p.add_argument("--only", default=None, help="run only cases whose name contains this")
+    p.add_argument(
+        "--clean-from",
+        metavar="RESULTS.json",
+        help="take each case's clean discovery from this results file (same cases, same code)",
+    )
+    p.add_argument(
+        "--compare",
+        metavar="RESULTS.json",
+        help="another camera's results: its filmed column joins the table",
+    )
     p.add_argument(
         "--merge",
         nargs="+",
@@ -87,90 +226,111 @@ def main(argv: list[str] | None = None) -> int:
         help="run nothing: join these results files (e.g. seeds run in parallel) into --out",
     )
     args = p.parse_args(argv)
-    out = Path(args.out)
+    out = Path(
+        args.out or ("results/video_discover" + ("_field" if args.camera == "field" else ""))
+    )
     out.mkdir(parents=True, exist_ok=True)
+    other = json.loads(Path(args.compare).read_text())["rows"] if args.compare else None
     if args.merge:
         parts = [json.loads(Path(f).read_text()) for f in args.merge]
         rows = [r for part in parts for r in part["rows"]]
         for r in rows:
-            r.setdefault("body_px", body_px(r["effect"], r["scene"], r["engine"], r["seed"]))
+            if parts[0].get("camera_kind", "camera") == "camera":
+                r.setdefault("body_px", body_px(r["effect"], r["scene"], r["engine"], r["seed"]))
         seeds = sorted({s for part in parts for s in part["seeds"]})
-        payload = {"camera": FILM, "seeds": seeds, "tolerance": TOLERANCE, "rows": rows}
-        (out / "results.json").write_text(json.dumps(payload, indent=1) + "\n")
-        (out / "table.md").write_text(table(rows))
-        print(table(rows))
+        write(out, {**parts[0], "seeds": seeds, "rows": rows}, other)
         return 0
+    clean = {}
+    if args.clean_from:
+        clean = {key(r): r["clean"] for r in json.loads(Path(args.clean_from).read_text())["rows"]}
     rows = []
     todo = cases(args.seeds)
     if args.only:
         todo = [c for c in todo if args.only in f"{c[0]}/{c[1]}/{c[2]}/{c[3]}"]
     t0 = time.perf_counter()
-    for i, (effect, scene, engine, seed) in enumerate(todo):
-        sim = ENGINES[engine]()
-        case = make_case(effect, scene, seed, sim)
-        row: dict = {"effect": effect, "scene": scene, "engine": engine, "seed": seed}
-        row["truth"] = case.truth
-        row["body_px"] = body_px(effect, scene, engine, seed)
-        row["clean"] = evaluate(effect, discover([case.run], sim, diagnose=False), case.truth)
-        try:
-            filmed = filmed_run(case, seed)
-        except Exception as exc:  # a failed track is a result to report
-            row["filmed"] = {"causes": None, "error": None, "gain": None, "ok": False}
-            row["filmed_failure"] = f"{type(exc).__name__}: {exc}"
-        else:
-            row["filmed"] = evaluate(effect, discover([filmed], sim, diagnose=False), case.truth)
+    for i, c in enumerate(todo):
+        row = run_case(*c, args.camera, clean.get(c))
         rows.append(row)
         f = row["filmed"]
         err = "" if f["error"] is None else f"err {f['error']:.1%}"
+        why = f" ({row['filmed_failure'][:120]})" if "filmed_failure" in row else ""
         print(
-            f"[{i + 1}/{len(todo)}] {effect or 'control'}/{scene}/{engine}/{seed}: clean "
-            f"{row['clean']['causes']} filmed {f['causes']} "
-            f"{err} "
-            f"{'ok' if f['ok'] else 'FAIL'} ({time.perf_counter() - t0:.0f} s)",
+            f"[{i + 1}/{len(todo)}] {c[0] or 'control'}/{c[1]}/{c[2]}/{c[3]}: clean "
+            f"{row['clean']['causes']} filmed {f['causes']} {err} "
+            f"{'ok' if f['ok'] else 'FAIL'}{why} ({time.perf_counter() - t0:.0f} s)",
             file=sys.stderr,
+            flush=True,
         )
-    (out / "results.json").write_text(
-        json.dumps(
-            {"camera": FILM, "seeds": args.seeds, "tolerance": TOLERANCE, "rows": rows},
-            indent=1,
-        )
-        + "\n"
-    )
-    (out / "table.md").write_text(table(rows))
-    print(table(rows))
+    payload = {
+        "camera_kind": args.camera,
+        "camera": FILM if args.camera == "camera" else "field (a domain per case: rows[].field)",
+        "seeds": args.seeds,
+        "tolerance": TOLERANCE,
+        "rows": rows,
+    }
+    write(out, payload, other)
     return 0
 
 
-def table(rows: list[dict]) -> str:
+def write(out: Path, payload: dict, other: list[dict] | None) -> None:
+    (out / "results.json").write_text(json.dumps(payload, indent=1) + "\n")
+    text = table(payload["rows"], other, payload.get("camera_kind", "camera"))
+    (out / "table.md").write_text(text)
+    print(text)
+
+
+def table(rows: list[dict], other: list[dict] | None = None, kind: str = "camera") -> str:
     """Per effect (and the controls): cases, named first with magnitude within 15 %, median
-    magnitude error, for the clean tracks and the filmed video."""
+    magnitude error, for the clean tracks and the filmed video (and ``other``'s filmed video,
+    the other camera, on the same cases)."""
+    names = {"camera": "camera", "field": "field camera"}
+    mine = names[kind]
+    theirs = names["field" if kind == "camera" else "camera"]
+    by_key = {key(r): r for r in other or []}
     groups: dict[str, list[dict]] = defaultdict(list)
     for r in rows:
         groups[r["effect"] or "(controls: no cause)"].append(r)
+    cols = ["clean", mine] + ([theirs] if other else [])
     lines = [
-        "| effect | cases | clean: right | filmed: right | clean: median error | "
-        "filmed: median error |",
-        "|---|---|---|---|---|---|",
+        "| effect | cases | "
+        + " | ".join(f"{c}: right" for c in cols)
+        + " | "
+        + " | ".join(f"{c}: median error" for c in cols)
+        + " |",
+        "|---|---|" + "---|" * (2 * len(cols)),
     ]
     for name, rs in groups.items():
+        theirs_rs = [by_key[key(r)] for r in rs if key(r) in by_key]
 
-        def med(kind: str, rs: list[dict] = rs) -> str:
+        def med(kind: str, rs: list[dict]) -> str:
             errs = [r[kind]["error"] for r in rs if r[kind]["error"] is not None]
             return f"{np.median(errs):.1%}" if errs else "-"
 
+        right = [sum(r["clean"]["ok"] for r in rs), sum(r["filmed"]["ok"] for r in rs)]
+        errs = [med("clean", rs), med("filmed", rs)]
+        if other:
+            right.append(sum(r["filmed"]["ok"] for r in theirs_rs))
+            errs.append(med("filmed", theirs_rs))
         lines.append(
-            f"| {name} | {len(rs)} | {sum(r['clean']['ok'] for r in rs)} | "
-            f"{sum(r['filmed']['ok'] for r in rs)} | {med('clean')} | {med('filmed')} |"
+            f"| {name} | {len(rs)} | "
+            + " | ".join(map(str, right))
+            + " | "
+            + " | ".join(errs)
+            + " |"
         )
+    refused = [r for r in rows if "filmed_failure" in r]
+    lines += ["", f"Clips refused by the tracker ({mine}): {len(refused)} of {len(rows)}."]
     misses = [
         f"- {r['effect'] or 'control'}/{r['scene']}/{r['engine']}/{r['seed']}: clean "
         f"{r['clean']['causes']}, filmed {r['filmed']['causes']} (smallest body "
         f"{r.get('body_px', float('nan')):.1f} px in radius)"
+        + (f"; {r['filmed_failure'][:160]}" if "filmed_failure" in r else "")
         for r in rows
         if not r["filmed"]["ok"] or (r["effect"] and (r["filmed"]["causes"] or [])[1:])
     ]
     if misses:
-        lines += ["", "Filmed cases that missed, or named more than the hidden effect:", *misses]
+        lines += ["", f"Filmed cases ({mine}) that missed, or named more than the hidden effect:"]
+        lines += misses
     return "\n".join(lines) + "\n"
 
 
