@@ -46,6 +46,7 @@ from physbench.discover.synthetic import (
     magnitude_error,
     make_case,
 )
+from physbench.errors import PhysbenchError
 from physbench.simulators.box2d_sim import Box2DSimulator
 from physbench.simulators.pymunk_sim import PymunkSimulator
 
@@ -198,8 +199,12 @@ def run_case(
     if filmed is None:
         row["filmed"] = dict(FAILED)
         row["filmed_failure"] = info["failure"]
-    else:
+        return row
+    try:
         row["filmed"] = evaluate(effect, discover([filmed], sim, diagnose=False), case.truth)
+    except PhysbenchError as exc:  # tracks too short or broken for discover: a failure too
+        row["filmed"] = dict(FAILED)
+        row["filmed_failure"] = f"{type(exc).__name__}: {exc}"
     return row
 
 
@@ -218,6 +223,9 @@ def main(argv: list[str] | None = None) -> int:
         "--compare",
         metavar="RESULTS.json",
         help="another camera's results: its filmed column joins the table",
+    )
+    p.add_argument(
+        "--resume", action="store_true", help="keep the finished cases of --out/partial.jsonl"
     )
     p.add_argument(
         "--merge",
@@ -243,14 +251,24 @@ def main(argv: list[str] | None = None) -> int:
     clean = {}
     if args.clean_from:
         clean = {key(r): r["clean"] for r in json.loads(Path(args.clean_from).read_text())["rows"]}
-    rows = []
     todo = cases(args.seeds)
     if args.only:
         todo = [c for c in todo if args.only in f"{c[0]}/{c[1]}/{c[2]}/{c[3]}"]
+    partial = out / "partial.jsonl"  # one row per finished case: --resume goes on from there
+    rows = []
+    if args.resume and partial.exists():
+        rows = [json.loads(line) for line in partial.read_text().splitlines() if line.strip()]
+    elif partial.exists():
+        partial.unlink()
+    done = {key(r) for r in rows}
     t0 = time.perf_counter()
     for i, c in enumerate(todo):
+        if c in done:
+            continue
         row = run_case(*c, args.camera, clean.get(c))
         rows.append(row)
+        with partial.open("a") as fh:
+            fh.write(json.dumps(row) + "\n")
         f = row["filmed"]
         err = "" if f["error"] is None else f"err {f['error']:.1%}"
         why = f" ({row['filmed_failure'][:120]})" if "filmed_failure" in row else ""
@@ -269,6 +287,7 @@ def main(argv: list[str] | None = None) -> int:
         "rows": rows,
     }
     write(out, payload, other)
+    partial.unlink()
     return 0
 
 
