@@ -34,6 +34,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "find the missing physical effect behind a recording's disagreement with the model",
     ),
     "track": ("track", "follow a scene's bodies through a video into a recording CSV (metres)"),
+    "scene": (
+        "scene_new",
+        "scene new: write the scene TOML of your own setup (flight, surface, pendulum, puck)",
+    ),
 }
 
 

@@ -365,7 +365,9 @@ def tracker_xml(
                 f"{media}.ImageCoordSystem$FrameData",
                 *(
                     _prop(k, "double", v)
-                    for k, v in zip(("xorigin", "yorigin", "angle", "xscale", "yscale"), f)
+                    for k, v in zip(
+                        ("xorigin", "yorigin", "angle", "xscale", "yscale"), f, strict=True
+                    )
                 ),
             )
             + "</property>"

@@ -113,7 +113,7 @@ def test_a_trz_archive_holds_the_project(trk, trk_image, tmp_path) -> None:  # t
     assert np.allclose(load_calibration(trz).homography, load_calibration(trk_path).homography)
     with zipfile.ZipFile(trz, "a") as z:
         z.write(trk_path, "second.trk")
-    with pytest.raises(TrackerFileError, match="holds 2 Tracker projects.*second.trk"):
+    with pytest.raises(TrackerFileError, match=r"holds 2 Tracker projects.*second\.trk"):
         read_tracker_project(trz)
     assert read_tracker_project(trz, member="second.trk").marks["ball"].frames[0] == 3
 
