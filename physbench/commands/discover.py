@@ -26,8 +26,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "recording",
         metavar="RECORDING",
         help="tracked trajectories (.csv: t,body,x,y[,angle][,run]), observed frames "
-        "(.npz, key 'frames'), or a camera's video (.mp4, .mov, .avi, .mkv, .webm, .gif, or a "
-        "folder of images): tracked first, as physbench track does",
+        "(.npz, key 'frames'), a Tracker project's hand-marked points (.trz, .trk), or a "
+        "camera's video (.mp4, .mov, .avi, .mkv, .webm, .gif, or a folder of images): tracked "
+        "first, as physbench track does",
     )
     add_scene_argument(
         p, required=True, help="the setup, with the base model's unknowns (its --seed instance)"

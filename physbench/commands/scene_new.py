@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from physbench.commands.arguments import positive_int
+from physbench.commands.arguments import add_quiet_argument, positive_int
 
 KINDS_HELP = (
     "flight (a ball thrown or dropped, side view), surface (a ball rolling or sliding along a "
@@ -16,22 +16,20 @@ KINDS_HELP = (
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
-    n = sub.add_parser(
-        "new",
-        help="write the scene TOML of your own setup",
-        description="Write the scene TOML of your own setup from a few answers. What is not "
-        "given is estimated from --from (a recording CSV or a Tracker project): the initial "
-        "position and velocity from its first 0.3 s, a pendulum's pivot from the circle through "
-        "its samples, the frame rate and length from its samples.",
+    p.description = (
+        "Write the scene TOML of your own setup from a few answers. What is not given is "
+        "estimated from --from (a recording CSV or a Tracker project): the initial position and "
+        "velocity from its first 0.3 s, a pendulum's pivot from the circle through its samples, "
+        "the frame rate and length from its samples."
     )
-    n.add_argument("kind", choices=("flight", "surface", "pendulum", "puck"), help=KINDS_HELP)
-    n.add_argument("--out", required=True, metavar="S.toml", help="write the scene here")
-    n.add_argument("--radius", type=float, required=True, metavar="M", help="body radius (m)")
-    n.add_argument("--body", help="body name (default: the recording's track, else ball/bob/puck)")
-    n.add_argument("--mass", type=float, metavar="KG", help="body mass (default 1 kg)")
-    n.add_argument("--name", help="scene name (default my_KIND)")
-    src = n.add_argument_group("from measurements")
+    p.add_argument("action", choices=("new",), help="new: write a new scene file")
+    p.add_argument("kind", choices=("flight", "surface", "pendulum", "puck"), help=KINDS_HELP)
+    p.add_argument("--out", required=True, metavar="FILE", help="write the scene TOML here")
+    p.add_argument("--radius", type=float, required=True, metavar="M", help="body radius (m)")
+    p.add_argument("--body", help="body name (default: the recording's track, else ball/bob/puck)")
+    p.add_argument("--mass", type=float, metavar="KG", help="body mass (default 1 kg)")
+    p.add_argument("--name", help="scene name (default my_KIND)")
+    src = p.add_argument_group("from measurements")
     src.add_argument(
         "--from",
         dest="source",
@@ -44,7 +42,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="the clip: its frame rate and length (and with --calibration, its view as bounds)",
     )
     src.add_argument("--calibration", metavar="CAL", help="calibration file (for --pixel, --video)")
-    st = n.add_argument_group("answers (each overrides its estimate)")
+    st = p.add_argument_group("answers (each overrides its estimate)")
     st.add_argument("--fps", type=float, help="frames per second")
     st.add_argument("--frames", type=positive_int, help="frames to simulate")
     st.add_argument("--position", type=float, nargs=2, metavar=("X", "Y"), help="start (m)")
@@ -67,6 +65,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     st.add_argument(
         "--bounds", type=float, nargs=4, metavar=("XMIN", "YMIN", "XMAX", "YMAX"), help="m"
     )
+    add_quiet_argument(p, "print only the file written")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -130,8 +129,9 @@ def main(args: argparse.Namespace) -> int:
     text = format_setup(scene, [*notes, *more])
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(text, encoding="utf-8")
-    for line in [*notes, *more]:
-        print(line)
+    if not args.quiet:
+        for line in [*notes, *more]:
+            print(line)
     wrote(args.out)
     return 0
 
