@@ -30,7 +30,6 @@ import argparse
 import json
 import sys
 import time
-import zlib
 from collections import defaultdict
 from pathlib import Path
 
@@ -41,7 +40,6 @@ from physbench.discover.synthetic import (
     EFFECT_SCENES,
     FILM,
     SCENES,
-    SyntheticRun,
     filmed_run,
     magnitude_error,
     make_case,
@@ -85,78 +83,6 @@ def body_px(effect: str | None, scene: str, engine: str, seed: int) -> float:
     return round(min(b.shape.extent() for b in sc.bodies) / cal.metres_per_pixel(centre), 2)
 
 
-def camera_seed(effect: str | None, scene: str, engine: str, seed: int) -> int:
-    """The field camera's seed for one case: every clip draws its own domain."""
-    return zlib.crc32(f"{effect or 'control'}/{scene}/{engine}/{seed}".encode())
-
-
-def film_field(case: SyntheticRun, cam_seed: int) -> tuple:
-    """``case``'s run as the field camera films it and the tracker follows it: the run with the
-    tracked recording, and a dict of what happened (domain, frames seen, centre errors)."""
-    import tempfile
-    from dataclasses import replace
-
-    from physbench.calibration import Calibration
-    from physbench.testing.field_camera import FieldCamera
-    from physbench.video.footage import frame_trajectory, motion_view
-    from physbench.video.track import track_video
-    from physbench.video.writer import write_clip
-
-    run, rec = case.run, case.run.recording
-    assert case.trajectory is not None and rec is not None
-    sc = run.scene
-    traj = frame_trajectory(case.trajectory, np.arange(sc.frames) / sc.fps)
-    cam = FieldCamera(seed=cam_seed, view=motion_view(sc, traj))
-    x0, y0, x1, y1 = cam.view
-    corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
-    cal = Calibration.from_points(
-        cam.image_points(sc, corners), corners, lens=cam.calibration(sc).lens
-    )
-    info: dict = {"domain": cam.describe()}
-    info["body_px"] = round(
-        min(
-            b.shape.extent() / cal.metres_per_pixel(cal.to_image(np.asarray(b.position)))
-            for b in sc.bodies
-        ),
-        2,
-    )
-    with tempfile.TemporaryDirectory(prefix="physbench-field-") as tmp:
-        clip = Path(tmp) / "run.mp4"
-        write_clip(cam, clip, sc, traj)
-        try:
-            result = track_video(clip, sc, cal, background=cam.plate(sc))
-        except Exception as exc:  # a refused clip is a result to report
-            info["failure"] = f"{type(exc).__name__}: {exc}"
-            return None, info
-    summary = result.summary
-    info["frames"] = summary.frames
-    info["seen"] = dict(summary.detections)
-    info["lost"] = {b: [list(p) for p in v] for b, v in summary.lost.items()}
-    info["contacts"] = dict(summary.contacts)
-    info["centre_px"] = centre_errors(cam, sc, traj, result.pixels)
-    filmed = replace(result.recording, fields=rec.fields, run=rec.run, source="field camera")
-    return replace(run, recording=filmed, source="filmed"), info
-
-
-def centre_errors(cam, scene, traj, pixels: dict) -> dict:
-    """Per body: median, 95th percentile and largest distance (px) between the tracked centre
-    and the camera's projection of the true centre at that time."""
-    out = {}
-    times = np.asarray(traj.times)
-    for i, name in enumerate(scene.body_names):
-        tuv = pixels.get(name)
-        if tuv is None or not len(tuv):
-            continue
-        xy = np.column_stack([np.interp(tuv[:, 0], times, traj.states[:, i, c]) for c in (0, 1)])
-        d = np.hypot(*(cam.image_points(scene, xy) - tuv[:, 1:3]).T)
-        out[name] = {
-            "median": round(float(np.median(d)), 3),
-            "p95": round(float(np.percentile(d, 95)), 3),
-            "max": round(float(d.max()), 3),
-        }
-    return out
-
-
 def evaluate(effect, disc, truth) -> dict:
     found = disc.cause_results[0] if effect is not None and disc.causes[:1] == [effect] else None
     err = magnitude_error(effect, truth, found.params) if found is not None else None
@@ -193,12 +119,15 @@ def run_case(
         else:
             row["filmed"] = evaluate(effect, discover([filmed], sim, diagnose=False), case.truth)
         return row
-    filmed, info = film_field(case, camera_seed(effect, scene, engine, seed))
-    row["body_px"] = info.pop("body_px")
-    row["field"] = info
+    from physbench.testing.field_footage import camera_seed, film_case
+
+    film = film_case(case, camera_seed(f"{effect or 'control'}/{scene}/{engine}/{seed}"))
+    row["body_px"] = film.body_px
+    row["field"] = film.info()
+    filmed = film.run
     if filmed is None:
         row["filmed"] = dict(FAILED)
-        row["filmed_failure"] = info["failure"]
+        row["filmed_failure"] = film.failure
         return row
     try:
         row["filmed"] = evaluate(effect, discover([filmed], sim, diagnose=False), case.truth)

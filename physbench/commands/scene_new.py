@@ -50,8 +50,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--pixel",
         type=float,
         nargs=2,
+        action="append",
         metavar=("U", "V"),
-        help="start as the body's pixel in the first frame (needs --calibration)",
+        help="the body's centre pixel in the first frame (needs --calibration); given again for "
+        "the next frames, it gives the velocity too",
     )
     st.add_argument("--velocity", type=float, nargs=2, metavar=("VX", "VY"), help="m/s")
     st.add_argument("--pivot", type=float, nargs=2, metavar=("X", "Y"), help="pendulum pivot (m)")
@@ -75,7 +77,7 @@ def main(args: argparse.Namespace) -> int:
 
     from physbench.commands.console import wrote
     from physbench.errors import PhysbenchError
-    from physbench.scenes.setups import Answers, build_setup, format_setup
+    from physbench.scenes.setups import Answers, build_setup, format_setup, start_from_points
 
     recording, mass, notes = None, args.mass, []
     if args.source:
@@ -104,13 +106,20 @@ def main(args: argparse.Namespace) -> int:
                 np.array([[-0.5, -0.5], [w - 0.5, -0.5], [w - 0.5, h - 0.5], [-0.5, h - 0.5]])
             )
             bounds = [*corners.min(axis=0), *corners.max(axis=0)]
-    position = args.position
+    position, velocity = args.position, args.velocity
     if args.pixel is not None:
         if cal is None:
             raise PhysbenchError("--pixel needs --calibration (to turn the pixel into metres)")
         if position is not None:
             raise PhysbenchError("give the start once: --position or --pixel")
-        position = tuple(float(c) for c in cal.to_scene(np.asarray(args.pixel, dtype=float)))
+        points = cal.to_scene(np.asarray(args.pixel, dtype=float))
+        if len(points) > 1 and not fps:
+            raise PhysbenchError("--pixel in several frames needs the frame rate: --fps or --video")
+        start = start_from_points(args.kind, points, fps or 1.0)
+        position = start.position
+        if len(points) > 1 and velocity is None:
+            velocity = start.velocity
+            notes.append(f"velocity from the body's pixels in the first {len(points)} frames")
     answers = Answers(
         kind=args.kind,
         radius=args.radius,
@@ -119,7 +128,7 @@ def main(args: argparse.Namespace) -> int:
         fps=fps,
         frames=frames,
         position=None if position is None else tuple(position),
-        velocity=None if args.velocity is None else tuple(args.velocity),
+        velocity=None if velocity is None else tuple(velocity),
         pivot=None if args.pivot is None else tuple(args.pivot),
         surface_angle=args.surface_angle,
         bounds=None if bounds is None else tuple(bounds),

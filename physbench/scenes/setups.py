@@ -155,6 +155,22 @@ def estimate(
     raise SetupError(f"kind {kind!r}: expected one of {', '.join(SETUPS)}")
 
 
+def start_from_points(kind: str, points: Sequence[Sequence[float]], fps: float) -> Estimate:
+    """Position and velocity at the first of ``points`` (m), the body's centre in consecutive
+    frames at ``fps`` (e.g. read off the first frames of a clip): a straight-line fit, with
+    gravity taken out for a flight."""
+    p = np.asarray(points, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 2 or len(p) < 1:
+        raise SetupError(f"points {points!r}: expected [x, y] pairs")
+    if len(p) == 1:
+        return Estimate((float(p[0, 0]), float(p[0, 1])), (0.0, 0.0), None, 1, 0.0)
+    t = np.arange(len(p)) / fps
+    a = G if kind == "flight" else 0.0
+    cx, rx = _fit(t, p[:, 0], 1)
+    cy, ry = _fit(t, p[:, 1] + 0.5 * a * t * t, 1)
+    return Estimate((cx[0], cy[0]), (cx[1], cy[1]), None, len(p), math.hypot(rx, ry))
+
+
 def _clock(answers: Answers, rec: Recording | None) -> tuple[float, int]:
     fps, frames = answers.fps, answers.frames
     if fps is None and rec is not None:
