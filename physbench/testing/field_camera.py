@@ -136,7 +136,10 @@ class Domain:
         """:class:`RenderError` naming the first value out of its range."""
         limits = {
             "oblique": (0.0, 70.0),
+            "azimuth": (-360.0, 360.0),
             "roll": (-360.0, 360.0),
+            "light_azimuth": (-360.0, 360.0),
+            "light_elevation": (1.0, 90.0),
             "fov": (10.0, 120.0),
             "margin": (0.0, 0.45),
             "k1": (-0.5, 0.5),
@@ -209,6 +212,15 @@ class _Geometry:
         r = np.sqrt((q * q).sum(axis=-1))
         table = np.linspace(0.0, 1.5 * float(r.max()) + 1e-9, 20001)
         ahead = table * (1 + self.k1 * table**2 + self.k2 * table**4)
+        grows = np.diff(ahead) > 0
+        if not grows.all():  # strong barrel distortion folds back: keep the rising part
+            stop = int(np.argmin(grows))
+            table, ahead = table[: stop + 1], ahead[: stop + 1]
+        if r.max() > ahead[-1]:
+            raise RenderError(
+                f"k1 = {self.k1!r}, k2 = {self.k2!r}: the lens folds the image over before its "
+                "corners; use a smaller |k1|, |k2| or field of view"
+            )
         rho = np.interp(r, ahead, table)
         for _ in range(2):
             rho2 = rho * rho
