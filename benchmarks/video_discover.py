@@ -163,6 +163,9 @@ def main(argv: list[str] | None = None) -> int:
         "issue's target)",
     )
     p.add_argument(
+        "--label", default=None, help="what code ran (default: the git commit), into the results"
+    )
+    p.add_argument(
         "--resume", action="store_true", help="keep the finished cases of --out/partial.jsonl"
     )
     p.add_argument(
@@ -188,6 +191,8 @@ def main(argv: list[str] | None = None) -> int:
         merged = {**parts[0], "seeds": seeds, "rows": rows}
         if args.tolerance:
             merged["tolerance"] = args.tolerance
+        if args.label:
+            merged["code"] = args.label
         write(out, merged, other)
         return 0
     clean = {}
@@ -222,6 +227,7 @@ def main(argv: list[str] | None = None) -> int:
             flush=True,
         )
     payload = {
+        "code": args.label or _commit(),
         "camera_kind": args.camera,
         "camera": FILM if args.camera == "camera" else "field (a domain per case: rows[].field)",
         "seeds": args.seeds,
@@ -231,6 +237,18 @@ def main(argv: list[str] | None = None) -> int:
     write(out, payload, other)
     partial.unlink()
     return 0
+
+
+def _commit() -> str:
+    import subprocess
+
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
+        )
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    return f"git {out.stdout.strip()}"
 
 
 def write(out: Path, payload: dict, other: list[dict] | None) -> None:
