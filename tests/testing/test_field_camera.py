@@ -97,5 +97,5 @@ def test_bad_options_are_named() -> None:
         FieldCamera(texture="marble")
     with pytest.raises(RenderError, match="view = "):
         FieldCamera(view=(1, 1, 0, 0))
-    with pytest.raises(RenderError, match="k1 = -0.5.*folds the image"):
+    with pytest.raises(RenderError, match=r"k1 = -0\.5.*folds the image"):
         FieldCamera(320, k1=-0.5, fov=100).calibration(ball_scene())
