@@ -1,9 +1,12 @@
 """Camera calibration: image pixels to the scene's metres, for a planar scene.
 
 A :class:`Calibration` is a plane homography ``H`` (3 x 3) from undistorted pixel coordinates
-``(u, v)`` (``u`` to the right, ``v`` down, pixel centres at integers) to scene coordinates
-``(x, y)`` in metres (``y`` up), plus optional radial lens distortion. It is made in one of three
-ways, each a small TOML file (:func:`load_calibration`):
+``(u, v)`` (``u`` to the right, ``v`` down, pixel centres at integers: the centre of the top-left
+pixel is ``(0, 0)``, its top-left corner ``(-0.5, -0.5)``) to scene coordinates ``(x, y)`` in
+metres (``y`` up), plus optional radial lens distortion. :func:`load_calibration` reads it from
+one of these files:
+
+A TOML file with exactly one of four tables (:func:`loads_calibration`):
 
 ``[scale]``
     ``metres_per_pixel`` and ``origin_pixel`` (the pixel of the scene's origin): a camera looking
@@ -16,10 +19,24 @@ ways, each a small TOML file (:func:`load_calibration`):
     ``pixels`` and ``metres``: the size of an object of known size in the image (e.g. a ball's
     diameter) and in the scene, with ``origin_pixel``; the same as ``[scale]`` with the scale from
     that object.
+``[homography]``
+    ``matrix``: the 3 x 3 homography itself, rows of ``[a, b, c]`` mapping ``(u, v, 1)`` to
+    ``(x, y, 1)`` up to scale, with an optional top-level ``reprojection_error_px``. This is what
+    :meth:`Calibration.to_toml` writes: any calibration, saved exactly.
 
 ``[lens]`` (optional, with any of them) holds Brown's radial distortion ``k1``, ``k2`` about the
 principal point ``centre`` (pixels) with focal length ``focal`` (pixels): a pixel at normalised
 radius ``r`` from the centre was seen at ``r (1 + k1 r² + k2 r⁴)``.
+
+A CSV file (``.csv``, :func:`loads_calibration_csv`) of image <-> scene point pairs, one per
+row, under a header naming the columns ``u, v, x, y`` (in any order; lines starting with ``#``
+are skipped): the same as ``[[points]]``, for points measured in another program. Mind its pixel
+convention: a program that puts the top-left *corner* of the image at ``(0, 0)`` (Tracker, ImageJ)
+has pixel centres at ``.5``; subtract 0.5 from its ``u`` and ``v``.
+
+A Tracker project (``.trz`` or ``.trk``, :mod:`physbench.tracker_files`): its fixed coordinate
+system (origin, axis angle in degrees, scale in pixels per length unit, converted to metres), with
+Tracker's pixel centres at ``.5`` shifted to physbench's integers.
 
 :attr:`Calibration.reprojection_error` is the RMS distance in pixels between the given image
 points and the scene points mapped back into the image (0 for a scale, which fits no points).
@@ -353,13 +370,63 @@ def loads_calibration(text: str, *, source: str = "") -> Calibration:
         raise CalibrationError(f"{where}{exc}") from None
 
 
+def loads_calibration_csv(text: str, *, source: str = "") -> Calibration:
+    """A calibration through the image <-> scene point pairs of CSV text with the columns ``u, v,
+    x, y`` (see the module docstring)."""
+    import csv
+    import io
+
+    where = f"{source}: " if source else ""
+    rows = [
+        (n, r)
+        for n, r in enumerate(csv.reader(io.StringIO(text.removeprefix("\ufeff"))), start=1)
+        if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")
+    ]
+    if not rows:
+        raise CalibrationError(f"{where}empty; expected a header u,v,x,y and 4 or more rows")
+    line, header = rows[0]
+    names = [c.strip() for c in header]
+    want = ("u", "v", "x", "y")
+    if sorted(names) != sorted(want):
+        raise CalibrationError(
+            f"{where}line {line}: header {','.join(names)}; expected the columns u, v, x, y "
+            "(image pixels, scene metres) in any order"
+        )
+    col = {name: names.index(name) for name in want}
+    image, scene = [], []
+    for line, r in rows[1:]:
+        if len(r) != 4:
+            raise CalibrationError(f"{where}line {line}: {len(r)} values; expected 4 (u, v, x, y)")
+        try:
+            vals = {k: float(r[i]) for k, i in col.items()}
+        except ValueError:
+            raise CalibrationError(
+                f"{where}line {line}: {r} holds a value that is not a number"
+            ) from None
+        image.append((vals["u"], vals["v"]))
+        scene.append((vals["x"], vals["y"]))
+    try:
+        return Calibration.from_points(image, scene, source=source)
+    except CalibrationError as exc:
+        raise CalibrationError(f"{where}{exc}") from None
+
+
 def load_calibration(path: str | Path) -> Calibration:
-    """Read a calibration TOML file; errors name the file and the key."""
+    """Read a calibration file (TOML, CSV of point pairs, or a Tracker project: see the module
+    docstring); errors name the file and the key."""
     p = Path(path)
     if not p.is_file():
         raise CalibrationError(f"calibration file {str(p)!r} does not exist")
+    suffix = p.suffix.lower()
+    if suffix in (".trz", ".trk"):
+        from physbench.tracker_files import read_tracker_project
+
+        project = read_tracker_project(p)
+        return Calibration(project.homography(), None, 0.0, project.source)
     try:
         text = p.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise CalibrationError(f"{p}: cannot read as UTF-8 text ({exc})") from None
+    if suffix == ".csv":
+        return loads_calibration_csv(text, source=str(p))
     return loads_calibration(text, source=str(p))

@@ -40,6 +40,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "datasets",
         "the measured data sets that ship with physbench: list them, their runs, write them out",
     ),
+    "scene": (
+        "scene_new",
+        "scene new: write the scene TOML of your own setup (flight, surface, pendulum, puck)",
+    ),
 }
 
 

@@ -357,3 +357,158 @@ def texts_outside() -> Callable[[Any], list[str]]:
     """``texts_outside(fig)``: the texts of a figure that lie (partly) outside it (issue 28:
     titles and legends were cut at the image's edge)."""
     return _texts_outside
+
+
+# --------------------------------------------------------------------------- Tracker projects
+
+
+def _prop(name: str, kind: str, value: object) -> str:
+    return f'<property name="{name}" type="{kind}">{value}</property>'
+
+
+def _obj(cls: str, *props: str) -> str:
+    return f'<object class="{cls}">' + "".join(props) + "</object>"
+
+
+def tracker_xml(
+    *,
+    origin: tuple[float, float] = (100.0, 300.0),
+    angle: float = 0.0,
+    scale: tuple[float, float] = (200.0, 200.0),
+    unit: str | None = "m",
+    marks: dict[str, dict[int, tuple[float, float]]] | None = None,
+    mass: float = 1.0,
+    mass_unit: str = "kg",
+    start_frame: int = 0,
+    start_time: float = 0.0,
+    delta_t: float = 1000.0 / 30,
+    size: tuple[int, int] = (640, 480),
+    coords_frames: dict[int, tuple[float, float, float, float, float]] | None = None,
+    filters: tuple[str, ...] = (),
+) -> str:
+    """A Tracker project (.trk XML) laid out as Tracker 6 saves one: the panel's image size and
+    units, the video clip and its clip control, the fixed coordinate system (``angle`` in
+    degrees, ``scale`` in px per unit), an axes track, a tape measure, a model particle (which is
+    not a measurement) and one point-mass track per entry of ``marks`` (frame -> Tracker image
+    point)."""
+    media, tracker = "org.opensourcephysics.media.core", "org.opensourcephysics.cabrillo.tracker"
+    frames = coords_frames or {0: (*origin, angle, *scale)}
+    coords = _obj(
+        f"{media}.ImageCoordSystem",
+        _prop("fixedorigin", "boolean", "true" if coords_frames is None else "false"),
+        _prop("fixedangle", "boolean", "true"),
+        _prop("fixedscale", "boolean", "true"),
+        _prop("locked", "boolean", "false"),
+        f'<property name="framedata" type="array" class="[L{media}.ImageCoordSystem$FrameData;">'
+        + "".join(
+            f'<property name="[{n}]" type="object">'
+            + _obj(
+                f"{media}.ImageCoordSystem$FrameData",
+                *(
+                    _prop(k, "double", v)
+                    for k, v in zip(
+                        ("xorigin", "yorigin", "angle", "xscale", "yscale"), f, strict=True
+                    )
+                ),
+            )
+            + "</property>"
+            for n, f in frames.items()
+        )
+        + "</property>",
+    )
+    video = _obj(
+        f"{media}.ImageVideo",
+        _prop("path", "string", "videos/clip.mp4"),
+        '<property name="filters" type="collection" class="java.util.ArrayList">'
+        + "".join(
+            f'<property name="item" type="object">{_obj(f"{media}.{f}")}</property>'
+            for f in filters
+        )
+        + "</property>",
+    )
+    clip = _obj(
+        f"{media}.VideoClip",
+        f'<property name="video" type="object">{video}</property>',
+        _prop("startframe", "int", start_frame),
+        _prop("stepsize", "int", 1),
+        _prop("stepcount", "int", 100),
+        _prop("starttime", "double", start_time),
+        _prop("readout", "string", "frame"),
+    )
+    control = _obj(
+        f"{media}.StepperClipControl",
+        _prop("rate", "double", 1.0),
+        _prop("delta_t", "double", delta_t),
+        _prop("frame", "int", 0),
+    )
+    items = [
+        _obj(f"{tracker}.CoordAxes", _prop("name", "string", "axes")),
+        _obj(f"{tracker}.TapeMeasure", _prop("name", "string", "tape measure")),
+        _obj(f"{tracker}.DynamicParticle", _prop("name", "string", "model A")),
+    ]
+    for name, points in (marks or {}).items():
+        steps = "".join(
+            f'<property name="[{n}]" type="object">'
+            + _obj(
+                f"{tracker}.PointMass$FrameData", _prop("x", "double", x), _prop("y", "double", y)
+            )
+            + "</property>"
+            for n, (x, y) in sorted(points.items())
+        )
+        items.append(
+            _obj(
+                f"{tracker}.PointMass",
+                _prop("mass", "double", mass),
+                _prop("name", "string", name),
+                f'<property name="framedata" type="array" class="[L{tracker}.PointMass$FrameData;">'
+                + steps
+                + "</property>",
+            )
+        )
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        + _obj(
+            f"{tracker}.TrackerPanel",
+            _prop("semantic_version", "string", "6.1.5"),
+            _prop("width", "double", float(size[0])),
+            _prop("height", "double", float(size[1])),
+            f'<property name="videoclip" type="object">{clip}</property>',
+            f'<property name="clipcontrol" type="object">{control}</property>',
+            f'<property name="coords" type="object">{coords}</property>',
+            *([_prop("length_unit", "string", unit)] if unit is not None else []),
+            _prop("mass_unit", "string", mass_unit),
+            '<property name="tracks" type="collection" class="java.util.ArrayList">'
+            + "".join(f'<property name="item" type="object">{i}</property>' for i in items)
+            + "</property>",
+        )
+        + "\n"
+    )
+
+
+def tracker_image(
+    xy: Sequence[float], origin: Sequence[float], angle: float, scale: Sequence[float]
+) -> tuple[float, float]:
+    """Where Tracker draws world point ``xy`` (length units) in its image coordinates: rotate by
+    ``angle`` degrees counter-clockwise, scale, flip y (image rows go down), shift to the origin
+    (the transform of Tracker's ImageCoordSystem)."""
+    import math
+
+    a = math.radians(angle)
+    x, y = xy
+    return (
+        scale[0] * (x * math.cos(a) - y * math.sin(a)) + origin[0],
+        -scale[1] * (x * math.sin(a) + y * math.cos(a)) + origin[1],
+    )
+
+
+@pytest.fixture
+def trk() -> Callable[..., str]:
+    """``trk(**options)``: the text of a Tracker project (:func:`tracker_xml`)."""
+    return tracker_xml
+
+
+@pytest.fixture
+def trk_image() -> Callable[..., tuple[float, float]]:
+    """``trk_image(xy, origin, angle, scale)``: Tracker's image point of a world point
+    (:func:`tracker_image`)."""
+    return tracker_image

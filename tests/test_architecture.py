@@ -32,6 +32,7 @@ LAYERS: dict[str, int] = {
     "physbench.recording": 0,
     "physbench.observation": 0,
     "physbench.calibration": 0,
+    "physbench.tracker_files": 0,
     "physbench.codec": 0,
     "physbench.metrics": 0,
     "physbench.cost": 0,

@@ -129,3 +129,30 @@ def test_collinear_or_too_few_points_cannot_fix_the_plane(tmp_path) -> None:  # 
     (tmp_path / "latin1.toml").write_bytes(b"# \xe9\n")
     with pytest.raises(CalibrationError, match="cannot read as UTF-8"):
         load_calibration(tmp_path / "latin1.toml")
+
+
+def test_a_csv_of_point_pairs_is_the_points_calibration(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    h = oblique_camera()
+    xy = np.vstack([CORNERS, [[2.0, 1.5], [1.0, 2.5]]])
+    uv = project(h, xy)
+    rows = [
+        ",".join(repr(float(c)) for c in (x, y, u, v))
+        for (u, v), (x, y) in zip(uv, xy, strict=True)
+    ]
+    path = tmp_path / "points.csv"
+    path.write_text("# measured in an image viewer\nx,y,u,v\n" + "\n".join(rows) + "\n")
+    cal = load_calibration(path)
+    toml = Calibration.from_points(uv, xy)
+    np.testing.assert_allclose(cal.homography, toml.homography, rtol=1e-9, atol=1e-12)
+    assert cal.reprojection_error < 1e-6 and cal.source == str(path)
+    assert np.allclose(cal.to_scene(uv), xy, atol=1e-9)
+    for text, message in [
+        ("u,v,x\n1,2,3\n", "expected the columns u, v, x, y"),
+        ("u,v,x,y\n1,2,3\n", "line 2: 3 values"),
+        ("u,v,x,y\n1,2,3,a\n", "not a number"),
+        ("u,v,x,y\n0,0,0,0\n1,0,1,0\n0,1,0,1\n", "3 pairs given"),
+        ("", "empty"),
+    ]:
+        path.write_text(text)
+        with pytest.raises(CalibrationError, match=message):
+            load_calibration(path)

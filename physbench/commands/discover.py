@@ -54,8 +54,9 @@ def _add_data_arguments(p: argparse.ArgumentParser) -> None:
         nargs="?",
         default=None,
         help="tracked trajectories (.csv: t,body,x,y[,angle][,run]), observed frames "
-        "(.npz, key 'frames'), or a camera's video (.mp4, .mov, .avi, .mkv, .webm, .gif, or a "
-        "folder of images): tracked first, as physbench track does (or --dataset instead)",
+        "(.npz, key 'frames'), a Tracker project's hand-marked points (.trz, .trk), or a "
+        "camera's video (.mp4, .mov, .avi, .mkv, .webm, .gif, or a folder of images): tracked "
+        "first, as physbench track does (or --dataset instead)",
     )
     add_scene_argument(
         p,

@@ -99,7 +99,8 @@ def load_runs(
     progress: bool = False,
 ) -> list[Run]:
     """Runs from a recording file (``.csv``: tracked trajectories, one run per ``run`` label;
-    ``.npz``: observed frames under key ``frames``; a video file or a folder of images: tracked
+    ``.npz``: observed frames under key ``frames``; ``.trz``/``.trk``: the hand-marked points of a
+    Tracker project, :mod:`physbench.tracker_files`; a video file or a folder of images: tracked
     first, see :func:`~physbench.video.track.track_video`) and a scene (object or ``.toml`` file)
     that every run shares. ``run`` keeps one run of a multi-run CSV. ``calibration``,
     ``background``, ``start``, ``end`` and ``allow_gaps`` apply to a video only (a body lost in
@@ -146,6 +147,8 @@ def load_runs(
             )
         ]
     suffix = path.suffix.lower()
+    if suffix in (".trz", ".trk"):
+        return [_tracker_run(path, sc)]
     if suffix == ".csv":
         from physbench.recording import read_recordings
 
@@ -165,9 +168,26 @@ def load_runs(
         ]
     raise DiscoverError(
         f"recording {str(path)!r}: unknown format {suffix or '(no suffix)'!r}; expected .csv "
-        "(tracked trajectories t,body,x,y[,angle][,run]), .npz (frames) or a video "
+        "(tracked trajectories t,body,x,y[,angle][,run]), .npz (frames), a Tracker project "
+        "(.trz, .trk) or a video "
         f"({', '.join(VIDEO_SUFFIXES)}, or a folder of images)"
     )
+
+
+def _tracker_run(path: Path, scene: Scene) -> Run:
+    """The hand-marked points of a Tracker project as one run; every marked track must be a
+    body of the scene."""
+    from physbench.tracker_files import read_tracker_project
+
+    rec = read_tracker_project(path).recording()
+    unknown = [b for b in rec.bodies if b not in scene.body_names]
+    if unknown:
+        raise DiscoverError(
+            f"{path}: Tracker track {unknown[0]!r} is not a body of scene {scene.name!r} "
+            f"(bodies: {', '.join(scene.body_names)}); name the scene's body after the track "
+            "(physbench scene new --from the project does)"
+        )
+    return Run(path.stem, scene, recording=rec, source=str(path))
 
 
 def _video_run(

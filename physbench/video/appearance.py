@@ -73,12 +73,14 @@ class Appearance:
     def first(cls, look: Look) -> Appearance:
         return cls(look.size, np.asarray(look.colour, dtype=float))
 
-    def mismatch(self, look: Look) -> str | None:
-        """Why ``look`` is not this body (a few words with the measured values), or ``None``."""
+    def mismatch(self, look: Look, *, size: bool = True) -> str | None:
+        """Why ``look`` is not this body (a few words with the measured values), or ``None``.
+        ``size=False`` judges the colour only: the tracker passes it for a body's share of a blob
+        it shares with touching bodies, whose area is where the split put the border."""
         ratio = look.size / max(self.size, 1e-9)
         # A body of a few pixels has a size of a few pixels, give or take most of them.
         allowed = SIZE_RATIO * max(1.0, math.sqrt(SMALL / max(look.pixels, 1e-9)))
-        if not 1 / allowed <= ratio <= allowed:
+        if size and not 1 / allowed <= ratio <= allowed:
             return f"{ratio:.2f} times its size"
         hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread):

@@ -665,6 +665,7 @@ class Tracker:
                 centres, own, inside = split_pixels(u, v, w, self.pred_uv[members], outlines)
         for j, i in enumerate(members):
             s = self.states[i]
+            share = False
             if i in discs and (discs[i] is not None or not shared):
                 got = discs[i]
             elif not shared:
@@ -687,9 +688,10 @@ class Tracker:
                 axes = plane_pose(u[mine], v[mine], wi[mine], self.cal)
                 look = self._look(i, part.area, img[mine], w[mine], at=part.centre)
                 got = _Found(centre.xy, centres[j], replace(axes, xy=centre.xy), look)
+                share = True
             if got is None:
                 continue
-            if s.look is not None and s.look.mismatch(got.look) is not None:
+            if s.look is not None and s.look.mismatch(got.look, size=not share) is not None:
                 s.rejected += 1
                 continue
             out[i] = got

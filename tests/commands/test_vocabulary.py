@@ -20,9 +20,17 @@ from physbench.cli import COMMANDS, build_parser, main
 from physbench.unknowns import split_params
 
 #: commands that write files: all take --out for their result
-WRITERS = {"run", "simulate", "track", "train", "bench", "plot", "discover", "datasets"}
+WRITERS = {"run", "simulate", "track", "train", "bench", "plot", "discover", "datasets", "scene"}
 #: the only other flags that name a file or folder to write
-NAMED_OUTPUTS = {"--preview", "--plot", "--report", "--plate", "--track-out", "--save-observation"}
+NAMED_OUTPUTS = {
+    "--preview",
+    "--plot",
+    "--report",
+    "--plate",
+    "--track-out",
+    "--save-observation",
+    "--pixels-out",
+}
 #: listings, instant, that print only their result
 LISTINGS = {"scenes", "plugins", "datasets"}
 #: commands with --json, and what it prints
@@ -80,6 +88,7 @@ REQUIRED: dict[str, list[str]] = {
     "datasets": [],
     "discover": ["r.csv", "--scene", "s.toml"],
     "track": ["v.mp4", "--scene", "s.toml", "--out", "r.csv"],
+    "scene": ["new", "flight", "--radius", "0.03", "--out", "s.toml"],
 }
 
 

@@ -1,0 +1,415 @@
+"""Project files of Tracker, the video analysis tool of Open Source Physics: a calibration and
+hand-marked points, read into physbench's pixels, metres and seconds.
+
+A ``.trk`` file is Tracker's XML (``<object class=...>`` elements holding ``<property
+name=... type=...>`` elements); a ``.trz`` file is a zip archive holding one (or more) ``.trk``
+files and usually the video. :func:`read_tracker_project` reads:
+
+- **the coordinate system** (``coords``: an ``ImageCoordSystem``): the origin ``xorigin``,
+  ``yorigin`` (Tracker image pixels), the x axis' ``angle`` (degrees, counter-clockwise as seen
+  in the picture, stored in degrees in the file), and ``xscale``, ``yscale`` (image pixels per
+  length unit), with the ``length_unit`` (m, cm, mm, km, in, ft or yd; a file that names none is
+  taken as metres, and :attr:`TrackerProject.notes` says so). Tracker maps a world point to the
+  image by ``X = xs (x cos a - y sin a) + X0``, ``Y = -ys (x sin a + y cos a) + Y0``. A tape
+  measure, calibration points or an offset origin only set these values, so they are what is
+  read. A coordinate system that moves from frame to frame is refused (physbench needs a fixed
+  camera).
+- **the pixel convention**: Tracker draws the video with the top-left corner of its top-left
+  pixel at ``(0, 0)``, so a pixel's centre is at ``(i + 0.5, j + 0.5)``; physbench puts pixel
+  centres at integers. physbench pixel ``(u, v)`` is Tracker image point ``(u + 0.5, v + 0.5)``
+  (:data:`PIXEL_OFFSET`).
+- **the clock**: frame ``n`` is at ``starttime + (n - startframe) delta_t`` (ms; ``startframe``
+  and ``starttime`` from the ``VideoClip``, ``delta_t`` from the clip control), as Tracker itself
+  times it. physbench's recording time 0 is the first marked frame (recordings start at 0).
+- **hand-marked points**: every ``PointMass`` track (not model particles, centres of mass or
+  other tracks), one body per track name, its marks ``framedata[n]`` (Tracker image pixels in
+  frame ``n``) and its ``mass`` (with ``mass_unit``: kg, g or mg).
+
+Video filters that move pixels (perspective, radial distortion, rotation, resize) put Tracker's
+image coordinates in the filtered picture: such a project still gives a recording, but
+:meth:`TrackerProject.homography` refuses it, since its pixels are not the video's.
+"""
+
+from __future__ import annotations
+
+import math
+import zipfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+from xml.etree import ElementTree
+
+import numpy as np
+
+from physbench.errors import PhysbenchError
+
+if TYPE_CHECKING:
+    from physbench.recording import Recording
+
+#: physbench pixel ``(u, v)`` is Tracker image point ``(u + PIXEL_OFFSET, v + PIXEL_OFFSET)``.
+PIXEL_OFFSET = 0.5
+#: Metres per length unit Tracker files name.
+LENGTH_UNITS = {
+    "m": 1.0,
+    "cm": 0.01,
+    "mm": 0.001,
+    "km": 1000.0,
+    "in": 0.0254,
+    "ft": 0.3048,
+    "yd": 0.9144,
+}
+MASS_UNITS = {"kg": 1.0, "g": 1e-3, "mg": 1e-6}
+#: How well a person marks a point in a frame (px): the accuracy a project's recording states.
+MARK_ACCURACY_PX = 1.0
+#: Video filters that move pixels, so Tracker's coordinates are not the video's.
+GEOMETRIC_FILTERS = (
+    "PerspectiveFilter",
+    "RadialDistortionFilter",
+    "BarrelPincushionFilter",
+    "RotateFilter",
+    "ResizeFilter",
+)
+#: Largest .trk file read (bytes).
+MAX_TRK_BYTES = 64 * 1024 * 1024
+TRACKER_SUFFIXES = (".trz", ".trk")
+_POINT_MASS = "org.opensourcephysics.cabrillo.tracker.PointMass"
+
+
+class TrackerFileError(PhysbenchError, ValueError):
+    """A Tracker project physbench cannot read: names the file and the element or value."""
+
+
+@dataclass(frozen=True)
+class Marks:
+    """One hand-marked track: frame numbers and Tracker image points ``(X, Y)`` (px)."""
+
+    frames: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    mass: float | None = None  # kg, as entered in Tracker
+
+
+@dataclass(frozen=True)
+class TrackerProject:
+    """What physbench reads from a Tracker project (see the module docstring)."""
+
+    source: str
+    origin: tuple[float, float]  # Tracker image px
+    angle: float  # degrees
+    scale: tuple[float, float]  # image px per length unit
+    unit: str
+    metres_per_unit: float
+    start_frame: int
+    start_time: float  # ms
+    frame_ms: float  # ms
+    image_size: tuple[int, int] | None  # (W, H) px
+    video: str | None  # the video's path as the project names it
+    marks: Mapping[str, Marks]
+    filters: tuple[str, ...] = ()
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    # ----------------------------------------------------------------- the maps
+
+    def _world_to_tracker(self) -> np.ndarray:
+        """3 x 3: Tracker world ``(x, y, 1)`` (length units) -> Tracker image ``(X, Y, 1)``."""
+        a = math.radians(self.angle)
+        c, s = math.cos(a), math.sin(a)
+        sx, sy = self.scale
+        x0, y0 = self.origin
+        return np.array([[sx * c, -sx * s, x0], [-sy * s, -sy * c, y0], [0.0, 0.0, 1.0]])
+
+    def homography(self) -> np.ndarray:
+        """3 x 3: physbench pixel ``(u, v, 1)`` -> scene metres ``(x, y, 1)``; refused when a
+        video filter moved the pixels."""
+        if self.filters:
+            raise TrackerFileError(
+                f"{self.source}: the video has Tracker filter(s) {', '.join(self.filters)}, which "
+                "move its pixels: Tracker's coordinates are of the filtered picture, not of the "
+                "video; remove the filter in Tracker and calibrate again, or calibrate with "
+                "points (a [[points]] TOML or a u,v,x,y CSV)"
+            )
+        to_world = np.linalg.inv(self._world_to_tracker())
+        shift = np.array([[1.0, 0.0, PIXEL_OFFSET], [0.0, 1.0, PIXEL_OFFSET], [0.0, 0.0, 1.0]])
+        metres = np.diag([self.metres_per_unit, self.metres_per_unit, 1.0])
+        return metres @ to_world @ shift
+
+    def to_scene(self, xy_tracker: np.ndarray) -> np.ndarray:
+        """Scene metres ``(..., 2)`` of Tracker image points ``(..., 2)`` (filters or not: the
+        marks and the coordinate system share Tracker's picture)."""
+        p = np.asarray(xy_tracker, dtype=float)
+        to_world = np.linalg.inv(self._world_to_tracker())
+        q = p @ to_world[:2, :2].T + to_world[:2, 2]
+        return q * self.metres_per_unit
+
+    def frame_time(self, frames: np.ndarray) -> np.ndarray:
+        """Tracker's time (s) of frame numbers ``frames``."""
+        n = np.asarray(frames, dtype=float)
+        return (self.start_time + (n - self.start_frame) * self.frame_ms) / 1000.0
+
+    @property
+    def t0(self) -> float:
+        """Tracker's time (s) of the first marked frame: physbench's time 0."""
+        first = min(int(m.frames[0]) for m in self.marks.values())
+        return float(self.frame_time(np.array([first]))[0])
+
+    def pixels(self) -> dict[str, np.ndarray]:
+        """Per track, ``(n, 3)``: recording time (s), and the marks in physbench pixels."""
+        return {
+            name: np.column_stack(
+                [
+                    self.frame_time(m.frames) - self.t0,
+                    m.x - PIXEL_OFFSET,
+                    m.y - PIXEL_OFFSET,
+                ]
+            )
+            for name, m in self.marks.items()
+        }
+
+    def recording(self) -> Recording:
+        """The hand marks as a :class:`~physbench.recording.Recording` (metres, s from the first
+        marked frame), stating an accuracy of :data:`MARK_ACCURACY_PX` in metres."""
+        from physbench.recording import Recording, RecordingError, Track
+
+        if not self.marks:
+            raise TrackerFileError(
+                f"{self.source}: no point-mass track with marks; mark the bodies in Tracker "
+                "(Track > New > Point Mass) and save the project"
+            )
+        tracks = {}
+        for name, m in self.marks.items():
+            xy = self.to_scene(np.column_stack([m.x, m.y]))
+            try:
+                tracks[name] = Track(self.frame_time(m.frames) - self.t0, xy[:, 0], xy[:, 1])
+            except RecordingError as exc:
+                raise TrackerFileError(f"{self.source}: track {name!r}: {exc}") from None
+        per_px = self.metres_per_unit / math.sqrt(abs(self.scale[0] * self.scale[1]))
+        return Recording(
+            tracks,
+            fields=("x", "y"),
+            source=self.source,
+            meta={"tracker_t0": self.t0, "notes": list(self.notes)},
+            accuracy=MARK_ACCURACY_PX * per_px,
+        )
+
+
+# --------------------------------------------------------------------------- XML
+
+
+class _Xml:
+    """Reading Tracker's ``XMLControl`` elements, with errors that name the file."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, what: str) -> TrackerFileError:
+        return TrackerFileError(f"{self.source}: {what}")
+
+    @staticmethod
+    def props(obj: ElementTree.Element) -> dict[str, ElementTree.Element]:
+        """The ``<property>`` children of an ``<object>`` by name (the first of each)."""
+        out: dict[str, ElementTree.Element] = {}
+        for p in obj.findall("property"):
+            out.setdefault(p.get("name", ""), p)
+        return out
+
+    def number(self, obj: ElementTree.Element, name: str, default: float | None = None) -> float:
+        p = self.props(obj).get(name)
+        if p is None or p.text is None:
+            if default is not None:
+                return default
+            raise self.fail(f"{obj.get('class', 'object')} has no {name!r}")
+        try:
+            v = float(p.text)
+        except ValueError:
+            raise self.fail(f"{name} = {p.text!r} is not a number") from None
+        if not math.isfinite(v):
+            raise self.fail(f"{name} = {p.text!r} is not a finite number")
+        return v
+
+    def text(self, obj: ElementTree.Element, name: str) -> str | None:
+        p = self.props(obj).get(name)
+        return None if p is None or p.text is None else p.text.strip()
+
+    def child(self, obj: ElementTree.Element, name: str) -> ElementTree.Element | None:
+        """The ``<object>`` a property of type object holds."""
+        p = self.props(obj).get(name)
+        return None if p is None else p.find("object")
+
+    def indexed(self, obj: ElementTree.Element, name: str) -> dict[int, ElementTree.Element]:
+        """The objects of an array property (``[n]`` -> its object)."""
+        p = self.props(obj).get(name)
+        out: dict[int, ElementTree.Element] = {}
+        if p is None:
+            return out
+        for item in p.findall("property"):
+            label = item.get("name", "")
+            o = item.find("object")
+            if o is None or not (label.startswith("[") and label.endswith("]")):
+                continue
+            try:
+                out[int(label[1:-1])] = o
+            except ValueError:
+                raise self.fail(f"{name}: element {label!r} is not [index]") from None
+        return out
+
+
+def _coords(x: _Xml, root: ElementTree.Element) -> tuple[tuple[float, float], float, tuple]:
+    """Origin, angle (degrees) and scale of the project's fixed coordinate system."""
+    coords = x.child(root, "coords")
+    if coords is None:
+        raise x.fail("no coordinate system ('coords'); is this a Tracker project?")
+    frames = x.indexed(coords, "framedata")
+    if not frames:
+        raise x.fail("the coordinate system holds no frame data")
+    values = {
+        n: tuple(x.number(o, k) for k in ("xorigin", "yorigin", "angle", "xscale", "yscale"))
+        for n, o in frames.items()
+    }
+    first = values[min(values)]
+    moved = [n for n, v in values.items() if not np.allclose(v, first, rtol=1e-9, atol=1e-9)]
+    if moved:
+        raise x.fail(
+            f"the coordinate system changes at frame {min(moved)} (origin, angle or scale "
+            "differ from frame to frame); physbench needs one calibration for a fixed camera: "
+            "in Tracker, fix the origin, angle and scale of the axes"
+        )
+    x0, y0, angle, sx, sy = first
+    if sx == 0 or sy == 0:
+        raise x.fail(f"scale ({sx:g}, {sy:g}) px per unit: expected non-zero scales")
+    return (x0, y0), angle, (sx, sy)
+
+
+def _clock(x: _Xml, root: ElementTree.Element) -> tuple[int, float, float, str | None]:
+    """Start frame, start time (ms), frame duration (ms) and the video's path."""
+    clip = x.child(root, "videoclip")
+    control = x.child(root, "clipcontrol")
+    if clip is None or control is None:
+        raise x.fail("no video clip or clip control: the frame times are unknown")
+    start = int(x.number(clip, "startframe", 0.0)) - int(x.number(clip, "frameshift", 0.0))
+    t0 = x.number(clip, "starttime", 0.0)
+    dt = x.number(control, "delta_t")
+    if dt <= 0:
+        raise x.fail(f"delta_t = {dt:g} ms: expected a frame duration > 0")
+    video = x.child(clip, "video")
+    path = None if video is None else x.text(video, "path")
+    return start, t0, dt, path
+
+
+def _filters(root: ElementTree.Element) -> tuple[str, ...]:
+    found = set()
+    for obj in root.iter("object"):
+        name = obj.get("class", "").rsplit(".", 1)[-1]
+        if name in GEOMETRIC_FILTERS:
+            found.add(name)
+    return tuple(sorted(found))
+
+
+def _marks(x: _Xml, root: ElementTree.Element, kg_per_unit: float) -> dict[str, Marks]:
+    tracks = x.props(root).get("tracks")
+    out: dict[str, Marks] = {}
+    if tracks is None:
+        return out
+    for item in tracks.findall("property"):
+        obj = item.find("object")
+        if obj is None or obj.get("class") != _POINT_MASS:
+            continue
+        name = (x.text(obj, "name") or "").strip()
+        if not name:
+            raise x.fail("a point-mass track has no name; name it in Tracker")
+        if name in out:
+            raise x.fail(f"two point-mass tracks are named {name!r}; rename one in Tracker")
+        steps = x.indexed(obj, "framedata")
+        if not steps:
+            continue
+        frames = np.array(sorted(steps))
+        xs = np.array([x.number(steps[n], "x") for n in frames])
+        ys = np.array([x.number(steps[n], "y") for n in frames])
+        mass = x.number(obj, "mass", math.nan)
+        out[name] = Marks(frames, xs, ys, None if math.isnan(mass) else mass * kg_per_unit)
+    return out
+
+
+def _unit(x: _Xml, root: ElementTree.Element, key: str, table: Mapping[str, float]) -> tuple:
+    """``(unit, factor, note)`` of ``length_unit`` or ``mass_unit`` (absent: the SI unit)."""
+    unit = x.text(root, key)
+    si = next(iter(table)) if key == "mass_unit" else "m"
+    if unit is None or unit == "":
+        return si, 1.0, f"{key} not stated: taken as {si}"
+    if unit not in table:
+        raise x.fail(f"{key} = {unit!r}: physbench knows {', '.join(table)}")
+    return unit, table[unit], None
+
+
+def parse_tracker_xml(text: str | bytes, *, source: str = "<trk>") -> TrackerProject:
+    """A :class:`TrackerProject` from the XML of a ``.trk`` file."""
+    x = _Xml(source)
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError as exc:
+        raise x.fail(f"not readable as XML ({exc})") from None
+    cls = root.get("class", "")
+    if root.tag != "object" or not cls.endswith("TrackerPanel"):
+        raise x.fail(
+            f"the root element is <{root.tag} class={cls!r}>; a Tracker project's is a "
+            "TrackerPanel object (save it from Tracker as a .trk or .trz)"
+        )
+    origin, angle, scale = _coords(x, root)
+    unit, metres, note = _unit(x, root, "length_unit", LENGTH_UNITS)
+    _, kg, mass_note = _unit(x, root, "mass_unit", MASS_UNITS)
+    start, t0, dt, video = _clock(x, root)
+    w, h = x.number(root, "width", 0.0), x.number(root, "height", 0.0)
+    return TrackerProject(
+        source=source,
+        origin=origin,
+        angle=angle,
+        scale=scale,
+        unit=unit,
+        metres_per_unit=metres,
+        start_frame=start,
+        start_time=t0,
+        frame_ms=dt,
+        image_size=(round(w), round(h)) if w > 0 and h > 0 else None,
+        video=video,
+        marks=_marks(x, root, kg),
+        filters=_filters(root),
+        notes=tuple(n for n in (note, mass_note) if n),
+    )
+
+
+def is_tracker_file(path: str | Path) -> bool:
+    return Path(path).suffix.lower() in TRACKER_SUFFIXES
+
+
+def read_tracker_project(path: str | Path, *, member: str | None = None) -> TrackerProject:
+    """Read a ``.trk`` file, or the ``.trk`` inside a ``.trz`` archive (``member`` names it when
+    the archive holds several)."""
+    p = Path(path)
+    if not p.is_file():
+        raise TrackerFileError(f"Tracker project {str(p)!r} does not exist")
+    if p.suffix.lower() == ".trk":
+        if p.stat().st_size > MAX_TRK_BYTES:
+            raise TrackerFileError(f"{p}: over {MAX_TRK_BYTES >> 20} MiB; not a Tracker project?")
+        return parse_tracker_xml(p.read_bytes(), source=str(p))
+    if p.suffix.lower() != ".trz":
+        raise TrackerFileError(f"{p}: expected a Tracker project (.trz or .trk)")
+    try:
+        with zipfile.ZipFile(p) as z:
+            projects = [i for i in z.infolist() if i.filename.lower().endswith(".trk")]
+            if member is not None:
+                projects = [i for i in projects if i.filename == member]
+            if len(projects) != 1:
+                names = ", ".join(i.filename for i in projects) or "none"
+                raise TrackerFileError(
+                    f"{p}: holds {len(projects)} Tracker projects (.trk: {names}); "
+                    + ("name one" if projects else "expected one")
+                )
+            info = projects[0]
+            if info.file_size > MAX_TRK_BYTES:
+                raise TrackerFileError(f"{p}: {info.filename} is over {MAX_TRK_BYTES >> 20} MiB")
+            data = z.read(info)
+    except zipfile.BadZipFile:
+        raise TrackerFileError(
+            f"{p}: not a zip archive; a .trz is a zipped Tracker project"
+        ) from None
+    return parse_tracker_xml(data, source=f"{p}:{info.filename}")

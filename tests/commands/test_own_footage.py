@@ -1,0 +1,90 @@
+"""docs/video.md's "your own footage" walkthrough, run as printed on a throw filmed square-on by the
+second camera, with a Tracker project (written here in Tracker's format) as the calibration and
+as hand marks: the scene from a pixel, tracking, the pixel centres against the hand marks, the
+scene's initial state from the tracks."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from physbench.cli import main as cli
+from physbench.recording import read_recording
+from physbench.scene import Body, Circle, Scene
+from physbench.scene_toml import load_scene
+from physbench.simulators.pymunk_sim import PymunkSimulator
+from physbench.testing.field_camera import FieldCamera
+from physbench.tracker_files import read_tracker_project
+from physbench.video.writer import write_clip
+
+#: Square-on, no lens distortion and steady light: Tracker's calibration is a scale and an angle.
+#: A flat-lit ball: a lit sphere's centre is pulled from its highlight by the tracker of this
+#: branch (0.46 px here; issue 26), which would hide the half pixel this test is about.
+SQUARE_ON = {"oblique": 0.0, "k1": 0.0, "k2": 0.0, "drift": 0.0, "roll": 0.0}
+FLAT = {"ambient": 1.0, "specular": 0.0}
+
+
+def test_the_walkthrough_from_a_clip_and_a_tracker_project(tmp_path, trk, capsys) -> None:  # type: ignore[no-untyped-def]
+    truth = Scene(
+        "toss",
+        (Body("ball", Circle(0.04), (0.2, 0.3), velocity=(2.0, 3.0), mass=0.06),),
+        bounds=(0.0, 0.0, 1.6, 1.2),
+        fps=30.0,
+        frames=18,
+        substeps=20,
+    )
+    traj = PymunkSimulator().simulate(truth)
+    cam = FieldCamera(seed=11, **SQUARE_ON, **FLAT)
+    write_clip(cam, tmp_path / "clip.mp4", truth, traj)
+    Image.fromarray(cam.plate(truth)).save(tmp_path / "plate.png")
+    # The project a teacher saved: axes on the scene's origin, a scale, hand marks (Tracker's
+    # pixel centres are at .5, so each mark is the true pixel + 0.5, clicked to 0.2 px).
+    cal = cam.calibration(truth)
+    mpp = cal.metres_per_pixel(cal.to_image([0.8, 0.6]))
+    origin = cal.to_image([0.0, 0.0]) + 0.5
+    rng = np.random.default_rng(0)
+    true_px = cam.image_points(truth, traj.states[:, 0, :2])
+    marks = {k: tuple(p + 0.5 + rng.normal(0, 0.2, 2)) for k, p in enumerate(true_px)}
+    text = trk(
+        origin=tuple(origin), scale=(1 / mpp, 1 / mpp), marks={"ball": marks}, delta_t=1000 / 30
+    )
+    (tmp_path / "toss.trk").write_text(text)
+    project = str(tmp_path / "toss.trk")
+
+    (u0, v0), (u1, v1) = true_px[:2]  # the ball's centre read off the first two frames
+    step3 = ["scene", "new", "flight", "--radius", "0.04", "--pixel", str(u0), str(v0)]
+    step3 += ["--pixel", str(u1), str(v1)]
+    step3 += ["--calibration", project, "--video", str(tmp_path / "clip.mp4")]
+    assert cli([*step3, "--out", str(tmp_path / "toss.toml")]) == 0
+    scene = load_scene(tmp_path / "toss.toml")
+    assert scene.frames == 18 and scene.fps == pytest.approx(30.0)
+    assert scene.bodies[0].position == pytest.approx((0.2, 0.3), abs=0.003)
+    assert scene.bodies[0].velocity == pytest.approx((2.0, 3.0), rel=0.02)
+
+    step4 = ["track", str(tmp_path / "clip.mp4"), "--scene", str(tmp_path / "toss.toml")]
+    step4 += ["--calibration", project, "--background", str(tmp_path / "plate.png")]
+    assert cli([*step4, "--out", str(tmp_path / "rec.csv")]) == 0
+    with open(tmp_path / "rec.pixels.csv") as fh:
+        rows = [r for r in csv.reader(line for line in fh if not line.startswith("#"))][1:]
+    tracked = {round(float(t) * 30): (float(a), float(b)) for t, _, a, b in rows}
+    hand = read_tracker_project(project).pixels()["ball"]
+    gaps = [np.hypot(*(np.array(tracked[k]) - hand[k, 1:])) for k in tracked]
+    # measured: 0.62 px, the marks' own 0.38 px with the tracker's 0.43 px on a lit sphere (its
+    # centre is pulled from the highlight: issue 26); half a pixel of convention would add 0.7
+    bias = np.mean([np.array(tracked[k]) - hand[k, 1:] for k in tracked], axis=0)
+    # measured: 0.38 px apart (the marks' 0.2 px per axis, and the tracker), no common offset
+    # (0.09 px); Tracker's half pixel taken the wrong way: 0.83 px apart, offset by 0.69 px
+    assert len(tracked) == 18 and np.median(gaps) < 0.6 and np.hypot(*bias) < 0.25
+
+    step5 = ["scene", "new", "flight", "--radius", "0.04", "--mass", "0.06"]
+    assert (
+        cli([*step5, "--from", str(tmp_path / "rec.csv"), "--out", str(tmp_path / "toss.toml")])
+        == 0
+    )
+    (ball,) = load_scene(tmp_path / "toss.toml").bodies
+    assert ball.velocity == pytest.approx((2.0, 3.0), rel=0.05) and ball.mass == 0.06
+    rec = read_recording(tmp_path / "rec.csv")
+    assert rec.track("ball").t[0] == 0.0 and "fitted to its first" in capsys.readouterr().out

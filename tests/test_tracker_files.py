@@ -1,0 +1,156 @@
+"""Tracker project files (``physbench/tracker_files.py``): the calibration (origin, axis angle in
+degrees, scale and length unit, Tracker's pixel centres at .5) and the hand-marked points as a
+recording, on projects written here in Tracker's XML layout (no third-party files)."""
+
+from __future__ import annotations
+
+import math
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from physbench.calibration import load_calibration
+from physbench.tracker_files import (
+    MARK_ACCURACY_PX,
+    PIXEL_OFFSET,
+    TrackerFileError,
+    parse_tracker_xml,
+    read_tracker_project,
+)
+
+ORIGIN, ANGLE, SCALE = (212.5, 301.25), 30.0, (150.0, 150.0)  # px, degrees, px per cm
+#: A throw in cm (Tracker's world units here), one point per frame from frame 3.
+WORLD = {n: (10.0 * (n - 3), 40.0 * (n - 3) / 10 - 4.9 * ((n - 3) / 10) ** 2) for n in range(3, 12)}
+
+
+def project(trk, trk_image, tmp_path: Path, name: str = "toss.trk", **options) -> Path:  # type: ignore[no-untyped-def]
+    marks = {n: trk_image(xy, ORIGIN, ANGLE, SCALE) for n, xy in WORLD.items()}
+    kw = {
+        "origin": ORIGIN,
+        "angle": ANGLE,
+        "scale": SCALE,
+        "unit": "cm",
+        "marks": {"ball": marks},
+        "start_frame": 2,
+        "start_time": 500.0,
+        "delta_t": 100.0,
+        **options,
+    }
+    path = tmp_path / name
+    path.write_text(trk(**kw), encoding="utf-8")
+    return path
+
+
+def test_marks_become_metres_and_seconds_from_the_first_marked_frame(
+    trk, trk_image, tmp_path
+) -> None:  # type: ignore[no-untyped-def]
+    p = read_tracker_project(project(trk, trk_image, tmp_path))
+    assert p.angle == ANGLE and p.unit == "cm" and p.metres_per_unit == 0.01
+    rec = p.recording()
+    tr = rec.track("ball")
+    want = np.array([WORLD[n] for n in sorted(WORLD)]) * 0.01
+    assert np.allclose(np.column_stack([tr.x, tr.y]), want, atol=1e-12)
+    # frame 3 is 0.6 s on Tracker's clock (500 ms + (3 - 2) x 100 ms): recording time 0
+    assert p.t0 == pytest.approx(0.6)
+    assert np.allclose(tr.t, 0.1 * np.arange(len(WORLD)))
+    assert rec.fields == ("x", "y") and rec.bodies == ("ball",)  # the model particle is not read
+    assert rec.accuracy == pytest.approx(MARK_ACCURACY_PX * 0.01 / 150.0)
+
+
+def test_the_angle_is_read_in_degrees(trk, trk_image, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # A point on the world's x axis at 1 unit: at 90 degrees Tracker draws it straight up.
+    path = tmp_path / "up.trk"
+    up = trk_image((1.0, 0.0), (50.0, 50.0), 90.0, (10.0, 10.0))
+    assert up == pytest.approx((50.0, 40.0))
+    path.write_text(
+        trk(origin=(50.0, 50.0), angle=90.0, scale=(10.0, 10.0), marks={"b": {0: up, 1: (50, 50)}})
+    )
+    tr = read_tracker_project(path).recording().track("b")
+    assert (tr.x[0], tr.y[0]) == pytest.approx((1.0, 0.0))  # radians would give (0.45, -0.89)
+
+
+def test_pixel_centres_are_shifted_by_half_a_pixel(trk, trk_image, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """Tracker draws pixel (i, j) over [i, i + 1) x [j, j + 1): a person who puts the origin on the
+    centre of pixel (120, 80) gets xorigin = 120.5, yorigin = 80.5. physbench's pixel (120, 80) is
+    then the scene's origin, and one pixel to its right is one scale step along x."""
+    assert PIXEL_OFFSET == 0.5
+    path = tmp_path / "px.trk"
+    path.write_text(trk(origin=(120.5, 80.5), scale=(100.0, 100.0), marks={"b": {0: (0, 0)}}))
+    cal = load_calibration(path)
+    assert cal.to_scene([120.0, 80.0]) == pytest.approx((0.0, 0.0), abs=1e-12)
+    assert cal.to_scene([121.0, 79.0]) == pytest.approx((0.01, 0.01), abs=1e-12)
+    assert cal.to_image([0.0, 0.0]) == pytest.approx((120.0, 80.0), abs=1e-12)
+    # and a mark on that pixel's centre is the origin in the recording
+    path.write_text(
+        trk(origin=(120.5, 80.5), scale=(100.0, 100.0), marks={"b": {0: (120.5, 80.5)}})
+    )
+    tr = read_tracker_project(path).recording().track("b")
+    assert (tr.x[0], tr.y[0]) == pytest.approx((0.0, 0.0), abs=1e-12)
+    assert read_tracker_project(path).pixels()["b"][0].tolist() == [0.0, 120.0, 80.0]
+
+
+def test_calibration_and_marks_agree_through_physbench_pixels(trk, trk_image, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    path = project(trk, trk_image, tmp_path)
+    p = read_tracker_project(path)
+    cal = load_calibration(path)
+    rec = p.recording().track("ball")
+    uv = p.pixels()["ball"][:, 1:]
+    assert np.allclose(cal.to_scene(uv), np.column_stack([rec.x, rec.y]), atol=1e-12)
+    assert cal.reprojection_error == 0.0 and "toss.trk" in cal.source
+
+
+def test_a_trz_archive_holds_the_project(trk, trk_image, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    trk_path = project(trk, trk_image, tmp_path)
+    trz = tmp_path / "toss.trz"
+    with zipfile.ZipFile(trz, "w") as z:
+        z.write(trk_path, "toss_toss.trk")
+        z.writestr("toss_thumbnail.png", b"\x89PNG")
+    from_trz = read_tracker_project(trz).recording().track("ball")
+    from_trk = read_tracker_project(trk_path).recording().track("ball")
+    assert np.array_equal(from_trz.x, from_trk.x) and np.array_equal(from_trz.t, from_trk.t)
+    assert np.allclose(load_calibration(trz).homography, load_calibration(trk_path).homography)
+    with zipfile.ZipFile(trz, "a") as z:
+        z.write(trk_path, "second.trk")
+    with pytest.raises(TrackerFileError, match=r"holds 2 Tracker projects.*second\.trk"):
+        read_tracker_project(trz)
+    assert read_tracker_project(trz, member="second.trk").marks["ball"].frames[0] == 3
+
+
+def test_units_masses_and_a_missing_unit(trk, trk_image, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    p = read_tracker_project(
+        project(trk, trk_image, tmp_path, unit="ft", mass=250.0, mass_unit="g")
+    )
+    assert p.metres_per_unit == 0.3048 and p.marks["ball"].mass == pytest.approx(0.25)
+    p = read_tracker_project(project(trk, trk_image, tmp_path, unit=None))
+    assert p.metres_per_unit == 1.0 and any("taken as m" in n for n in p.notes)
+    with pytest.raises(TrackerFileError, match="length_unit = 'furlong'"):
+        read_tracker_project(project(trk, trk_image, tmp_path, unit="furlong"))
+
+
+def test_what_cannot_be_read_is_named(trk, trk_image, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    moving = {0: (*ORIGIN, ANGLE, *SCALE), 5: (ORIGIN[0] + 3, ORIGIN[1], ANGLE, *SCALE)}
+    with pytest.raises(TrackerFileError, match="changes at frame 5"):
+        read_tracker_project(project(trk, trk_image, tmp_path, coords_frames=moving))
+    # a key frame that repeats frame 0 is not a change
+    same = {0: (*ORIGIN, ANGLE, *SCALE), 5: (*ORIGIN, ANGLE, *SCALE)}
+    read_tracker_project(project(trk, trk_image, tmp_path, coords_frames=same))
+    filtered = read_tracker_project(
+        project(trk, trk_image, tmp_path, filters=("PerspectiveFilter",))
+    )
+    assert len(filtered.recording().track("ball")) == len(WORLD)  # marks and axes share a picture
+    with pytest.raises(TrackerFileError, match="PerspectiveFilter"):
+        filtered.homography()
+    with pytest.raises(TrackerFileError, match="no point-mass track"):
+        read_tracker_project(project(trk, trk_image, tmp_path, marks={})).recording()
+    with pytest.raises(TrackerFileError, match="TrackerPanel"):
+        parse_tracker_xml('<object class="java.awt.Color"/>')
+    with pytest.raises(TrackerFileError, match="not readable as XML"):
+        parse_tracker_xml("<object")
+    (tmp_path / "junk.trz").write_bytes(b"not a zip")
+    with pytest.raises(TrackerFileError, match="not a zip archive"):
+        read_tracker_project(tmp_path / "junk.trz")
+    with pytest.raises(TrackerFileError, match="does not exist"):
+        read_tracker_project(tmp_path / "none.trk")
+    assert math.isfinite(read_tracker_project(project(trk, trk_image, tmp_path)).t0)
