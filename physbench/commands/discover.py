@@ -102,6 +102,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "disagreement names no cause (default: what the recording states; a video's tracker "
         "states half a pixel)",
     )
+    p.add_argument(
+        "--reference",
+        nargs="+",
+        default=[],
+        metavar="WHAT",
+        help="what the setup fixes by a reference, so that it is not a candidate cause: scale "
+        "(a reference length in the plane), clock (a known frame rate), axes (a plumb line or "
+        "level), origin, lens, plane",
+    )
     p.add_argument("--max-causes", type=int, default=None, help="most effects added (default 3)")
     add_renderer_arguments(p, from_frames=True)
     p.add_argument(
@@ -154,7 +163,7 @@ def main(args: argparse.Namespace) -> int:
     from physbench.commands.console import show_progress, stages, wrote
     from physbench.components import create
     from physbench.discover import Settings, discover, load_runs, renderer_for
-    from physbench.discover.verdict import text, to_dict
+    from physbench.discover.verdict import headline, text, to_dict
     from physbench.errors import PhysbenchError
     from physbench.scenes import resolve_scene
 
@@ -197,6 +206,7 @@ def main(args: argparse.Namespace) -> int:
         estimator=args.estimator,
         estimator_iterations=args.iterations,
         seed=args.seed,
+        references=tuple(args.reference),
         **kw,
     )
     renderer = None
@@ -217,9 +227,8 @@ def main(args: argparse.Namespace) -> int:
     if to_stdout:
         print(json.dumps(to_dict(disc), indent=2))
     elif args.quiet:
-        causes = ", ".join(disc.causes) or "none"
         print(
-            f"causes: {causes}; gain {disc.gain:.1%} (held-out error "
+            f"{headline(disc)}; gain {disc.gain:.1%} (held-out error "
             f"{disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})"
         )
     else:

@@ -51,6 +51,15 @@ class Settings:
     #: Candidates whose held-out error is within this factor of the chosen one's are reported as
     #: explaining the data about as well.
     ambiguity: float = 0.05
+    #: What the setup fixes by a reference (names of
+    #: :data:`~physbench.discover.candidates.REFERENCES`: ``scale`` a reference length in the
+    #: plane, ``clock`` a known frame rate, ``axes`` a plumb line, ``origin``, ``lens``,
+    #: ``plane``): the measurement causes they fix are not candidates.
+    references: Sequence[str] = ()
+    #: A cause beats another explanation when its held-out sum of squares is lower by this many
+    #: standard deviations of the paired held-out noise (:mod:`physbench.discover.equivalence`);
+    #: short of that the recording cannot tell them apart.
+    beat_z: float = 2.0
 
     def __post_init__(self) -> None:
         for name, v in (("min_gain", self.min_gain), ("ambiguity", self.ambiguity)):
@@ -74,5 +83,15 @@ class Settings:
             or self.floor < 0
         ):
             raise DiscoverError(f"floor = {self.floor!r}: expected a number >= 0 (metres) or None")
+        from physbench.discover.candidates import REFERENCES
+
+        if isinstance(self.references, str) or any(r not in REFERENCES for r in self.references):
+            raise DiscoverError(
+                f"references = {self.references!r}: expected a list of {', '.join(REFERENCES)}"
+            )
+        if isinstance(self.beat_z, bool) or not isinstance(self.beat_z, int | float):
+            raise DiscoverError(f"beat_z = {self.beat_z!r}: expected a number >= 0")
+        if self.beat_z < 0:
+            raise DiscoverError(f"beat_z = {self.beat_z!r}: expected a number >= 0")
         if not isinstance(self.min_delta_bic, int | float) or self.min_delta_bic < 0:
             raise DiscoverError(f"min_delta_bic = {self.min_delta_bic!r}: expected a number >= 0")

@@ -15,6 +15,9 @@ from physbench.discover import DiscoverError, Settings
         ({"screen": 0}, r"screen = 0: expected a whole number >= 1"),
         ({"budget": 2.5}, r"budget = 2\.5"),
         ({"min_delta_bic": -1}, r"min_delta_bic = -1: expected a number >= 0"),
+        ({"references": ["ruler"]}, r"references = \['ruler'\]: expected a list of scale, clock"),
+        ({"references": "scale"}, r"references = 'scale'"),
+        ({"beat_z": -1.0}, r"beat_z = -1\.0: expected a number >= 0"),
     ],
 )
 def test_bad_settings_are_named(bad, message):
@@ -26,3 +29,8 @@ def test_settings_are_a_frozen_value():
     s = Settings()
     with pytest.raises(AttributeError):
         s.min_gain = 0.2  # type: ignore[misc]
+
+
+def test_references_name_what_the_setup_fixes():
+    assert Settings(references=("scale", "clock", "axes")).references == ("scale", "clock", "axes")
+    assert Settings().references == () and Settings().beat_z == 2.0
