@@ -84,6 +84,28 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "force0.fx",
     )
     p.add_argument("--run", help="use only this run of a multi-run CSV")
+    _add_criteria(p)
+    add_renderer_arguments(p, from_frames=True)
+    p.add_argument(
+        "--seed",
+        type=seed_int,
+        default=0,
+        help="instance of a registered --scene and seed of a black-box base-fit estimator "
+        "(default 0)",
+    )
+    add_quiet_argument(p, "print only the causes and the gain")
+    video = p.add_argument_group("video", "when RECORDING is a video: how to read and track it")
+    add_video_input_arguments(video)
+    video.add_argument(
+        "--track-out",
+        default=None,
+        metavar="REC.csv",
+        help="also write the video's tracks as a recording CSV",
+    )
+
+
+def _add_criteria(p: argparse.ArgumentParser) -> None:
+    """The options that decide when a candidate is a cause, and what the setup fixes."""
     p.add_argument(
         "--min-gain",
         type=float,
@@ -112,23 +134,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "level), origin, lens, plane",
     )
     p.add_argument("--max-causes", type=int, default=None, help="most effects added (default 3)")
-    add_renderer_arguments(p, from_frames=True)
-    p.add_argument(
-        "--seed",
-        type=seed_int,
-        default=0,
-        help="instance of a registered --scene and seed of a black-box base-fit estimator "
-        "(default 0)",
-    )
-    add_quiet_argument(p, "print only the causes and the gain")
-    video = p.add_argument_group("video", "when RECORDING is a video: how to read and track it")
-    add_video_input_arguments(video)
-    video.add_argument(
-        "--track-out",
-        default=None,
-        metavar="REC.csv",
-        help="also write the video's tracks as a recording CSV",
-    )
 
 
 def check_size(runs: list[Any], settings: Any, renderer: Any) -> None:

@@ -43,6 +43,9 @@ CONTACT_LAWS = ("velocity_dependent_restitution",)
 CAMERA = ("calibration_scale", "axis_rotation", "lens_distortion", "plane_tilt")
 #: Measurement causes centred on the view (options ``centre`` and ``radius``).
 VIEW_CENTRED = ("lens_distortion", "plane_tilt")
+#: The camera's errors that act in two dimensions: with one coordinate tracked (a drop in y) they
+#: would mix the simulated, unmeasured one into it.
+PLANAR = ("axis_rotation", "lens_distortion", "plane_tilt")
 #: What a reference in the setup fixes (the names ``Settings.references`` takes): the measurement
 #: cause it rules out, and the reference in words (also what would tell that cause apart).
 REFERENCES: dict[str, tuple[str, str]] = {
@@ -77,6 +80,11 @@ def fixed_by(references: Sequence[str]) -> dict[str, str]:
     """Measurement cause -> the reference that fixes it, for ``references`` (names of
     :data:`REFERENCES`)."""
     return {REFERENCES[r][0]: REFERENCES[r][1] for r in references}
+
+
+def _planar(recordings: Sequence[Recording] | None) -> bool:
+    """Whether every recording tracks both x and y (None: frames, which show the plane)."""
+    return recordings is None or all({"x", "y"} <= set(r.fields or ("x", "y")) for r in recordings)
 
 
 def camera_view(
@@ -159,6 +167,7 @@ def candidates_for(
     fixed = fixed_by(references)
     view = camera_view(recordings) if recordings is not None else None
     positions = recordings is None or view is not None
+    planar = _planar(recordings)
     for name in chosen:
         options: dict[str, Any] = {}
         if name in fixed:
@@ -168,6 +177,9 @@ def candidates_for(
             skipped.append(
                 (name, "the data hold no positions: a camera's calibration does not enter")
             )
+            continue
+        if name in PLANAR and not planar:
+            skipped.append((name, "it acts in the plane, and the data track one coordinate"))
             continue
         if name in VIEW_CENTRED and view is not None:
             options.update(centre=view[0], radius=view[1])

@@ -78,6 +78,10 @@ def test_the_camera_s_errors_need_positions_and_are_centred_on_the_view():
     assert camera_view([tracked]) == ((2.0, 1.0), pytest.approx(np.hypot(2.0, 2.0) / 2))
     (lens,), _ = candidates_for(side, ["lens_distortion"], recordings=[tracked])
     assert dict(lens.options)["centre"] == (2.0, 1.0)
+    dropped = Recording({"ball": Track(t, np.zeros(2), np.array([2.0, 0.0]))}, fields=("y",))
+    specs, skipped = candidates_for(side, MEASUREMENT, recordings=[dropped])
+    assert [s.label for s in specs] == ["clock_scale", "calibration_scale"]  # a drop in y only
+    assert "track one coordinate" in dict(skipped)["axis_rotation"]
     assert lens.make().radius() == pytest.approx(np.hypot(2.0, 2.0) / 2)
 
 
