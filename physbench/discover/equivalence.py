@@ -58,6 +58,7 @@ SAME = 0.25
 #: Registered names of the uniform accelerations of a free body, and of the measurement causes
 #: that are one in free flight.
 UNIFORM = ("constant_force", "table_tilt")
+G_LIKE = ("calibration_scale", "clock_scale", *UNIFORM)
 #: Most measurement causes combined against a physical cause, and how many partial combinations
 #: are carried to the next size: in free flight the camera's errors act as one uniform
 #: acceleration, whose size a scale (or clock) error sets and whose direction a turn of the axes
@@ -65,7 +66,6 @@ UNIFORM = ("constant_force", "table_tilt")
 #: one by one.
 COMBINED = 2
 BEAM = 3
-G_LIKE = ("calibration_scale", "clock_scale", *UNIFORM)
 
 
 def compare_explanations(
