@@ -162,6 +162,15 @@ def _add_threshold_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--max-causes", type=positive_int, default=None, help="most effects added (default 3)"
     )
+    p.add_argument(
+        "--reference",
+        nargs="+",
+        default=[],
+        metavar="WHAT",
+        help="what the setup fixes by a reference, so that it is not a candidate cause: scale "
+        "(a reference length in the plane), clock (a known frame rate), axes (a plumb line or "
+        "level), origin, lens, plane",
+    )
 
 
 def check_size(runs: list[Any], settings: Any, renderer: Any) -> None:
@@ -245,7 +254,7 @@ def main(args: argparse.Namespace) -> int:
     from physbench.commands.console import stages, wrote
     from physbench.components import create
     from physbench.discover import Settings, discover, renderer_for
-    from physbench.discover.verdict import text, to_dict
+    from physbench.discover.verdict import headline, text, to_dict
     from physbench.errors import PhysbenchError
 
     out, to_stdout = args.out, args.json == "-"
@@ -275,6 +284,7 @@ def main(args: argparse.Namespace) -> int:
         estimator=args.estimator,
         estimator_iterations=args.iterations,
         seed=args.seed,
+        references=tuple(args.reference),
         **kw,
     )
     renderer = None
@@ -295,9 +305,8 @@ def main(args: argparse.Namespace) -> int:
     if to_stdout:
         print(json.dumps(to_dict(disc), indent=2))
     elif args.quiet:
-        causes = ", ".join(disc.causes) or "none"
         print(
-            f"causes: {causes}; gain {disc.gain:.1%} (held-out error "
+            f"{headline(disc)}; gain {disc.gain:.1%} (held-out error "
             f"{disc.base.heldout:.4g} -> {disc.final.heldout:.4g} {disc.unit})"
         )
     else:

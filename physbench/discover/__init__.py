@@ -19,6 +19,7 @@ words), :mod:`~physbench.discover.candidates` (which effects to try),
 :mod:`~physbench.discover.trial` (one candidate fitted on top of a model),
 :mod:`~physbench.discover.significance` (when a candidate is a cause),
 :mod:`~physbench.discover.select` (greedy addition, backward elimination),
+:mod:`~physbench.discover.equivalence` (what the recording cannot tell apart, the setup's priors),
 :mod:`~physbench.discover.pipeline` (the stages composed), :mod:`~physbench.discover.verdict`
 (text and JSON) and :mod:`~physbench.discover.report` (plots and HTML).
 """
@@ -28,6 +29,7 @@ from __future__ import annotations
 from physbench.discover.candidates import CandidateSpec
 from physbench.discover.data import DiscoverError, Run, load_runs, make_split, runs_from_dataset
 from physbench.discover.diagnostics import diagnose
+from physbench.discover.equivalence import compare_explanations
 from physbench.discover.phrasing import describe
 from physbench.discover.pipeline import (
     candidate_specs,
@@ -37,11 +39,14 @@ from physbench.discover.pipeline import (
     renderer_for,
 )
 from physbench.discover.results import (
+    Ambiguity,
     CandidateResult,
     Diagnosis,
     Discovery,
     Finding,
     FitResult,
+    Prior,
+    Rival,
     Scored,
     Selection,
     Skipped,
@@ -51,6 +56,7 @@ from physbench.discover.settings import Settings
 from physbench.discover.trial import try_effect
 
 __all__ = [
+    "Ambiguity",
     "CandidateResult",
     "CandidateSpec",
     "Diagnosis",
@@ -58,12 +64,15 @@ __all__ = [
     "Discovery",
     "Finding",
     "FitResult",
+    "Prior",
+    "Rival",
     "Run",
     "Scored",
     "Selection",
     "Settings",
     "Skipped",
     "candidate_specs",
+    "compare_explanations",
     "conclude",
     "describe",
     "diagnose",

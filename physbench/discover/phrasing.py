@@ -1,12 +1,15 @@
 """Findings in words: one sentence per :class:`~physbench.discover.results.Finding`, for the text
-verdict, the JSON's ``text`` field and the HTML report. Only the numbers of the finding go into
-the sentence; nothing here computes a statistic."""
+verdict, the JSON's ``text`` field and the HTML report; likewise the explanations a recording
+cannot tell apart (:class:`~physbench.discover.results.Ambiguity`) and what would tell them apart,
+and the setup's priors (:class:`~physbench.discover.results.Prior`). Only the numbers of the
+finding go into the sentence; nothing here computes a statistic."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
-from physbench.discover.results import Finding
+from physbench.discover.results import Ambiguity, Finding, Prior
 
 #: How a free-flight loss scales with speed, in words.
 SPEED_LAWS = {
@@ -105,3 +108,104 @@ _PHRASES: dict[str, Callable[[Finding], str]] = {
     "period": _period,
     "centre": _centre,
 }
+
+
+# --------------------------------------------------------------------------- rivals and priors
+
+#: Degeneracies by construction (:func:`physbench.discover.equivalence.degeneracies`), in words.
+DEGENERACIES = {
+    "g": "in free flight a length-scale error, a clock error and a change of g are one and the "
+    "same uniform acceleration (with initial speeds to match)",
+    "tilt": "a turn of the axes tilts g, which is the same as a horizontal uniform force",
+    "angle": "for an angle measured alone, a turn of the axes is an offset of the angle",
+}
+#: The measurement causes each degeneracy involves besides those named (so that what would tell
+#: them apart names their references too).
+DEGENERATE_WITH = {
+    "g": ("calibration_scale", "clock_scale"),
+    "tilt": ("axis_rotation",),
+    "angle": ("axis_rotation", "sensor_offset"),
+}
+#: What would tell a physical effect apart from other explanations of the same data.
+PHYSICAL_SEPARATORS = {
+    "constant_force": "bodies of other masses, or a force of known size (a kick), in the same "
+    "recording (a force accelerates each body by F/m, a measurement error all alike)",
+    "table_tilt": "a level on the table, or a body that runs in other directions",
+    "linear_drag": "a longer flight or faster throws, where the drag laws differ",
+    "quadratic_drag": "a longer flight or faster throws, where the drag laws differ",
+    "rolling_resistance": "a body that comes to rest, or runs in other directions",
+    "joint_viscous_damping": "swings over a wider range of amplitudes",
+    "joint_coulomb_friction": "swings over a wider range of amplitudes",
+    "joint_quadratic_damping": "swings over a wider range of amplitudes",
+    "velocity_dependent_restitution": "impacts over a wider range of speeds",
+}
+
+
+def separator(name: str) -> str:
+    """What would tell the registered effect ``name`` apart from other explanations: for a
+    measurement cause the reference that fixes it, for a physical effect the data that would."""
+    from physbench.discover.candidates import REFERENCES
+
+    for effect, reference in REFERENCES.values():
+        if effect == name:
+            return reference
+    return PHYSICAL_SEPARATORS.get(name, "more data where their predictions differ")
+
+
+def separators(a: Ambiguity) -> list[str]:
+    """What would tell the explanations of ``a`` apart, one entry per piece of evidence with the
+    effects it pins: ``"<what> (<effect>, ...)"``."""
+    names = [n for member in a.members for n in member]
+    names += [n for code in a.degeneracies for n in DEGENERATE_WITH.get(code, ())]
+    by: dict[str, list[str]] = {}
+    for n in dict.fromkeys(names):
+        by.setdefault(separator(n), []).append(n)
+    return [f"{what} ({', '.join(ns)})" for what, ns in by.items()]
+
+
+def ambiguity_lines(a: Ambiguity, unit: str) -> list[str]:
+    """The set of explanations of ``a`` in words: each with its held-out error and how much
+    better the named cause predicts it (``z``, in standard deviations of the noise), the
+    degeneracies by construction, what would tell them apart, and whether a physical cause is
+    named alone."""
+    lines = [
+        "this recording cannot tell these explanations apart (held-out error; how much better "
+        "the first predicts, in standard deviations of the noise):",
+        f"  - {a.name:<36} {a.heldout_error:.4g} {unit}",
+    ]
+    for r in a.rivals:
+        if r.same:  # z of a difference smaller than the noise says nothing worth printing
+            how = "the same predictions"
+        else:
+            how = f"z {r.z:+.1f}" if math.isfinite(r.z) else "not comparable"
+        lines.append(f"  - {' + '.join(r.names):<36} {r.heldout_error:.4g} {unit}  ({how})")
+    lines += [f"by construction: {DEGENERACIES[code]}" for code in a.degeneracies]
+    lines.append("what would tell them apart: " + "; ".join(separators(a)))
+    if not a.measurement and any(r.measurement for r in a.rivals):
+        lines.append(
+            f"so {a.name} is not named alone: a measurement error explains the data as well"
+        )
+    return lines
+
+
+def _percent(x: float) -> str:
+    return f"{abs(x):.3g} %"
+
+
+def prior_text(p: Prior) -> str:
+    """The prior ``p`` in words, starting with its body's name."""
+    v = p.values
+    if p.kind == "level_table":
+        return (
+            f"{p.body}: a body on a level table feels no uniform pull; {v['accel']:.3g} m/s² "
+            f"({p.effect}) is what a table sloping {1000 * v['slope']:.3g} mm per metre gives"
+        )
+    scale, clock = 100 * v["scale"], 100 * v["clock"]
+    return (
+        f"{p.body}: in still air no horizontal constant force acts on a free body; the "
+        f"horizontal part of {p.effect}, {v['horizontal']:+.3g} m/s², is what axes turned by "
+        f"{math.degrees(v['turn']):+.2g}° give (or a wind). And g is known: its vertical part, "
+        f"{v['vertical']:+.3g} m/s² ({_percent(100 * v['vertical'] / v['g'])} of g), is what a "
+        f"length scale {_percent(scale)} {'long' if scale > 0 else 'short'} or a clock "
+        f"{_percent(clock)} {'slow' if clock > 0 else 'fast'} gives"
+    )

@@ -6,6 +6,7 @@ them::
     specs, skipped = candidate_specs(scene, settings)         # which effects to try
     selection = select_causes(base, specs, settings, skipped) # greedy rounds of candidate fits
     selection = prune_causes(selection, settings)             # drop causes made redundant
+    selection = compare_explanations(selection, specs, settings)  # what it cannot tell apart
     disc = conclude(selection, settings)                      # Discovery, for the verdict
 
 One candidate can be tried by hand on a fitted model with
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 from physbench.discover import diagnostics
 from physbench.discover.candidates import CandidateSpec, candidates_for
 from physbench.discover.data import DiscoverError, Run, make_split
+from physbench.discover.equivalence import compare_explanations
 from physbench.discover.fit import fit_model, is_rough, score
 from physbench.discover.model import Model, Problem, body_params, nuisance_params
 from physbench.discover.profile import profiled
@@ -61,11 +63,12 @@ def discover(
     stage("base fit")
     base = fit_base(runs, simulator, settings, renderer=renderer)
     if candidates is None:
-        specs, skipped = candidate_specs(base.model.problem.runs[0].scene, settings)
+        specs, skipped = candidate_specs(base.model.problem.runs[0].scene, settings, runs)
     else:
         specs, skipped = list(candidates), []
     stage("candidate effects")
     selection = prune_causes(select_causes(base, specs, settings, skipped), settings)
+    selection = compare_explanations(selection, specs, settings)
     stage("verdict")
     return conclude(selection, settings, diagnose=diagnose, started=started)
 
@@ -140,12 +143,19 @@ def fit_base(
 
 
 def candidate_specs(
-    scene: Scene, settings: Settings
+    scene: Scene, settings: Settings, runs: Sequence[Run] | None = None
 ) -> tuple[list[CandidateSpec], list[tuple[str, str]]]:
     """The candidate effects for ``scene`` (``settings.effects``, or every registered one that
-    applies) and the ones left out with the reason; raises :class:`DiscoverError` when effects
-    were named and none applies."""
-    specs, skipped = candidates_for(scene, settings.effects)
+    applies; none that ``settings.references`` fix) and the ones left out with the reason;
+    ``runs``: the data, whose fields and extent decide the camera's candidates (None: as frames,
+    positions within the scene's bounds). Raises :class:`DiscoverError` when effects were named
+    and none applies."""
+    recordings = None
+    if runs is not None and all(r.recording is not None for r in runs):
+        recordings = [r.recording for r in runs if r.recording is not None]
+    specs, skipped = candidates_for(
+        scene, settings.effects, recordings=recordings, references=settings.references
+    )
     if settings.effects is not None and not specs:
         why = "; ".join(f"{n}: {r}" for n, r in skipped)
         raise DiscoverError(
@@ -185,6 +195,8 @@ def conclude(
         gain=selection.gain,
         skipped=selection.skipped,
         alternatives=selection.alternatives,
+        ambiguities=selection.ambiguities,
+        priors=selection.priors,
         findings=found,
         breakdowns=breakdowns,
         seconds=0.0 if started is None else time.perf_counter() - started,

@@ -18,7 +18,7 @@ import numpy as np
 
 from physbench.discover.phrasing import describe
 from physbench.discover.residuals import EVENTS
-from physbench.discover.verdict import params_text, text
+from physbench.discover.verdict import headline, params_text, text
 from physbench.plotting.embed import png_data_uri
 
 if TYPE_CHECKING:
@@ -279,7 +279,9 @@ def _html(disc: Discovery, figures: list[tuple[Path, str]]) -> str:
         f"<li>{e(describe(f))}{' → ' + e(', '.join(f.suggests)) if f.suggests else ''}</li>"
         for f in findings.get("base", [])
     )
-    title = "physbench discover: " + (", ".join(disc.causes) if disc.causes else "no cause found")
+    title = "physbench discover: " + (
+        headline(disc).removeprefix("causes: ") if disc.causes else "no cause found"
+    )
     style = (
         "body{font-family:sans-serif;max-width:1100px;margin:1em auto;} "
         "pre{background:#f6f6f6;padding:.6em;overflow-x:auto;font-size:12px}\n"

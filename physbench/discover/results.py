@@ -201,6 +201,74 @@ def _num(v: float) -> float | None:
     return float(v) if v is not None and math.isfinite(v) else None
 
 
+@dataclass(frozen=True)
+class Rival:
+    """Another explanation of what a cause explains: the effects ``effects`` (keys; registered
+    ``names``) added instead of it to the model it extends, fitted and scored on the held-out
+    data. ``z``: how much better the cause predicts the held-out data, in standard deviations of
+    the noise of that difference (> 0: the cause is better; nan: not comparable); ``same``: the
+    two predict the same held-out data (they differ by less than a quarter of the noise), as
+    explanations that are one and the same by construction do; ``measurement``: every one of its
+    effects is a measurement cause."""
+
+    effects: tuple[str, ...]
+    names: tuple[str, ...]
+    measurement: bool
+    heldout_error: float
+    z: float
+    same: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "effects": list(self.effects),
+            "names": list(self.names),
+            "kind": "measurement" if self.measurement else "physical",
+            "heldout_error": _num(self.heldout_error),
+            "z": _num(self.z),
+            "same_predictions": self.same,
+        }
+
+
+@dataclass(frozen=True)
+class Ambiguity:
+    """A cause and the rival explanations this recording cannot tell apart from it
+    (:mod:`physbench.discover.equivalence`): each explains the data as the cause does, and the
+    cause does not beat it by ``Settings.beat_z`` standard deviations of the held-out noise.
+    ``degeneracies``: why some are one and the same by construction (codes that
+    :mod:`physbench.discover.phrasing` puts into words: ``"g"``, ``"tilt"``, ``"angle"``)."""
+
+    cause: str
+    name: str
+    measurement: bool
+    heldout_error: float
+    rivals: tuple[Rival, ...]
+    degeneracies: tuple[str, ...] = ()
+
+    @property
+    def members(self) -> list[tuple[str, ...]]:
+        """Every explanation, the cause first, each as its registered effect names."""
+        return [(self.name,), *(r.names for r in self.rivals)]
+
+    @property
+    def physical_alone(self) -> bool:
+        """Whether the cause is physical and no rival is a measurement error: the physical
+        explanation stands, though the recording does not pin which one."""
+        return not self.measurement and not any(r.measurement for r in self.rivals)
+
+
+@dataclass(frozen=True)
+class Prior:
+    """What the setup says about a cause, as numbers (:mod:`physbench.discover.phrasing` puts it
+    into words). ``kind``: ``still_air`` (a uniform pull on a free body in a side view: no
+    horizontal force acts in still air, and g is known), ``level_table`` (a uniform pull seen from
+    above: the table's tilt it takes); ``values``: the numbers (m/s², rad, relative errors)."""
+
+    kind: str
+    effect: str
+    body: str
+    values: dict[str, float] = field(default_factory=dict)
+
+
 @dataclass(frozen=True, eq=False)
 class Selection:
     """The outcome of the greedy selection: the (possibly refitted) base model, the final model,
@@ -213,6 +281,11 @@ class Selection:
     causes: list[str]
     alternatives: dict[str, list[str]]
     skipped: list[tuple[str, str]]
+    #: The causes the data cannot tell apart from other explanations, with those explanations
+    #: (:func:`~physbench.discover.equivalence.compare_explanations`); a cause not listed is
+    #: named alone.
+    ambiguities: list[Ambiguity] = field(default_factory=list)
+    priors: list[Prior] = field(default_factory=list)
 
     @property
     def gain(self) -> float:
@@ -240,7 +313,14 @@ class Discovery:
     findings: dict[str, list[Finding]] = field(default_factory=dict)
     breakdowns: dict[str, Breakdown] = field(default_factory=dict)
     seconds: float = 0.0
+    #: See :attr:`Selection.ambiguities` and :attr:`Selection.priors`.
+    ambiguities: list[Ambiguity] = field(default_factory=list)
+    priors: list[Prior] = field(default_factory=list)
 
     @property
     def cause_results(self) -> list[CandidateResult]:
         return [c for c in self.candidates if c.chosen]
+
+    def ambiguity(self, cause: str) -> Ambiguity | None:
+        """The rivals of ``cause`` (a key of :attr:`causes`), or None when it is named alone."""
+        return next((a for a in self.ambiguities if a.cause == cause), None)

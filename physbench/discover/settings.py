@@ -55,6 +55,15 @@ class Settings:
     #: Candidates whose held-out error is within this factor of the chosen one's are reported as
     #: explaining the data about as well.
     ambiguity: float = 0.05
+    #: What the setup fixes by a reference (names of
+    #: :data:`~physbench.discover.candidates.REFERENCES`: ``scale`` a reference length in the
+    #: plane, ``clock`` a known frame rate, ``axes`` a plumb line, ``origin``, ``lens``,
+    #: ``plane``): the measurement causes they fix are not candidates.
+    references: Sequence[str] = ()
+    #: A cause beats another explanation when its held-out sum of squares is lower by this many
+    #: standard deviations of the paired held-out noise (:mod:`physbench.discover.equivalence`);
+    #: short of that the recording cannot tell them apart.
+    beat_z: float = 2.0
 
     def __post_init__(self) -> None:
         """Refuse a setting outside its range (:mod:`physbench.numeric`): NaN and the
@@ -75,6 +84,7 @@ class Settings:
             "quick_budget": numeric.COUNT,
             "screen": numeric.COUNT,
             "diff_step": numeric.POSITIVE,
+            "beat_z": numeric.NON_NEGATIVE,
         }
         for name, number in checks.items():
             number.check(getattr(self, name), name, DiscoverError)
@@ -87,3 +97,9 @@ class Settings:
                 )
             for h in self.horizons:
                 HORIZON.check(h, "horizons", DiscoverError)
+        from physbench.discover.candidates import REFERENCES
+
+        if isinstance(self.references, str) or any(r not in REFERENCES for r in self.references):
+            raise DiscoverError(
+                f"references = {self.references!r}: expected a list of {', '.join(REFERENCES)}"
+            )

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from physbench.discover.candidates import VIEW_CENTRED, camera_view, is_measurement
 from physbench.discover.data import Run
 from physbench.recording import Recording, Track
 from physbench.scene import Body, Box, Circle, Force, Joint, Scene, Segment, body_unknown
@@ -42,6 +43,9 @@ class SyntheticRun:
     #: What the bodies really did (the effect's measurement included), before tracking noise: what
     #: a camera filming the run would see.
     trajectory: Trajectory | None = None
+    #: Measurement errors of the recording on top of the hidden effect (``make_case``'s
+    #: ``distortion``): ``{effect name: values}``.
+    distortion: dict[str, dict[str, float]] = field(default_factory=dict)
 
 
 def _rng(seed: int, salt: int) -> np.random.Generator:
@@ -334,6 +338,10 @@ EFFECT_SCENES: dict[str, tuple[str, ...]] = {
     "velocity_dependent_restitution": ("bouncer", "drops"),
     "sensor_offset": ("pendulum_xy", "pendulum_both"),
     "clock_scale": ("projectile_kicked", "puck_kicked"),
+    "calibration_scale": ("puck_kicked", "pendulum_xy"),
+    "axis_rotation": ("projectile_kicked", "pendulum_xy"),
+    "lens_distortion": ("projectile", "two_pucks"),
+    "plane_tilt": ("projectile", "projectile_kicked"),
 }
 
 
@@ -380,6 +388,15 @@ def hidden_values(effect: str, scene: Scene, rng: np.random.Generator) -> dict[s
         return out
     if effect == "clock_scale":
         return {"scale": 1.0 + _sign(rng) * float(rng.uniform(0.05, 0.1))}
+    if effect == "calibration_scale":
+        return {"scale": 1.0 + _sign(rng) * float(rng.uniform(0.03, 0.08))}
+    if effect == "axis_rotation":
+        return {"angle": _sign(rng) * float(rng.uniform(0.03, 0.08))}
+    if effect == "lens_distortion":
+        return {"k1": _sign(rng) * float(rng.uniform(0.05, 0.1))}
+    if effect == "plane_tilt":
+        mag, ang = float(rng.uniform(0.15, 0.25)), float(rng.uniform(0, 2 * math.pi))
+        return {"tx": mag * math.cos(ang), "ty": mag * math.sin(ang)}
     raise KeyError(effect)
 
 
@@ -397,7 +414,7 @@ def magnitude_error(effect: str, truth: dict[str, float], got: dict[str, float])
     keys = list(truth)
     t = np.array([truth[k] for k in keys])
     g = np.array([got.get(k, math.nan) for k in keys])
-    if effect == "clock_scale":  # the magnitude is the deviation from a true clock
+    if effect in ("clock_scale", "calibration_scale"):  # the magnitude: the deviation from 1
         t, g = t - 1.0, g - 1.0
     return float(np.linalg.norm(g - t) / np.linalg.norm(t))
 
@@ -432,6 +449,7 @@ def make_case(
     engine: Any,
     truth: Mapping[str, float] | None = None,
     body_params: Mapping[str, float] | None = None,
+    distortion: Mapping[str, Mapping[str, float]] | None = None,
 ) -> SyntheticRun:
     """One synthetic run of ``scene_kind`` (see :data:`SCENES`) with ``effect`` hidden at a random
     magnitude (None: a control), simulated by ``engine`` (a simulator instance). ``truth``: the
@@ -439,31 +457,29 @@ def make_case(
     (an extensible range is widened to hold them; the random draws are made all the same, so the
     scene and the noise do not change). ``body_params``: body parameters (``{"ball.mass": 80}``)
     applied to the drawn scene, for magnitudes that need a heavier or larger body to stay
-    visible without swamping the motion."""
-    from physbench.components import create
-    from physbench.effects import apply_measurements
-
+    visible without swamping the motion. ``distortion``: measurement errors of the recording on
+    top, ``{effect name: values}`` (``{"calibration_scale": {"scale": 0.97}}``), applied after the
+    hidden effect; the camera's view is the box the true positions span."""
     rng = _rng(seed, 1 + sorted(SCENES).index(scene_kind))
     scene = SCENES[scene_kind](rng).with_params(body_params or {}).validate()
     values: dict[str, float] = {}
-    effects = []
     if effect is not None:
         values = {**hidden_values(effect, scene, rng), **(truth or {})}
-        eff = create("effect", effect)
-        for p in eff.parameters():
-            wide = p
-            while not wide.contains(values.get(p.name, 0.0)) and wide.extensible:
-                wide = wide.widened()
-            if wide is not p:
-                eff.widen(p.name, wide.low, wide.high)
-        eff.setup(scene, values)
-        effects = [eff]
     t_end = (scene.frames - 1) / scene.fps
-    scale = values.get("scale", 1.0)
+    clocks = [values.get("scale", 1.0)] if effect == "clock_scale" else []
+    clocks += [v.get("scale", 1.0) for k, v in (distortion or {}).items() if k == "clock_scale"]
+    stretch = max([1.0, *clocks])
     sim_scene = (
-        scene if scale <= 1 else replace(scene, frames=math.ceil(t_end * scale * scene.fps) + 2)
+        scene if stretch <= 1 else replace(scene, frames=math.ceil(t_end * stretch * scene.fps) + 2)
     )
-    traj = apply_measurements(engine.simulate(sim_scene, effects=effects), effects)
+    errors = dict(distortion or {})
+    physical = []
+    if effect is not None and is_measurement(effect):
+        errors = {effect: values, **errors}
+    elif effect is not None:
+        physical = [_effect(effect, scene, values)]
+    traj = engine.simulate(sim_scene, effects=physical)
+    traj = _measured(traj, scene, errors, t_end)
     rec = _record(scene_kind, scene, traj, t_end, rng)
     name = f"{effect or 'control'}/{scene_kind}/{seed}"
     return SyntheticRun(
@@ -473,7 +489,59 @@ def make_case(
         effect,
         values,
         trajectory=traj,
+        distortion={k: dict(v) for k, v in (distortion or {}).items()},
     )
+
+
+def _effect(
+    name: str, scene: Scene, values: Mapping[str, float], options: Mapping[str, Any] | None = None
+) -> Any:
+    """The registered effect ``name`` set up on ``scene`` with ``values``, its extensible ranges
+    widened to hold them."""
+    from physbench.components import create
+
+    eff = create("effect", name, dict(options or {}))
+    for p in eff.parameters():
+        wide = p
+        while not wide.contains(values.get(p.name, 0.0)) and wide.extensible:
+            wide = wide.widened()
+        if wide is not p:
+            eff.widen(p.name, wide.low, wide.high)
+    eff.setup(scene, dict(values))
+    return eff
+
+
+def _measured(
+    traj: Trajectory, scene: Scene, errors: Mapping[str, Mapping[str, float]], t_end: float
+) -> Trajectory:
+    """``traj`` as the sensor reports it, through each measurement effect of ``errors`` in turn.
+    Those centred on the camera's view get the box the *reported* positions span up to ``t_end``,
+    as discovery gives its candidates the data's (found by iterating: the view moves the
+    reported positions a little, which move the view)."""
+    from physbench.effects import apply_measurements
+
+    times = traj.times[traj.times <= t_end + 1e-9]
+
+    def view_of(t: Trajectory) -> tuple[tuple[float, float], float] | None:
+        return camera_view([Recording.from_trajectory(t, times=times)])
+
+    view, out = view_of(traj), traj
+    for _ in range(8 if any(n in VIEW_CENTRED for n in errors) else 1):
+        effects = [
+            _effect(n, scene, v, {"centre": view[0], "radius": view[1]})
+            if n in VIEW_CENTRED and view is not None
+            else _effect(n, scene, v)
+            for n, v in errors.items()
+        ]
+        out = apply_measurements(traj, effects)
+        seen = view_of(out)
+        if seen == view or seen is None or view is None:
+            break
+        moved = math.hypot(seen[0][0] - view[0][0], seen[0][1] - view[0][1])
+        view = seen
+        if moved + abs(seen[1] - view[1]) < 1e-9:
+            break
+    return out
 
 
 def _blur(scene: Scene, rng: np.random.Generator) -> Scene:
@@ -531,3 +599,138 @@ def filmed_run(case: SyntheticRun, seed: int = 0, **camera: Any) -> Run:
     options = {**FILM, "seed": seed, "view": motion_view(run.scene, traj), **camera}
     filmed = filmed_recording(run.scene, traj, CameraRenderer(**options), fields=rec.fields)
     return replace(run, recording=replace(filmed, run=rec.run), source="filmed")
+
+
+# --------------------------------------------------------------------------- measurement errors
+
+#: Scenes of the measurement benchmark (``benchmarks/discover_measurement.py``): a ball in free
+#: flight (side view), and a puck seen from above with two kicks of known size (without them a
+#: puck's steady slide hides any scale, clock or turn of the axes in its initial state).
+MEASUREMENT_SCENES = ("projectile", "puck_kicked")
+#: The recording's errors of a measurement case: one of the camera's scale, the clock, the turn
+#: of the axes, or all three at once.
+DISTORTIONS = ("scale", "clock", "rotation", "all")
+#: The real forces of the same size in each scene (a uniform pull is ``constant_force`` in a side
+#: view and ``table_tilt`` from above, where those are offered), and what a reference fixes in
+#: those cases: the length scale and the frame rate.
+REAL_FORCES = {
+    "projectile": ("constant_force", "linear_drag"),
+    "puck_kicked": ("table_tilt", "linear_drag"),
+}
+REAL_REFERENCES = ("scale", "clock")
+
+
+@dataclass(frozen=True)
+class MeasurementCase:
+    """One case of the measurement benchmark: ``kind`` ``"measurement"`` (a recording distorted by
+    ``label``, one of :data:`DISTORTIONS`, with no force) or ``"physical"`` (a real force
+    ``label`` of the same size, with scale and clock fixed by a reference), the synthetic run
+    and the discovery settings it is judged with."""
+
+    kind: str
+    scene: str
+    label: str
+    seed: int
+    case: SyntheticRun
+    settings: Any
+
+
+def distortion_values(label: str, rng: np.random.Generator) -> dict[str, dict[str, float]]:
+    """The errors of distortion ``label``: a length scale and a clock each 1-3 % off, axes turned
+    by 0.3-1°, or all three, each sign at random."""
+    out: dict[str, dict[str, float]] = {}
+    if label in ("scale", "all"):
+        out["calibration_scale"] = {"scale": 1.0 + _sign(rng) * float(rng.uniform(0.01, 0.03))}
+    if label in ("clock", "all"):
+        out["clock_scale"] = {"scale": 1.0 + _sign(rng) * float(rng.uniform(0.01, 0.03))}
+    if label in ("rotation", "all"):
+        out["axis_rotation"] = {"angle": _sign(rng) * math.radians(float(rng.uniform(0.3, 1.0)))}
+    if not out:
+        raise KeyError(f"distortion {label!r}: expected one of {', '.join(DISTORTIONS)}")
+    return out
+
+
+def real_force_values(effect: str, scene: Scene, rng: np.random.Generator) -> dict[str, float]:
+    """A real ``effect`` as large as the distortions: a uniform pull of 0.1-0.3 m/s² in a random
+    direction (what a 1-3 % scale or a 0.6-1.8° turn of the axes gives in free flight), or linear
+    drag slowing the body by about as much at its typical speed."""
+    m = float(np.mean([b.mass for b in scene.bodies]))
+    if effect in ("constant_force", "table_tilt"):
+        mag, ang = float(rng.uniform(0.1, 0.3)), float(rng.uniform(0, 2 * math.pi))
+        k = ("fx", "fy") if effect == "constant_force" else ("ax", "ay")
+        f = m if effect == "constant_force" else 1.0
+        return {k[0]: f * mag * math.cos(ang), k[1]: f * mag * math.sin(ang)}
+    if effect == "linear_drag":
+        speed = float(np.mean([math.hypot(*b.velocity) for b in scene.bodies]))
+        return {"c": m * float(rng.uniform(0.1, 0.3)) / speed}
+    raise KeyError(effect)
+
+
+def measurement_case(
+    kind: str, scene_kind: str, label: str, seed: int, engine: Any
+) -> MeasurementCase:
+    """One case of the measurement benchmark (see :class:`MeasurementCase`), seeded."""
+    from physbench.discover.settings import Settings
+
+    salt = 1000 + 10 * sorted(SCENES).index(scene_kind)
+    if kind == "measurement":
+        rng = _rng(seed, salt + DISTORTIONS.index(label))
+        case = make_case(None, scene_kind, seed, engine, distortion=distortion_values(label, rng))
+        settings = Settings()
+    elif kind == "physical":
+        rng = _rng(seed, salt + 5 + REAL_FORCES[scene_kind].index(label))
+        scene = SCENES[scene_kind](_rng(seed, 1 + sorted(SCENES).index(scene_kind)))
+        truth = real_force_values(label, scene, rng)
+        case = make_case(label, scene_kind, seed, engine, truth=truth)
+        settings = Settings(references=REAL_REFERENCES)
+    else:
+        raise KeyError(f"kind {kind!r}: expected 'measurement' or 'physical'")
+    return MeasurementCase(kind, scene_kind, label, seed, case, settings)
+
+
+def judge_measurement(mc: MeasurementCase, disc: Any) -> dict[str, Any]:
+    """The benchmark's verdict on one discovery ``disc`` of ``mc``: for a measurement case,
+    whether it lists a measurement cause (as a cause or as an explanation it cannot tell apart
+    from one) and whether it names a physical cause alone; for a real force, whether that force
+    is the first cause, whether it is named alone, and its magnitude error. ``ok``: the claim the
+    benchmark holds (measurement: no physical cause alone, and a measurement cause listed unless
+    nothing at all is named, as for a distortion within the noise; physical: named first).
+    "Alone" for a physical cause: no measurement error explains the data as well."""
+    causes = list(disc.causes)
+    results = {c.effect: c for c in disc.cause_results}
+    measured = [c for c in causes if is_measurement(results[c].name)]
+    rivals = [disc.ambiguity(c) for c in causes]
+    listed = bool(measured) or any(a is not None and not a.physical_alone for a in rivals)
+    alone = [
+        c
+        for c, a in zip(causes, rivals, strict=True)
+        if not is_measurement(results[c].name) and (a is None or a.physical_alone)
+    ]
+    out: dict[str, Any] = {
+        "causes": causes,
+        "named_alone": [c for c, a in zip(causes, rivals, strict=True) if a is None],
+        "indistinguishable": {
+            a.cause: [list(m) for m in a.members] for a in rivals if a is not None
+        },
+        "gain": disc.gain,
+    }
+    if mc.kind == "measurement":
+        # a distortion the recording cannot see names nothing, which is no claim of a force
+        out.update(
+            lists_measurement=listed,
+            physical_alone=alone,
+            no_cause=not causes,
+            ok=(listed or not causes) and not alone,
+        )
+        return out
+    first = causes[:1] == [mc.label]
+    amb = disc.ambiguity(mc.label) if first else None
+    error = magnitude_error(mc.label, mc.case.truth, results[mc.label].params) if first else None
+    out.update(
+        named_first=first,
+        alone=first and (amb is None or amb.physical_alone),
+        measurement_rivals=[] if amb is None else [r.names for r in amb.rivals if r.measurement],
+        magnitude_error=error,
+        ok=first,
+    )
+    return out

@@ -4,6 +4,11 @@ JSON layout (``to_json``): ``{"base": {...}, "candidates": [{"effect", "params",
 "gain", "criterion", ...}, ...], "causes": [names in order], "gain": number, ...}`` plus the final
 model, the diagnostics, the residual breakdowns, the split and the settings. ``gain`` is
 ``1 - heldout(final) / heldout(base)``; ``criterion`` is the BIC on the fitted part.
+``"named_alone"``: the causes no other explanation matches; ``"indistinguishable"``: for each other
+cause, the explanations this recording cannot tell apart from it (``"members"``, the cause first;
+``"rivals"`` with their held-out errors), the degeneracies by construction and what would tell
+them apart (``"separate_by"``), with the verdict's sentences (``"text"``); ``"priors"``: what the
+setup says about a named uniform pull.
 """
 
 from __future__ import annotations
@@ -14,11 +19,17 @@ from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 from physbench.discover.intervals import LEVEL
-from physbench.discover.phrasing import describe
+from physbench.discover.phrasing import (
+    DEGENERACIES,
+    ambiguity_lines,
+    describe,
+    prior_text,
+    separators,
+)
 from physbench.errors import counted
 
 if TYPE_CHECKING:
-    from physbench.discover.results import CandidateResult, Discovery, Finding
+    from physbench.discover.results import Ambiguity, CandidateResult, Discovery, Finding
 
 #: Findings shown in the text verdict.
 MAX_FINDINGS = 8
@@ -137,8 +148,11 @@ def text(disc: Discovery) -> str:
             )
             if c.at_bound:
                 lines.append(f"     {bound_caveat(c)}")
+            amb = disc.ambiguity(c.effect)
             alts = disc.alternatives.get(c.effect, [])
-            if alts:
+            if amb is not None:
+                lines += [f"     {line}" for line in ambiguity_lines(amb, u)]
+            elif alts:
                 lines.append(
                     f"     about as good on held-out data: {', '.join(alts)} (the data hardly "
                     "tell them apart)"
@@ -153,6 +167,9 @@ def text(disc: Discovery) -> str:
             f"extended model: held-out error {f.heldout:.4g} {u} (base {b.heldout:.4g}); "
             f"gain = 1 - extended/base = {disc.gain:.1%}"
         )
+        if disc.priors:
+            lines.append("priors from the setup:")
+            lines += [f"  - {prior_text(p)}" for p in disc.priors]
     else:
         best = min(disc.candidates, key=lambda c: c.heldout_error, default=None)
         why = (
@@ -172,6 +189,38 @@ def text(disc: Discovery) -> str:
     if disc.skipped:
         lines.append("not tried: " + "; ".join(f"{n} ({why})" for n, why in disc.skipped))
     return "\n".join(lines)
+
+
+def headline(disc: Discovery) -> str:
+    """The causes in one line, each with the explanations the recording cannot tell apart from
+    it: ``causes: clock_scale (or calibration_scale, constant_force: indistinguishable here)``."""
+    if not disc.causes:
+        return "causes: none"
+    parts = []
+    for cause in disc.causes:
+        amb = disc.ambiguity(cause)
+        if amb is None:
+            parts.append(cause)
+        else:
+            others = ", ".join(" + ".join(r.effects) for r in amb.rivals)
+            parts.append(f"{cause} (or {others}: indistinguishable here)")
+    return "causes: " + "; ".join(parts)
+
+
+def ambiguity_dict(a: Ambiguity, unit: str) -> dict[str, Any]:
+    """One cause's indistinguishable set in the JSON."""
+    return {
+        "cause": a.cause,
+        "name": a.name,
+        "kind": "measurement" if a.measurement else "physical",
+        "heldout_error": a.heldout_error,
+        "members": [list(m) for m in a.members],
+        "rivals": [r.to_dict() for r in a.rivals],
+        "degeneracies": [{"code": c, "text": DEGENERACIES[c]} for c in a.degeneracies],
+        "separate_by": separators(a),
+        "physical_alone": a.physical_alone,
+        "text": ambiguity_lines(a, unit),
+    }
 
 
 def table(disc: Discovery) -> str:
@@ -217,6 +266,18 @@ def to_dict(disc: Discovery) -> dict[str, Any]:
             "gain": disc.gain,
             "final": disc.final.summary(),
             "alternatives": disc.alternatives,
+            "named_alone": [c for c in disc.causes if disc.ambiguity(c) is None],
+            "indistinguishable": [ambiguity_dict(a, disc.unit) for a in disc.ambiguities],
+            "priors": [
+                {
+                    "kind": p.kind,
+                    "effect": p.effect,
+                    "body": p.body,
+                    "values": p.values,
+                    "text": prior_text(p),
+                }
+                for p in disc.priors
+            ],
             "engine": disc.engine,
             "unit": disc.unit,
             "runs": [

@@ -1,8 +1,9 @@
 """Built-in model extensions (:class:`~physbench.effects.base.Effect` plugins).
 
 Each adds named parameters and acts through forces and torques that both engines apply the same
-way every substep. Measurement effects (:class:`SensorOffset`, :class:`ClockScale`) apply no forces
-and change the simulated trajectory through :meth:`~Effect.measure` instead;
+way every substep. Measurement effects (:class:`SensorOffset`, :class:`ClockScale`,
+:class:`CalibrationScale`, :class:`AxisRotation`, :class:`LensDistortion`, :class:`PlaneTilt`) apply
+no forces and change the simulated trajectory through :meth:`~Effect.measure` instead;
 :func:`apply_measurements` is what the framework calls on every simulated trajectory before
 comparing it with data.
 """
@@ -21,7 +22,14 @@ from physbench.effects.joints import (
     JointQuadraticDamping,
     JointViscousDamping,
 )
-from physbench.effects.measurement import ClockScale, SensorOffset
+from physbench.effects.measurement import (
+    AxisRotation,
+    CalibrationScale,
+    ClockScale,
+    LensDistortion,
+    PlaneTilt,
+    SensorOffset,
+)
 from physbench.effects.surface import RollingResistance
 from physbench.hookspecs import hookimpl
 from physbench.trajectory import Trajectory
@@ -39,6 +47,10 @@ BUILTIN_EFFECTS: tuple[type[Effect], ...] = (
     VelocityDependentRestitution,
     SensorOffset,
     ClockScale,
+    CalibrationScale,
+    AxisRotation,
+    LensDistortion,
+    PlaneTilt,
 )
 
 
@@ -58,6 +70,8 @@ def register_effects() -> list[type[Any]]:
 
 __all__ = [
     "BUILTIN_EFFECTS",
+    "AxisRotation",
+    "CalibrationScale",
     "ClockScale",
     "ConstantForce",
     "Effect",
@@ -65,7 +79,9 @@ __all__ = [
     "JointCoulombFriction",
     "JointQuadraticDamping",
     "JointViscousDamping",
+    "LensDistortion",
     "LinearDrag",
+    "PlaneTilt",
     "QuadraticDrag",
     "RollingResistance",
     "SensorOffset",

@@ -285,6 +285,25 @@ def test_a_disagreement_below_the_floor_names_no_cause(tmp_path, slide):
     assert any("above the data's accuracy 1 " in n for n in notes), notes
 
 
+def test_a_reference_fixes_a_measurement_cause_and_quiet_names_the_sets(tmp_path, capsys, slide):
+    scene = slide
+    write_recordings(tmp_path / "r.csv", noisy(PymunkSimulator().simulate(scene)))
+    save_scene(scene, tmp_path / "s.toml")
+    argv = ["discover", str(tmp_path / "r.csv"), "--scene", str(tmp_path / "s.toml"), "-q"]
+    argv += ["--effects", "calibration_scale", "linear_drag", "--reference", "scale", "clock"]
+    assert cli([*argv, "--out", str(tmp_path / "v.json")]) == 0
+    assert capsys.readouterr().out.startswith("causes: none; gain")
+    d = json.loads((tmp_path / "v.json").read_text())
+    assert d["settings"]["references"] == ["scale", "clock"]
+    assert {
+        "effect": "calibration_scale",
+        "reason": "fixed by a reference: a reference length in the plane of motion",
+    } in d["skipped"]
+    assert d["named_alone"] == [] and d["indistinguishable"] == [] and d["priors"] == []
+    assert cli([*argv[:-3], "--reference", "ruler"]) == 2
+    assert "references = ('ruler',): expected a list of scale, clock" in capsys.readouterr().err
+
+
 def test_a_recording_tracked_in_y_only_is_fitted_in_y_only(tmp_path, slide):
     """The written CSV keeps the measured fields: the unseen x (filled with zeros by the tracker)
     is neither fitted nor blamed on a sensor offset."""

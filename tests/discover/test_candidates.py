@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-from physbench.discover.candidates import candidates_for, start_values
+from physbench.discover.candidates import (
+    REFERENCES,
+    camera_view,
+    candidates_for,
+    is_measurement,
+    start_values,
+)
 from physbench.effects import VelocityDependentRestitution
 from physbench.errors import UnknownNameError
+from physbench.recording import Recording, Track
 from physbench.scene import Body, Box, Circle, Force, Joint, Scene, Segment
 
 BALL = Body("ball", Circle(0.05), (1.0, 1.0), velocity=(1.0, 0.0), elasticity=0.8)
@@ -35,11 +43,46 @@ def test_a_uniform_acceleration_is_offered_once_on_bodies_of_one_mass():
     assert offered(Scene("two", (BALL, heavy), gravity=(0.0, 0.0)), both)[0] == both
 
 
-def test_a_clock_error_needs_a_force_of_known_size():
-    names, why = offered(Scene("side", (BALL,)), ["clock_scale"])
-    assert names == [] and "no force of known size" in why["clock_scale"]
+MEASUREMENT = ["clock_scale", "calibration_scale", "axis_rotation", "lens_distortion"]
+
+
+def test_measurement_causes_are_candidates_beside_the_physical_effects():
+    # without a force of known size a clock error is a change of g, and it is offered all the
+    # same: discovery then names it together with the change of g it cannot be told from
+    assert offered(Scene("side", (BALL,)), MEASUREMENT)[0] == MEASUREMENT
     kicked = Scene("kick", (BALL,), forces=(Force("ball", (1.0, 0.0), 0.1, 0.2),))
     assert offered(kicked, ["clock_scale"])[0] == ["clock_scale"]
+    assert all(is_measurement(n) for n in [*MEASUREMENT, "sensor_offset", "plane_tilt"])
+    assert not any(is_measurement(n) for n in ["constant_force", "linear_drag", "nope"])
+
+
+def test_a_reference_fixes_a_measurement_cause():
+    specs, skipped = candidates_for(
+        Scene("side", (BALL,)), MEASUREMENT, references=("scale", "clock")
+    )
+    assert [s.label for s in specs] == ["axis_rotation", "lens_distortion"]
+    why = dict(skipped)
+    assert why["calibration_scale"] == f"fixed by a reference: {REFERENCES['scale'][1]}"
+    assert why["clock_scale"] == f"fixed by a reference: {REFERENCES['clock'][1]}"
+
+
+def test_the_camera_s_errors_need_positions_and_are_centred_on_the_view():
+    side = Scene("side", (BALL,))
+    t3, zeros = np.arange(3.0), np.zeros(3)
+    angle_only = Recording({"ball": Track(t3, zeros, zeros, zeros)}, fields=("angle",))
+    specs, skipped = candidates_for(side, MEASUREMENT, recordings=[angle_only])
+    assert [s.label for s in specs] == ["clock_scale"]
+    assert "no positions" in dict(skipped)["axis_rotation"]
+    t = np.array([0.0, 1.0])
+    tracked = Recording({"ball": Track(t, np.array([1.0, 3.0]), np.array([2.0, 0.0]))})
+    assert camera_view([tracked]) == ((2.0, 1.0), pytest.approx(np.hypot(2.0, 2.0) / 2))
+    (lens,), _ = candidates_for(side, ["lens_distortion"], recordings=[tracked])
+    assert dict(lens.options)["centre"] == (2.0, 1.0)
+    dropped = Recording({"ball": Track(t, np.zeros(2), np.array([2.0, 0.0]))}, fields=("y",))
+    specs, skipped = candidates_for(side, MEASUREMENT, recordings=[dropped])
+    assert [s.label for s in specs] == ["clock_scale", "calibration_scale"]  # a drop in y only
+    assert "track one coordinate" in dict(skipped)["axis_rotation"]
+    assert lens.make().radius() == pytest.approx(np.hypot(2.0, 2.0) / 2)
 
 
 def test_translational_losses_act_on_free_bodies_only():

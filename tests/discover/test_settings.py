@@ -17,6 +17,9 @@ from physbench.discover import DiscoverError, Settings
         ({"min_delta_bic": -1}, r"min_delta_bic = -1: expected a finite number >= 0"),
         ({"floor": float("nan")}, r"floor = nan: expected a finite number >= 0 \(m\)"),
         ({"min_delta_bic": float("inf")}, r"min_delta_bic = inf: expected a finite number >= 0"),
+        ({"references": ["ruler"]}, r"references = \['ruler'\]: expected a list of scale, clock"),
+        ({"references": "scale"}, r"references = 'scale'"),
+        ({"beat_z": -1.0}, r"beat_z = -1\.0: expected a finite number >= 0"),
     ],
 )
 def test_bad_settings_are_named(bad, message):
@@ -28,3 +31,8 @@ def test_settings_are_a_frozen_value():
     s = Settings()
     with pytest.raises(AttributeError):
         s.min_gain = 0.2  # type: ignore[misc]
+
+
+def test_references_name_what_the_setup_fixes():
+    assert Settings(references=("scale", "clock", "axes")).references == ("scale", "clock", "axes")
+    assert Settings().references == () and Settings().beat_z == 2.0
