@@ -33,6 +33,8 @@ DARK = 16.0
 #: Below this area (px) a body's measured size is loose: the size ratio allowed grows as the
 #: root of this over its area.
 SMALL = 50.0
+#: The least share of its size that a body's own colour may show in a blob of several colours.
+HIDDEN = 0.2
 #: Weight of a new detection in the running appearance.
 RATE = 0.1
 
@@ -73,14 +75,18 @@ class Appearance:
     def first(cls, look: Look) -> Appearance:
         return cls(look.size, np.asarray(look.colour, dtype=float))
 
-    def mismatch(self, look: Look, *, size: bool = True) -> str | None:
+    def mismatch(self, look: Look, *, size: bool = True, hidden: bool = False) -> str | None:
         """Why ``look`` is not this body (a few words with the measured values), or ``None``.
         ``size=False`` judges the colour only: the tracker passes it for a body's share of a blob
-        it shares with touching bodies, whose area is where the split put the border."""
+        it shares with touching bodies, whose area is where the split put the border.
+        ``hidden``: the look is of the pixels of the body's colour in a blob that holds other
+        colours too, so part of the body may be hidden (by a neighbour, or where a median
+        background holds the body itself): down to :data:`HIDDEN` of its size."""
         ratio = look.size / max(self.size, 1e-9)
         # A body of a few pixels has a size of a few pixels, give or take most of them.
         allowed = SIZE_RATIO * max(1.0, math.sqrt(SMALL / max(look.pixels, 1e-9)))
-        if size and not 1 / allowed <= ratio <= allowed:
+        least = min(1 / allowed, HIDDEN) if hidden else 1 / allowed
+        if size and not least <= ratio <= allowed:
             return f"{ratio:.2f} times its size"
         hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread):

@@ -87,10 +87,18 @@ def not_found(
                 "px radius nor of its area: check the body's size in the scene and the "
                 f"calibration's scale{lit}"
             )
+        # With the clip's median as the background, a body that stays put is not there at all,
+        # and the blob of its size may be another body.
+        held = (
+            "; or it stays there for most of the clip and the background, the median of the "
+            "clip, holds it: film the empty scene and give it as --background"
+            if median
+            else ""
+        )
         return (
             f"{head}; a blob of its size is {far:.0f} px away, at pixel (u={best.u:.0f}, "
             f"v={best.v:.0f}): the scene's initial position, --seed, --start or the calibration "
-            f"is off{lit}"
+            f"is off{held}{lit}"
         )
     fix = (
         "too little contrast. Give it a colour or brightness unlike the wall behind it, light "

@@ -52,7 +52,7 @@ import numpy as np
 from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
 from physbench.video.accuracy import stated_accuracy
-from physbench.video.appearance import Appearance, Look, colour_directions
+from physbench.video.appearance import HIDDEN, Appearance, Look, colour_directions
 from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
     Outline,
@@ -565,45 +565,81 @@ class Tracker:
             )
             if not blobs:
                 continue
-            owner, dist = self._assign(group, blobs, gates)
+            own = [self._own_colours(image, blob, group) for blob in blobs]
+            owner, dist = self._assign(group, blobs, gates, own)
             for c, members in owner.items():
-                discs = [i for i in members if self.states[i].disc]
-                colours = self._colours(image, blobs[c]) if len(members) > 1 and discs else None
-                for i in discs:
-                    plan = self._plan(i, blobs[c], alone=len(members) == 1, colours=colours)
-                    plans[i] = (plan, window)
-            windows.append((group, window, blobs, owner, dist))
+                mixed = len(members) > 1 or _colours_of(blobs[c], own[c], self.states) > 1
+                for i in members:
+                    if self.states[i].disc:
+                        mask = own[c].get(i) if mixed else None
+                        plan = self._plan(i, blobs[c], alone=len(members) == 1, own=mask)
+                        plans[i] = (plan, window)
+            windows.append((group, window, blobs, owner, dist, own))
         fits = self._fit_discs(image, plans)
         found: dict[int, _Found] = {}
-        for group, window, blobs, owner, dist in windows:
+        for group, window, blobs, owner, dist, own in windows:
             mine = {i: p for i, (p, _) in plans.items() if i in group}
             taken = set(owner)
             for c, members in owner.items():
-                got = self._members(image, blobs[c], members, window, mine, fits)
+                got = self._members(image, blobs[c], members, window, mine, fits, own[c])
                 found.update(got)
                 for i in members:
-                    if i in got:
-                        continue
-                    # Rejected: the next blob within its gate that no one took, if any.
-                    j = group.index(i)
-                    for alt in np.argsort(dist[j]):
-                        if int(alt) in taken or dist[j, alt] > gates[i]:
-                            continue
-                        blob = blobs[int(alt)]
-                        plan = {i: self._plan(i, blob, alone=True)} if self.states[i].disc else {}
-                        fit = self._fit_discs(image, {k: (p, window) for k, p in plan.items()})
-                        again = self._members(image, blob, [i], window, plan, fit)
-                        if i in again:
-                            found[i] = again[i]
-                            taken.add(int(alt))
-                            break
+                    if i not in got:
+                        tries = self._tries(i, group, blobs, c, own, dist[group.index(i)], gates)
+                        tries = [a for a in tries if a == c or a not in taken]
+                        again = self._again(i, image, window, blobs, c, own, tries)
+                        if again is not None:
+                            found[i], alt = again
+                            taken.add(alt)
         return found
 
+    def _tries(
+        self,
+        i: int,
+        group: list[int],
+        blobs: list,
+        c: int,
+        own: list[dict[int, np.ndarray]],
+        dist: np.ndarray,
+        gates: np.ndarray,
+    ) -> list[int]:
+        """Where to look again for body ``i``, rejected on blob ``c``: among the pixels of its
+        colour in that blob where the blob is too big for the body alone (it holds something
+        else too: another body, or the body's ghost in a median background), then the other
+        blobs within its gate, nearest first (``dist``: its prediction's to each blob)."""
+        tries = []
+        if i in own[c] and blobs[c][0].area > 1.3 * self.states[i].area:
+            tries.append(c)
+        return tries + [int(a) for a in np.argsort(dist) if int(a) != c and dist[a] <= gates[i]]
+
+    def _again(
+        self,
+        i: int,
+        image: np.ndarray,
+        window: tuple[np.ndarray, tuple[int, int]],
+        blobs: list,
+        c: int,
+        own: list[dict[int, np.ndarray]],
+        tries: list[int],
+    ) -> tuple[_Found, int] | None:
+        """Body ``i`` measured on the first blob of ``tries`` where it looks like itself (on
+        blob ``c``, where it was rejected, among its colour's pixels only), and that blob."""
+        for alt in tries:
+            blob = blobs[alt]
+            mask = own[alt].get(i) if alt == c else None
+            disc = self.states[i].disc
+            plan = {i: self._plan(i, blob, alone=mask is None, own=mask)} if disc else {}
+            fit = self._fit_discs(image, {j: (p, window) for j, p in plan.items()})
+            again = self._members(image, blob, [i], window, plan, fit, own[alt])
+            if i in again:
+                return again[i], alt
+        return None
+
     def _assign(
-        self, ids: list[int], blobs: list, gates: np.ndarray
+        self, ids: list[int], blobs: list, gates: np.ndarray, own: list[dict[int, np.ndarray]]
     ) -> tuple[dict[int, list[int]], np.ndarray]:
         """Blobs to bodies ``ids``: each blob's owners, and the distance of each body's prediction
-        to each blob's centre (px)."""
+        to each blob's centre (px). ``own``: per blob, the pixels of each body's colour."""
         from scipy.optimize import linear_sum_assignment
 
         preds = self.pred_uv[ids]
@@ -629,7 +665,55 @@ class Tracker:
                 if blobs[c][0].area > 0.6 * expected:
                     owner.setdefault(int(c), []).append(i)
                     break
+        self._by_colour(ids, blobs, gates, own, owner, dist)
         return owner, dist
+
+    def _by_colour(
+        self,
+        ids: list[int],
+        blobs: list,
+        gates: np.ndarray,
+        own: list[dict[int, np.ndarray]],
+        owner: dict[int, list[int]],
+        dist: np.ndarray,
+    ) -> None:
+        """The assignment ``owner`` corrected by the bodies' colours: a blob that holds next to
+        none of a body's colour and much of another body's is not that body's (a ghost of a
+        body in a median background, or its neighbour, where the body itself is not found:
+        it is unseen rather than measured there), and a body left out shares the nearest blob
+        on its prediction that holds much of its colour (touching bodies whose blob is smaller
+        than two bodies, or a blob given to the neighbour alone)."""
+
+        def held(c: int, i: int) -> float:
+            mask = own[c].get(i)
+            return 0.0 if mask is None else float(blobs[c][3][mask].sum()) / self.states[i].area
+
+        for c, members in list(owner.items()):
+            others = [k for k in ids if k not in members and held(c, k) >= HIDDEN]
+            for i in [i for i in members if i in own[c] and held(c, i) < 0.1]:
+                if others:
+                    members.remove(i)
+            if not members:
+                del owner[c]
+        for j, i in enumerate(ids):
+            if self.states[i].look is None or any(i in v for v in owner.values()):
+                continue
+            for c in np.argsort(dist[j]):
+                _, u, v, _ = blobs[c]
+                d2 = (u - self.pred_uv[i, 0]) ** 2 + (v - self.pred_uv[i, 1]) ** 2
+                if d2.min() <= gates[i] ** 2 and held(int(c), i) >= HIDDEN:
+                    owner.setdefault(int(c), []).append(i)
+                    break
+
+    def _own_colours(self, image: np.ndarray, found_blob: tuple, ids: list[int]) -> dict:
+        """Which pixels of a blob are of each body's colour, for the bodies of ``ids`` whose
+        looks are known."""
+        looks = {i: self.states[i].look for i in ids}
+        known = {i: look for i, look in looks.items() if look is not None}
+        if not known:
+            return {}
+        colours = self._colours(image, found_blob)
+        return {i: look.matches(*colours) for i, look in known.items()}
 
     def _members(
         self,
@@ -639,6 +723,7 @@ class Tracker:
         window: tuple[np.ndarray, tuple[int, int]],
         plans: dict[int, _Plan],
         fits: dict[int, DiscFit | None],
+        own: dict[int, np.ndarray],
     ) -> dict[int, _Found]:
         """Measure ``members`` on one blob (pixels ``u``, ``v``, coverage ``w``): a disc by its
         outline (``fits``), a body alone by its centroid, bodies sharing the blob by its pixels
@@ -653,7 +738,8 @@ class Tracker:
         }
         for i, got in discs.items():
             look = self.states[i].look
-            if shared and got is not None and look is not None and look.mismatch(got.look):
+            hidden = plans[i].pixels is not None  # among its colour's pixels: part may be hidden
+            if shared and got is not None and look and look.mismatch(got.look, hidden=hidden):
                 discs[i] = None  # an outline of another body: try the body's share of the blob
         if any(i not in discs or (discs[i] is None and shared) for i in members):
             diff, (r0, c0) = window
@@ -662,7 +748,7 @@ class Tracker:
             img, bg = image[rows, cols], self.bg[rows, cols]
             if shared:
                 outlines = [self._outline(i) for i in members]
-                centres, own, inside = split_pixels(u, v, w, self.pred_uv[members], outlines)
+                centres, split, inside = split_pixels(u, v, w, self.pred_uv[members], outlines)
         for j, i in enumerate(members):
             s = self.states[i]
             share = False
@@ -673,10 +759,12 @@ class Tracker:
                 got = _Found(pose.xy, blob.centre, pose, self._look(i, blob.area, img, w))
             else:
                 # A disc whose outline is hidden by its neighbours, or another body: its share
-                # of the blob's pixels.
-                mine = own == j
+                # of the blob's pixels, those of its colour where the blob holds several.
+                mine, fit = split == j, (split == j) & inside
+                if i in own and len(own) > 1 and w[own[i]].sum() >= 0.2 * s.area:
+                    mine = fit = own[i]
+                    centres[j] = blob_from_pixels(u[mine], v[mine], w[mine]).centre
                 part = blob_from_pixels(u[mine], v[mine], w[mine])
-                fit = mine & inside
                 if part is None or not fit.any():
                     continue
                 # Centre from the pixels inside the outline, axes from all the body owns.
@@ -691,7 +779,8 @@ class Tracker:
                 share = True
             if got is None:
                 continue
-            if s.look is not None and s.look.mismatch(got.look, size=not share) is not None:
+            hidden = i in plans and plans[i].pixels is not None
+            if s.look and s.look.mismatch(got.look, size=not share, hidden=hidden) is not None:
                 s.rejected += 1
                 continue
             out[i] = got
@@ -710,27 +799,26 @@ class Tracker:
         found_blob: tuple,
         *,
         alone: bool,
-        colours: tuple[np.ndarray, np.ndarray] | None = None,
+        own: np.ndarray | None = None,
     ) -> _Plan:
         """Where to look for disc ``i``'s outline on a blob: from the blob's centroid where the
         blob is its alone and of its size, else from a mean shift over the blob's pixels within
         its radius, from the pixel nearest its prediction (its own part of a blob shared with a
-        rod, a hand or another ball), over the pixels of its colour (``colours`` of the blob's
-        pixels, for a shared blob) where it has one (a ball struck into a rack of others)."""
+        rod, a hand or another ball), over the pixels of its colour (``own``, given for a blob
+        that holds other bodies' colours too) where it has one (a ball struck into a rack of
+        others, two balls of different colours touching)."""
         blob, u, v, w = found_blob
         s = self.states[i]
         pred = self.pred_uv[i]
         mpp = self._mpp(pred)
         r = s.body.shape.extent() / mpp
         expected = s.body.shape.area() / mpp**2
-        if alone and 0.6 * expected <= blob.area <= 1.6 * expected:
+        if alone and own is None and 0.6 * expected <= blob.area <= 1.6 * expected:
             c = blob.centre
         else:
             pixels = None
-            if s.look is not None and colours is not None:
-                own = s.look.matches(*colours)
-                if w[own].sum() >= 0.2 * expected:
-                    u, v, w = pixels = u[own], v[own], w[own]
+            if own is not None and w[own].sum() >= 0.2 * expected:
+                u, v, w = pixels = u[own], v[own], w[own]
             c = self._shift(u, v, w, pred, r)
             rays = Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0)
             return _Plan(rays, mpp, expected, s.radius_m, pixels)
@@ -1126,3 +1214,9 @@ def _project(colour: np.ndarray, behind: np.ndarray, body: np.ndarray) -> np.nda
     span = body - behind
     norm = np.einsum("ij,ij->i", span, span)
     return np.einsum("ij,ij->i", colour - behind, span) / np.maximum(norm, 1.0)
+
+
+def _colours_of(found_blob: tuple, own: dict[int, np.ndarray], states: list[_State]) -> int:
+    """How many bodies' colours a blob holds much of (a fifth of a body's area or more)."""
+    w = found_blob[3]
+    return sum(float(w[mask].sum()) >= 0.2 * states[i].area for i, mask in own.items())
