@@ -35,6 +35,10 @@ DARK = 16.0
 SMALL = 50.0
 #: The least share of its size that a body's own colour may show in a blob of several colours.
 HIDDEN = 0.2
+#: Below this area (px) a body has no colour of its own to judge: its few pixels are mostly its
+#: outline, blended with the wall behind it and smeared by motion (a ball of 3.7 px on a brick
+#: wall measured 0-3 grey levels from the first frame, 90-170 in the next).
+COLOUR_PIXELS = 20.0
 #: Weight of a new detection in the running appearance.
 RATE = 0.1
 
@@ -81,13 +85,16 @@ class Appearance:
         it shares with touching bodies, whose area is where the split put the border.
         ``hidden``: the look is of the pixels of the body's colour in a blob that holds other
         colours too, so part of the body may be hidden (by a neighbour, or where a median
-        background holds the body itself): down to :data:`HIDDEN` of its size."""
+        background holds the body itself): down to :data:`HIDDEN` of its size. The colour of a
+        body smaller than :data:`COLOUR_PIXELS` is not judged."""
         ratio = look.size / max(self.size, 1e-9)
         # A body of a few pixels has a size of a few pixels, give or take most of them.
         allowed = SIZE_RATIO * max(1.0, math.sqrt(SMALL / max(look.pixels, 1e-9)))
         least = min(1 / allowed, HIDDEN) if hidden else 1 / allowed
         if size and not least <= ratio <= allowed:
             return f"{ratio:.2f} times its size"
+        if look.pixels < COLOUR_PIXELS:
+            return None
         hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread):
             return f"another colour (hue {hue:.2f} off)"
