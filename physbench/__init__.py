@@ -2,9 +2,10 @@
 methods that do it (Link, Schwarz, Behnke, IJCNN 2022).
 
 The Python API (:mod:`physbench.api`) is reachable from here: ``physbench.make_scene``,
-``simulate``, ``render_frames``, ``refine``, ``run``, ``sweep``, ``load_table``,
-``read_recording`` and ``discover_effects``. They load on first use, so that ``import physbench``
-(which every ``physbench`` command does) stays free of numpy and the engines.
+``simulate``, ``render_frames``, ``refine``, ``run``, ``sweep`` (``example`` names a shipped
+spec), ``load_table``, ``read_recording`` and ``discover_effects``. They load on first use, so
+that ``import physbench`` (which every ``physbench`` command does) stays free of numpy and the
+engines.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ __version__ = "0.2.0"
 #: The public entry points, defined in :mod:`physbench.api`.
 __all__ = [
     "discover_effects",
+    "example",
     "load_table",
     "make_scene",
     "read_recording",

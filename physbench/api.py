@@ -5,13 +5,19 @@ line give the same results for the same settings::
 
     import physbench
 
-    scene = physbench.make_scene("three_circles", seed=0)       # physbench scenes
-    traj = physbench.simulate(scene, engine="pymunk")            # physbench simulate
-    frames = physbench.render_frames(scene, traj, resolution=64)
-    history = physbench.run(scene="three_circles", iterations=5)  # physbench run
-    result = physbench.sweep("benchmarks/smoke.toml", "out/")    # physbench bench
-    table = physbench.load_table("out/")                         # results.parquet, flat
-    found = physbench.discover_effects("rec.csv", "scene.toml")  # physbench discover
+    if __name__ == "__main__":  # needed by sweep(): its worker processes re-run this script
+        scene = physbench.make_scene("three_circles", seed=0)        # physbench scenes
+        traj = physbench.simulate(scene, engine="pymunk")             # physbench simulate
+        frames = physbench.render_frames(scene, traj, resolution=64)
+        history = physbench.run(scene="three_circles", iterations=5)  # physbench run
+        result = physbench.sweep(physbench.example("smoke"), "out/")  # physbench bench
+        table = physbench.load_table("out/")                          # results.parquet, flat
+        found = physbench.discover_effects("rec.csv", "scene.toml")   # physbench discover
+
+A script that calls :func:`sweep` with worker processes (the default) must do so under
+``if __name__ == "__main__":``: each worker starts by running the script again (Python's
+``spawn``), and would start the sweep again; a sweep started outside the guard is refused before
+any cell runs, naming the line.
 
 :func:`refine` is :func:`physbench.loop.refine` (the loop with every part given as an object).
 The names differ from the commands where a command's name is already a module of the package
@@ -48,6 +54,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "discover_effects",
+    "example",
     "load_table",
     "make_scene",
     "read_recording",
@@ -76,9 +83,10 @@ def make_scene(name_or_path: str | Path, seed: int = 0) -> Scene:
         scene = physbench.make_scene("three_circles", seed=3)
         scene.body_names  # ('test', 'a', 'b')
     """
+    from physbench import numeric
     from physbench.scenes import resolve_scene
 
-    return resolve_scene(str(name_or_path), seed)
+    return resolve_scene(str(name_or_path), int(numeric.SEED.check(seed, "seed")))
 
 
 def _scene(scene: Scene | str | Path) -> Scene:
@@ -116,8 +124,11 @@ def simulate(
     from physbench.effects import apply_measurements
 
     sc = _scene(scene)
+    overrides = dict(params or {})
+    if overrides:  # refused by name (NaN, out of range, unknown key), before an engine sees them
+        sc.with_params(overrides).validate()
     made = _effects(effects)
-    traj = create("simulator", engine).simulate(sc, dict(params or {}), effects=made)
+    traj = create("simulator", engine).simulate(sc, overrides, effects=made)
     return apply_measurements(traj, made) if made else traj
 
 
@@ -146,8 +157,8 @@ def render_frames(
 
 
 def _config_settings(settings: Mapping[str, Any]) -> dict[str, Any]:
-    """``run``'s keywords as :class:`~physbench.experiment.RunConfig` fields: a single parameter
-    or body may be given as a string, lists as tuples, the scene file as a path."""
+    """``run``'s keywords as :class:`~physbench.experiment.RunConfig` fields: a single parameter,
+    body or effect may be given as a string, lists as tuples, the scene file as a path."""
     from physbench.experiment import RunConfig
 
     known = [f.name for f in fields(RunConfig)]
@@ -164,7 +175,11 @@ def _config_settings(settings: Mapping[str, Any]) -> dict[str, Any]:
             f"run(scene={type(scene).__name__}): expected a registered scene name or a scene "
             "TOML path; write a Scene object with physbench.scene_toml.save_scene first"
         )
-    for key in ("params", "bodies"):
+    if kw.get("params") is not None:
+        from physbench.unknowns import split_params
+
+        kw["params"] = split_params(kw["params"])  # "mass+elasticity" as on the command line
+    for key in ("bodies", "effects"):
         value = kw.get(key)
         if isinstance(value, str):
             kw[key] = (value,)
@@ -178,12 +193,15 @@ def run(**settings: Any) -> History:
     of :class:`~physbench.experiment.RunConfig` (``scene``, ``params``, ``estimator``,
     ``options``, ``seed``, ``iterations``, ``engine``, ``renderer``, ``resolution``, ...), with
     the same defaults. An unknown that moves no pixel is named in a :class:`UserWarning` and kept
-    in ``History.unseen``.
+    in ``History.unseen``. ``params`` may name scene-level unknowns by key and give any unknown a
+    range, as ``--params`` does (``"gravity=-11:-9"``); ``effects`` are ``--effect`` texts.
 
     Example::
 
         h = physbench.run(scene="three_circles", params="mass", estimator="cmaes", iterations=5)
         h.truth, h.best.params, h.best_nmse
+        g = physbench.run(scene="toss.toml", video="toss.mp4", params="gravity", iterations=40)
+        d = physbench.run(scene="toss.toml", effects="linear_drag", params="linear_drag.c=0:0.5")
     """
     import warnings
 
@@ -191,6 +209,19 @@ def run(**settings: Any) -> History:
 
     config = RunConfig(**_config_settings(settings))
     return run_config(config, notice=lambda text: warnings.warn(text, UserWarning, stacklevel=3))
+
+
+def example(name: str) -> Path:
+    """The spec file of a sweep that ships with physbench (``physbench bench --example NAME``):
+    ``"smoke"``, the quick start's sweep. Unknown names list the shipped ones.
+
+    Example::
+
+        physbench.sweep(physbench.example("smoke"), "smoke")  # under if __name__ == "__main__"
+    """
+    from physbench.examples import example_path
+
+    return example_path(name)
 
 
 def sweep(
@@ -207,13 +238,22 @@ def sweep(
     """Run a sweep spec into the folder ``out`` as ``physbench bench SPEC --out DIR`` does
     (resuming the cells already there). ``spec``: a TOML file, the same content as a dict, or a
     parsed :class:`~physbench.bench.spec.Spec`; ``executor``: ``serial`` (this process),
-    ``processes`` or ``dask``. Read the table back with :func:`load_table`.
+    ``processes`` or ``dask``. Read the table back with :func:`load_table`. Raises
+    :class:`~physbench.bench.runner.SweepFailedError` when every cell failed (the tables, with
+    each cell's error, are written first).
+
+    With worker processes (``processes``, a local ``dask`` cluster) a script must call it under
+    ``if __name__ == "__main__":``, since each worker starts by running the script again (Python's
+    ``spawn``); a call outside the guard is refused before any cell runs.
 
     Example::
 
-        res = physbench.sweep({"scenes": [{"name": "three_circles", "unknowns": ["mass"]}],
-                               "estimators": ["random"], "seeds": 2, "iterations": 3}, "out")
-        res.stats[["scene", "estimator", "mean"]]
+        import physbench
+
+        if __name__ == "__main__":
+            res = physbench.sweep({"scenes": [{"name": "three_circles", "unknowns": ["mass"]}],
+                                   "estimators": ["random"], "seeds": 2, "iterations": 3}, "out")
+            print(res.stats[["scene", "estimator", "mean"]])
     """
     from physbench.bench.runner import run_sweep
     from physbench.bench.spec import Spec, load_spec, parse_spec
@@ -287,6 +327,7 @@ def discover_effects(
         raise PhysbenchError(
             f"discover_effects(): unknown settings {extra}; known: {', '.join(known)}"
         )
+    checked = Settings(**settings)  # a bad setting is refused before the data are read
     sc = _scene(scene).validate()
     if isinstance(recording, str | Path):
         runs = load_runs(recording, sc, run=run)
@@ -299,4 +340,4 @@ def discover_effects(
         runs = [
             Run(r.run or f"run{i}", sc, recording=r, source=r.source) for i, r in enumerate(recs)
         ]
-    return discover(runs, engine, settings=Settings(**settings))
+    return discover(runs, engine, settings=checked)

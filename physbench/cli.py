@@ -8,7 +8,9 @@ import importlib
 import os
 import sys
 import traceback
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
 
 #: subcommand -> (module in physbench.commands, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -34,10 +36,16 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "find the missing physical effect behind a recording's disagreement with the model",
     ),
     "track": ("track", "follow a scene's bodies through a video into a recording CSV (metres)"),
+    "datasets": (
+        "datasets",
+        "the measured data sets that ship with physbench: list them, their runs, write them out",
+    ),
 }
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    from physbench.commands.arguments import refuse_empty_values
+
     parser = argparse.ArgumentParser(
         prog="physbench",
         description="Identify physical object properties from video or trajectories, and benchmark "
@@ -53,6 +61,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         if only is None or only == name:
             # Argument definitions are cheap; the heavy work sits in each module's main().
             importlib.import_module(f"physbench.commands.{module}").add_arguments(p)
+            refuse_empty_values(p)
     return parser
 
 
@@ -100,7 +109,8 @@ def _run(argv: list[str], debug: bool) -> int:
     module = importlib.import_module(f"physbench.commands.{COMMANDS[args.command][0]}")
     try:
         try:
-            return int(module.main(args) or 0)
+            with warnings_as_lines(args.command):
+                return int(module.main(args) or 0)
         except (Exception, SystemExit) as exc:
             _blame_plugin(exc)
             raise
@@ -131,6 +141,47 @@ def _run(argv: list[str], debug: bool) -> int:
         # report the failed flush of stdout again at exit.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141  # 128 + SIGPIPE, what a shell reports for a tool killed by the signal
+
+
+def warning_line(
+    command: str, message: Warning | str, category: type[Warning], filename: str
+) -> str:
+    """``physbench COMMAND: warning: MESSAGE`` on one line, as the commands word their own
+    warnings; a warning from outside physbench (numpy, a plugin) adds its category, e.g.
+    ``(RuntimeWarning)``."""
+    text = " ".join(str(message).split())
+    own = Path(__file__).parent in Path(filename).resolve().parents
+    return f"physbench {command}: warning: {text}" + ("" if own else f" ({category.__name__})")
+
+
+@contextmanager
+def warnings_as_lines(command: str) -> Iterator[None]:
+    """While ``command`` runs, Python's warnings (``warnings.warn``) reach stderr as one
+    :func:`warning_line` each, instead of Python's two lines with the source path and code.
+    Which warnings are shown, and how often, stays the warnings filters' business (``-W``)."""
+    import warnings
+
+    shown = warnings.showwarning
+
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: object = None,
+        line: str | None = None,
+    ) -> None:
+        text = warning_line(command, message, category, filename)
+        if "tqdm" in sys.modules:  # above a progress bar, not through it
+            sys.modules["tqdm"].tqdm.write(text, file=sys.stderr)
+        else:
+            print(text, file=sys.stderr)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = shown
 
 
 def _blame_plugin(exc: BaseException) -> None:

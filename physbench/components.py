@@ -8,7 +8,8 @@ itself becomes that sentence; a ``TypeError`` raised inside a constructor is a f
 component (a third party's becomes a :class:`~physbench.plugins.ComponentError`).
 
 :func:`make_renderer` and :func:`make_observer` add the standard keywords of renderers
-(``resolution``, ``mode``) and of observer cameras.
+(``resolution``, ``mode``) and of observer cameras; :func:`make_effect` reads an effect from the
+text the command line and sweep specs give it in.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from physbench.plugins import OWN, get_registry, guard
 from physbench.requirements import require
 
 if TYPE_CHECKING:
+    from physbench.effects.base import Effect
     from physbench.estimators.base import CorrectionEstimator
     from physbench.render.base import Camera, Renderer
 
@@ -185,3 +187,25 @@ def make_observer(name: str, options: Mapping[str, Any] | None = None) -> Camera
     opts = dict(options or {})
     resolution = opts.pop("resolution", OBSERVER_RESOLUTION)
     return create("renderer", name, opts, resolution=resolution, mode="rgb")  # type: ignore[no-any-return]
+
+
+def make_effect(text: str, *, where: str = "--effect") -> Effect:
+    """The registered effect of ``text``, ``NAME[:KEY=NUMBER,...]`` (``linear_drag:c=0.3``: its
+    parameters' values when not unknown), as ``physbench simulate --effect`` and ``physbench run
+    --effect`` take it; ``where`` names the setting in the error."""
+    from physbench.numeric import ANY
+
+    name, _, rest = text.partition(":")
+    values: dict[str, float] = {}
+    for pair in filter(None, (p.strip() for p in rest.split(","))):
+        key, sep, value = pair.partition("=")
+        try:
+            if not sep or not key.strip():
+                raise ValueError
+            values[key.strip()] = float(ANY.parse(value))
+        except ValueError:
+            raise PhysbenchError(
+                f"{where} {text!r}: expected NAME[:KEY=NUMBER,...] with finite numbers, e.g. "
+                "linear_drag:c=0.3"
+            ) from None
+    return create("effect", name.strip(), values)  # type: ignore[no-any-return]

@@ -9,6 +9,11 @@ class PhysbenchError(Exception):
     """Base class of every error physbench raises on purpose."""
 
 
+class PhysbenchWarning(UserWarning):
+    """Base class of the warnings physbench issues on purpose; the command line shows each as one
+    ``physbench COMMAND: warning: ...`` line."""
+
+
 def plural(noun: str) -> str:
     """``body`` -> ``bodies``, ``scene`` -> ``scenes`` (the nouns error messages use)."""
     if noun.endswith("y") and noun[-2:-1] not in ("a", "e", "o", "u"):
@@ -24,14 +29,18 @@ def counted(n: int, noun: str) -> str:
 class UnknownNameError(PhysbenchError, KeyError):
     """A name (scene, engine, estimator, parameter, ...) that is not registered."""
 
-    def __init__(self, kind: str, name: str, known: Iterable[str], *, where: str = "") -> None:
+    def __init__(
+        self, kind: str, name: str, known: Iterable[str], *, where: str = "", hint: str = ""
+    ) -> None:
+        """``hint``: a sentence added at the end (e.g. the plugins that failed to load)."""
         self.kind, self.name, self.known = kind, name, sorted(known)
         listed = ", ".join(self.known) or "(none registered)"
         at = f" {where}" if where else ""
         head, of, rest = kind.partition(" of ")  # "body of scene 'x'": the head noun is plural
         words = head.split(" ")
         many = " ".join([*words[:-1], plural(words[-1])]) + of + rest
-        super().__init__(f"unknown {kind} {name!r}{at}; known {many}{at}: {listed}")
+        tail = f"; {hint}" if hint else ""
+        super().__init__(f"unknown {kind} {name!r}{at}; known {many}{at}: {listed}{tail}")
 
     def __str__(self) -> str:  # KeyError would quote the whole message
         return str(self.args[0])

@@ -12,7 +12,7 @@ and the engine that made it.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,6 +25,8 @@ from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
+    from physbench.effects.base import Effect
+    from physbench.estimators.base import CorrectionEstimator
     from physbench.loop import History, Iteration, Restart
     from physbench.observation import Observation
     from physbench.posterior.failure import Reference
@@ -55,7 +57,11 @@ class RunConfig:
     which is then tracked and segmented back into the model renderer's frames (the visual gap;
     ``None``: the model renderer draws the observation); ``video``, ``calibration``,
     ``background``, ``video_start`` and ``video_end``: observe a video file instead (a camera's
-    footage, tracked and segmented the same way; no truth then)."""
+    footage, tracked and segmented the same way; no truth then); ``effects``: effects the model
+    (and a simulated observation) simulates besides the scene's physics, each
+    ``NAME[:KEY=NUMBER,...]`` (:func:`~physbench.components.make_effect`), whose parameters
+    ``params`` may name by key (``linear_drag.c``) besides gravity and the camera's
+    (:func:`~physbench.unknowns.scene_parameters`)."""
 
     scene: str | None = DEFAULT_SCENE
     params: tuple[str, ...] = ("mass",)
@@ -80,6 +86,7 @@ class RunConfig:
     background: str | None = None
     video_start: float | None = None
     video_end: float | None = None
+    effects: tuple[str, ...] = ()
     #: Posterior draws the posterior predictive check simulates after the loop, for an
     #: estimator that returns a posterior (:mod:`physbench.posterior.predictive`; 0: no check).
     predictive_draws: int = PREDICTIVE_DRAWS
@@ -89,12 +96,31 @@ class RunConfig:
     #: :data:`RESTART_BY_DEFAULT`.
     restart: bool | None = None
 
+    def __post_init__(self) -> None:
+        """Refuse a numeric setting outside its range (:mod:`physbench.numeric`), NaN and the
+        infinities included, naming it."""
+        from physbench import numeric
+
+        checks = {
+            "seed": numeric.SEED,
+            "iterations": numeric.COUNT,
+            "blur": numeric.BLUR,
+            "noise": numeric.NOISE,
+            "resolution": numeric.RESOLUTION,
+        }
+        for name, number in checks.items():
+            number.check(getattr(self, name), f"run setting {name}")
+        for name in ("video_start", "video_end"):
+            if getattr(self, name) is not None:
+                numeric.SECONDS.check(getattr(self, name), f"run setting {name}")
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings (tuples as lists); :meth:`from_dict` inverts it. Settings added
         after a sweep format existed are left out while at their defaults, so the cell keys of
         earlier sweeps (hashes of this dict) stay valid."""
         d = asdict(self)
         d["params"] = list(self.params)
+        d["effects"] = list(self.effects)
         d["bodies"] = None if self.bodies is None else list(self.bodies)
         d["options"] = dict(self.options)
         d["renderer_options"] = dict(self.renderer_options)
@@ -117,6 +143,7 @@ class RunConfig:
             raise PhysbenchError(f"run settings: unknown keys {extra}; known: {sorted(known)}")
         kw = dict(d)
         kw["params"] = tuple(kw.get("params", ("mass",)))
+        kw["effects"] = tuple(kw.get("effects", ()))
         if kw.get("bodies") is not None:
             kw["bodies"] = tuple(kw["bodies"])
         return cls(**kw)
@@ -136,6 +163,7 @@ _LATER = (
     "background",
     "video_start",
     "video_end",
+    "effects",
     "restart",
 )
 #: Settings added later with a default that is not empty: omitted while at that default.
@@ -213,14 +241,55 @@ def model_engine(config: RunConfig, observed: Observation | None = None) -> str:
     return config.engine or (observed.engine if observed else "") or DEFAULT_SIMULATOR
 
 
-def config_space(config: RunConfig, scene: Scene | None = None) -> ParamSpace:
-    """The unknowns of ``config`` on its scene instance (``scene`` saves regenerating it)."""
-    from physbench.unknowns import ParamSpace
+def config_effects(config: RunConfig) -> list[Effect]:
+    """The effects of ``config``, built (:func:`~physbench.components.make_effect`)."""
+    from physbench.components import make_effect
+
+    return [make_effect(text) for text in config.effects]
+
+
+def config_space(
+    config: RunConfig, scene: Scene | None = None, effects: Sequence[Effect] | None = None
+) -> ParamSpace:
+    """The unknowns of ``config`` on its scene instance (``scene`` saves regenerating it): the
+    scene's body unknowns it names and the scene-level parameters it names by key (gravity, the
+    camera's, ``effects``' parameters; ``None``: ``config``'s effects, built). An effect whose
+    parameter is given a range beyond its declared one accepts that range from then on."""
+    from physbench.unknowns import ParamSpace, scene_parameters
 
     scene = observed_scene(config) if scene is None else scene
-    return ParamSpace.from_scene(
-        scene, list(config.params), None if config.bodies is None else list(config.bodies)
+    effects = config_effects(config) if effects is None else effects
+    space = ParamSpace.from_scene(
+        scene,
+        list(config.params),
+        None if config.bodies is None else list(config.bodies),
+        offered=scene_parameters(effects),
     )
+    for eff in effects:
+        for u in space.unknowns:
+            p = eff.declared.get(u.name) if u.owner == eff.key else None
+            if p is not None and (u.low < p.low or u.high > p.high):
+                eff.widen(u.name, min(u.low, p.low), max(u.high, p.high))
+    return space
+
+
+def check_model(config: RunConfig, space: ParamSpace, estimator: type[CorrectionEstimator]) -> None:
+    """Called before a run or a sweep starts: refuse what the run's observation or ``estimator``
+    cannot take: scene-level unknowns for a ``per_object`` estimator, effects or camera errors in
+    an observation filmed by an observer (it films the scene's physics with its own true
+    calibration)."""
+    from physbench.loop import check_marked_space
+
+    check_marked_space(estimator, space)
+    if config.observer:
+        beyond = [k for k in space.scene_keys if k != "gravity"]
+        if beyond or config.effects:
+            what = ", ".join([*config.effects, *beyond])
+            raise PhysbenchError(
+                f"an observer camera films the scene's own physics with its true calibration; it "
+                f"cannot show {what}: film the effect with `physbench simulate --renderer camera "
+                "--effect ...` and give the clip as --video"
+            )
 
 
 def check_size(config: RunConfig, scene: Scene) -> None:
@@ -259,7 +328,7 @@ def check_config(config: RunConfig) -> ParamSpace:
             reg.get("simulator", engine)
     except UnknownNameError as exc:
         raise PhysbenchError(str(exc)) from None
-    make_estimator(config.estimator, config.options)
+    estimator = make_estimator(config.estimator, config.options)
     if config.observer:
         make_observer(config.observer, config.observer_options)
     make_renderer(
@@ -270,7 +339,9 @@ def check_config(config: RunConfig) -> ParamSpace:
     )
     scene = observed_scene(config, observed)
     check_size(config, scene)
-    return config_space(config, scene)
+    space = config_space(config, scene)
+    check_model(config, space, type(estimator))
+    return space
 
 
 def model_renderer(config: RunConfig) -> Renderer:
@@ -290,11 +361,13 @@ def make_observation(
     truth: Mapping[str, float],
     marked: tuple[str, ...],
     renderer: Renderer,
+    effects: Sequence[Effect] = (),
 ) -> Observation:
     """The observation ``config`` asks for, with each ``marked`` body's view: a ``video`` tracked
     and segmented into ``renderer``'s frames, a simulation of ``truth`` filmed by an ``observer``
-    camera and segmented the same way, or a simulation rendered sharp and degraded by the sensor
-    model (``blur``, ``noise``). (A frames file is loaded by :func:`load_observed` instead.)"""
+    camera and segmented the same way, or a simulation (with ``effects``, seen by the camera of
+    ``truth``) rendered sharp and degraded by the sensor model (``blur``, ``noise``). (A frames
+    file is loaded by :func:`load_observed` instead.)"""
     if config.video:
         from physbench.video.footage import video_observation
 
@@ -319,7 +392,13 @@ def make_observation(
 
     sensor = SensorModel(blur=config.blur, noise=config.noise, seed=config.seed)
     return simulate_observation(
-        scene, truth, simulator, model_renderer(config), marked=marked, sensor=sensor
+        scene,
+        truth,
+        simulator,
+        model_renderer(config),
+        marked=marked,
+        effects=effects,
+        sensor=sensor,
     )
 
 
@@ -330,12 +409,15 @@ def _probe(
     renderer: Renderer,
     initial: Mapping[str, float],
     notice: Callable[[str], None] | None,
+    effects: Sequence[Effect] = (),
 ) -> tuple[str, ...]:
     """The unknowns that move no pixel around ``initial`` (one sentence about them to
     ``notice``)."""
     from physbench.posterior import identifiability
 
-    probes = identifiability.probe(scene, space, simulator, renderer, dict(initial))
+    probes = identifiability.probe(
+        scene, space, simulator, renderer, dict(initial), effects=effects
+    )
     sentence = identifiability.describe(probes)
     if sentence and notice is not None:
         notice(sentence)
@@ -366,6 +448,8 @@ def _record_settings(history: History, config: RunConfig, observed: Observation 
         )
     if config.video:
         history.meta.update(video=config.video, calibration=config.calibration)
+    if config.effects:
+        history.meta.update(effects=list(config.effects))
     if observed is not None and observed.effects:
         history.meta.update(observe_effects=list(observed.effects))
 
@@ -377,6 +461,8 @@ def _reference(config: RunConfig, observed: Observation | None, scene: Scene) ->
     from physbench.posterior import failure
 
     if observed is not None or config.video or config.observer or config.bodies is not None:
+        return None
+    if config.effects:
         return None
     if config.options.get("weights"):
         return None
@@ -407,6 +493,28 @@ def _restart(config: RunConfig, reference: Reference | None) -> Restart | None:
     return Restart(threshold=SCENE_FACTOR * reference.median)
 
 
+def _with_known_truth(
+    observed: Observation, space: ParamSpace, notice: Callable[[str], None] | None
+) -> Observation:
+    """``observed`` (a file) with the truth of every unknown it knows: its scene's body
+    parameters and gravity. A file that cannot say an unknown's truth (an effect's, the camera's)
+    has none for the run: ``notice`` says so, and the run reports image MSE only."""
+    from dataclasses import replace
+
+    if observed.truth is None or observed.scene is None:
+        return observed
+    truth = {**observed.truth, "gravity": float(observed.scene.gravity[1])}
+    missing = [k for k in space.keys if k not in truth]
+    if missing:
+        if notice is not None:
+            notice(
+                f"the observation {observed.source} does not state the true {', '.join(missing)}:"
+                " the run reports image MSE only, no normalized error"
+            )
+        return replace(observed, truth=None)
+    return replace(observed, truth=truth)
+
+
 def run_config(
     config: RunConfig,
     *,
@@ -429,21 +537,23 @@ def run_config(
 
     observed = load_observed(config)
     scene = observed_scene(config, observed)
-    space = config_space(config, scene)
+    effects = config_effects(config)
+    space = config_space(config, scene, effects)
     check_size(config, scene)
     estimator = make_estimator(config.estimator, config.options)
+    check_model(config, space, type(estimator))
     simulator = create("simulator", model_engine(config, observed))
     renderer = model_renderer(config)
     truth, initial = draw_problem(space, config.seed)
     marked = space.bodies if type(estimator).per_object else ()
     obs = (
-        observed
+        _with_known_truth(observed, space, notice)
         if observed is not None
-        else make_observation(config, scene, truth, marked, renderer)
+        else make_observation(config, scene, truth, marked, renderer, effects)
     )
     if save_observation:
         save_obs(save_observation, obs)
-    unseen = _probe(scene, space, simulator, renderer, initial, notice) if probe else ()
+    unseen = _probe(scene, space, simulator, renderer, initial, notice, effects) if probe else ()
     reference = _reference(config, observed, scene)
     history = refine(
         obs,
@@ -455,6 +565,7 @@ def run_config(
         iterations=config.iterations,
         seed=config.seed,
         initial=initial,
+        effects=effects,
         callback=callback,
         restart=_restart(config, reference),
     )
@@ -475,6 +586,7 @@ def run_config(
             noise=obs.noise,
             draws=config.predictive_draws,
             seed=config.seed,
+            effects=effects,
         )
     _record_settings(history, config, observed)
     return history

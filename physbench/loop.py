@@ -30,7 +30,7 @@ from physbench.plugins import guard
 from physbench.posterior.failure import FitCheck
 from physbench.posterior.predictive import PredictiveCheck
 from physbench.posterior.samples import Posterior
-from physbench.unknowns import Params, ParamSpace
+from physbench.unknowns import Params, ParamSpace, scene_parameters, simulate_seen
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -280,12 +280,28 @@ def _check_posterior(name: str, space: ParamSpace, posterior: object) -> None:
         )
 
 
-def _space(scene: Scene, unknowns: ParamSpace | Sequence[str] | None) -> ParamSpace:
+def _space(
+    scene: Scene, unknowns: ParamSpace | Sequence[str] | None, effects: Sequence[Effect]
+) -> ParamSpace:
     if isinstance(unknowns, ParamSpace):
         return unknowns
     if isinstance(unknowns, str):
         unknowns = [unknowns]
-    return ParamSpace.from_scene(scene, unknowns)
+    return ParamSpace.from_scene(scene, unknowns, offered=scene_parameters(effects))
+
+
+def check_marked_space(estimator: type[CorrectionEstimator], space: ParamSpace) -> None:
+    """Refuse scene-level unknowns (gravity, an effect's or the camera's parameters) for an
+    estimator that corrects one marked body at a time (``per_object``): they belong to no body.
+    Called by :func:`refine`, and by a run's and a sweep's checks before anything runs."""
+    if estimator.per_object and space.scene_keys:
+        name = estimator.name or estimator.__name__
+        they = "it belongs" if len(space.scene_keys) == 1 else "they belong"
+        raise PhysbenchError(
+            f"estimator {name!r} corrects one marked body at a time, so it cannot fit "
+            f"{', '.join(space.scene_keys)} ({they} to no body); use an estimator that searches "
+            "the ranges (tpe, cmaes, optuna, random, smc)"
+        )
 
 
 @dataclass(frozen=True)
@@ -447,7 +463,8 @@ def image_objective(
     per_object: bool,
     effects: Sequence[Effect] = (),
 ) -> Callable[[Params], Evaluation]:
-    """The loop's objective: simulate a point, render it (and each unknown body marked, for a
+    """The loop's objective: simulate a point as the run's camera sees it
+    (:func:`~physbench.unknowns.simulate_seen`), render it (and each unknown body marked, for a
     ``per_object`` estimator) and compare with ``obs`` by image MSE. A simulation that fails
     gives empty frames and :data:`FAILED_LOSS`."""
 
@@ -455,7 +472,7 @@ def image_objective(
         t0 = time.perf_counter()
         try:
             with guard("simulator", simulator, "simulate()"):
-                traj = simulator.simulate(scene, params, effects=effects)
+                seen, traj = simulate_seen(simulator, scene, params, effects)
         except SimulationError as exc:
             frames = np.zeros_like(obs.frames)
             marked = dict.fromkeys(space.bodies, frames) if per_object else {}
@@ -463,9 +480,9 @@ def image_objective(
             return Evaluation(FAILED_LOSS, frames, None, marked, str(exc), t1 - t0, 0.0)
         t1 = time.perf_counter()
         with guard("renderer", renderer, "render()"):
-            frames = renderer.render(scene, traj)
+            frames = renderer.render(seen, traj)
             marked = (
-                {b: renderer.render(scene, traj, focus=b) for b in space.bodies}
+                {b: renderer.render(seen, traj, focus=b) for b in space.bodies}
                 if per_object
                 else {}
             )
@@ -506,8 +523,12 @@ def refine(
     """Run ``iterations`` iterations of the correction loop and return the :class:`History`.
 
     ``unknowns``: a :class:`ParamSpace`, or parameter names (``["mass"]``) of the scene's unknowns
-    (``None``: all of them). ``initial`` defaults to a uniform draw from ``derive_seeds(seed)``; the
-    estimator is started with that stream's estimator seed. ``renderer`` is the *model* renderer
+    (``None``: all of them) and keys of scene-level parameters (``"gravity"``, an effect's
+    ``"linear_drag.c"``, ``"camera.scale"``; :func:`~physbench.unknowns.scene_parameters`), each
+    optionally with a range (``"gravity=-11:-9"``). ``effects``: what the model simulates besides
+    the scene's physics. An estimator that is ``per_object`` is refused scene-level unknowns.
+    ``initial`` defaults to a uniform draw from ``derive_seeds(seed)``; the estimator is started
+    with that stream's estimator seed. ``renderer`` is the *model* renderer
     (sharp); an observation model (blur, noise) belongs to whoever made ``observation``.
     ``callback`` is called with each :class:`Iteration` as it completes (progress displays).
     ``restart``: restart from a global design while the fit looks failed (:class:`Restart`;
@@ -515,7 +536,8 @@ def refine(
     (:mod:`physbench.posterior.failure`).
     """
     iterations = _checked_iterations(iterations)
-    space = _space(scene, unknowns)
+    space = _space(scene, unknowns, effects)
+    check_marked_space(type(estimator), space)
     obs = (
         observation
         if isinstance(observation, Observation)

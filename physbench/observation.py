@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from physbench.errors import PhysbenchError
+from physbench.unknowns import scene_values, simulate_seen
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
@@ -153,11 +154,12 @@ def simulate_observation(
     effects: Sequence[Effect] = (),
     sensor: SensorModel | None = None,
 ) -> Observation:
-    """Simulate ``scene`` with the true parameters and render it (and once per ``marked`` body with
-    that body in focus); ``sensor`` (blur, noise) degrades every rendered view."""
-    traj = simulator.simulate(scene, dict(truth), effects=effects)
-    views = {None: renderer.render(scene, traj)}
-    views.update({b: renderer.render(scene, traj, focus=b) for b in marked})
+    """Simulate ``scene`` with the true parameters (body parameters, gravity, ``effects``' and the
+    camera's: :func:`~physbench.unknowns.simulate_seen`) and render it (and once per ``marked``
+    body with that body in focus); ``sensor`` (blur, noise) degrades every rendered view."""
+    seen, traj = simulate_seen(simulator, scene, truth, effects)
+    views = {None: renderer.render(seen, traj)}
+    views.update({b: renderer.render(seen, traj, focus=b) for b in marked})
     if sensor is not None:
         views = {b: sensor.apply(f) for b, f in views.items()}
     frames = views.pop(None)
@@ -167,7 +169,7 @@ def simulate_observation(
         dict(truth),
         views,
         source=f"simulated ({name})",
-        scene=scene.with_params(truth),
+        scene=scene.with_params(scene_values(truth, effects)),
         engine=name,
         effects=tuple(repr(e) for e in effects),
         noise=None if sensor is None else float(sensor.noise),

@@ -25,7 +25,13 @@ from typing import Any
 import pluggy
 
 from physbench import hookspecs
-from physbench.errors import PhysbenchError, PluginError, UnknownNameError
+from physbench.errors import (
+    PhysbenchError,
+    PhysbenchWarning,
+    PluginError,
+    UnknownNameError,
+    counted,
+)
 from physbench.kinds import KINDS
 
 #: The package name of physbench's own components: a conflict keeps them, and what they raise is
@@ -55,6 +61,13 @@ def _who(c: Component) -> str:
     return f"plugin {c.plugin!r} ({c.package} {c.version})"
 
 
+def _source(f: FailedPlugin) -> str:
+    """Where a failed plugin came from, for messages."""
+    if f.package == "PHYSBENCH_PLUGINS":
+        return "named in PHYSBENCH_PLUGINS"
+    return f"package {f.package} {f.version}"
+
+
 @dataclass(frozen=True)
 class Conflict:
     """Components of one kind that share a name. ``kept`` is physbench's own, or ``None`` when
@@ -79,6 +92,11 @@ class Conflict:
         )
 
 
+class PluginWarning(PhysbenchWarning):
+    """A plugin's component that is not used: another one of the same kind and name (physbench's
+    own) is used in its place."""
+
+
 class ComponentError(PluginError):
     """A third party's component raised (or called ``sys.exit``) where the framework called
     it; the message names the component, its plugin and its package."""
@@ -100,20 +118,52 @@ class Registry:
     )
     failed: list[FailedPlugin] = field(default_factory=list)
     conflicts: list[Conflict] = field(default_factory=list)
+    #: (kind, name) of the shadowed components already warned about (once each)
+    _warned: set[tuple[str, str]] = field(default_factory=set, repr=False)
 
     def names(self, kind: str) -> list[str]:
         return sorted(self.components[kind])
 
     def get(self, kind: str, name: str) -> Any:
-        """The registered class (or scene generator) ``name`` of ``kind``; unknown names list the
-        known."""
+        """The registered class (or scene generator) ``name`` of ``kind``. An unknown name lists
+        the known ones and the plugins that failed to load (one of them may have provided it);
+        a name that a plugin also claims is physbench's own, and the first use of it warns
+        (:class:`PluginWarning`) that the plugin's is not used."""
         try:
-            return self.components[kind][name].obj
+            found = self.components[kind][name].obj
         except KeyError:
             for c in self.conflicts:
                 if (c.kind, c.name) == (kind, name):
                     raise PluginError(c.describe()) from None
-            raise UnknownNameError(kind, name, self.components[kind]) from None
+            raise UnknownNameError(
+                kind, name, self.components[kind], hint=self.failures_hint(name)
+            ) from None
+        self._warn_shadowed(kind, name)
+        return found
+
+    def failures_hint(self, name: str = "") -> str:
+        """A sentence on the plugins that failed to load, those whose name contains ``name``
+        first ("" when none failed): an unknown name may be one of theirs."""
+        if not self.failed:
+            return ""
+        ranked = sorted(self.failed, key=lambda f: name.lower() not in f.plugin.lower())
+        shown = "; ".join(f"{f.plugin} ({_source(f)}): {f.error}" for f in ranked[:3])
+        more = f"; {len(ranked) - 3} more" if len(ranked) > 3 else ""
+        return (
+            f"{counted(len(ranked), 'plugin')} failed to load and may have provided it: "
+            f"{shown}{more} (see `physbench plugins`)"
+        )
+
+    def _warn_shadowed(self, kind: str, name: str) -> None:
+        """Warn once that a plugin's ``kind`` ``name`` is ignored in favour of physbench's own."""
+        if (kind, name) in self._warned:
+            return
+        for c in self.conflicts:
+            if (c.kind, c.name) == (kind, name) and c.kept is not None:
+                import warnings
+
+                self._warned.add((kind, name))
+                warnings.warn(c.describe(), PluginWarning, stacklevel=3)
 
     def info(self, kind: str, name: str) -> Component:
         self.get(kind, name)

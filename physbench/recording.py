@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from physbench.errors import PhysbenchError
+from physbench.limits import FPS, MAX_ANGLE, MAX_COORDINATE, MAX_FRAMES, MAX_TIME
 from physbench.scene import Scene
 
 if TYPE_CHECKING:
@@ -49,6 +50,15 @@ _STATE_COLUMN = {"x": (0, 3), "y": (1, 4), "angle": (2, 5)}
 #: A comment line naming measured fields: an optional run label (a JSON string), then the fields.
 _ACCURACY_LINE = re.compile(r"#\s*accuracy\s*:\s*(\S+?)\s*(?:m)?")
 _FIELDS_LINE = re.compile(r'#\s*fields(?:\s+of\s+run\s+(".*"|[^:]*?))?\s*:(.*)')
+#: The largest |value| of each numeric column (a scene's limits, physbench.limits), its unit, and
+#: why: a value beyond it fits no scene (and its square overflows). Negative times have their own
+#: rule.
+_LIMITS = {
+    "t": (MAX_TIME, "s", f"the longest a scene simulates: {MAX_FRAMES} frames at {FPS[0]:g} fps"),
+    "x": (MAX_COORDINATE, "m", "the largest coordinate a scene has"),
+    "y": (MAX_COORDINATE, "m", "the largest coordinate a scene has"),
+    "angle": (MAX_ANGLE, "rad", "a body at the scenes' fastest spin for their longest time"),
+}
 
 
 class RecordingError(PhysbenchError, ValueError):
@@ -607,7 +617,7 @@ class _Samples:
         return _Sample(run, body, t, x, y, a, has_angle)
 
     def _number(self, cells: list[str], name: str, line: int, row_no: int) -> float:
-        """The finite number in column ``name``."""
+        """The finite number in column ``name``, within its limit (:data:`_LIMITS`)."""
         raw = cells[self.col[name]]
         try:
             v = float(raw)
@@ -615,6 +625,15 @@ class _Samples:
             raise self.err(f"{raw!r} is not a number", name, line, row_no) from None
         if not math.isfinite(v):
             raise self.err(f"{raw!r}: values must be finite numbers", name, line, row_no)
+        most, unit, why = _LIMITS[name]
+        if abs(v) > most and not (name == "t" and v < 0):
+            which = f"{name} <= {most:g}" if name == "t" else f"|{name}| <= {most:g}"
+            raise self.err(
+                f"{name} = {v:g} {unit} is beyond the scene limit {which} {unit} ({why})",
+                name,
+                line,
+                row_no,
+            )
         return v
 
     def tracks(self) -> dict[str, dict[str, Track]]:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from physbench.errors import SceneError
+from physbench.limits import FPS, MAX_COORDINATE, MAX_FRAMES, MAX_SPIN
 from physbench.parameter import Parameter
 
 Vec = tuple[float, float]
@@ -28,25 +29,18 @@ BODY_PARAMS: dict[str, tuple[float, float]] = {
 
 # Limits a scene must keep, so that a typo fails when the scene is loaded rather than deep inside
 # an engine or the rasteriser (pixel coordinates that overflow, areas that underflow to 0, an
-# allocation per substep).
-#: m: the largest |coordinate| of a bound, position, anchor or vertex; far beyond any lab set-up.
-MAX_COORDINATE = 1e6
+# allocation per substep). Those that recordings share live in physbench.limits: MAX_COORDINATE,
+# FPS, MAX_SPIN, MAX_FRAMES.
 #: m: the smallest radius, width and height (and square root of a polygon's area); a smaller shape
 #: has an area and a moment that underflow.
 MIN_SIZE = 1e-6
-#: Hz: the frame rates accepted, from a frame every 10 s to a high-speed camera's 100,000 fps.
-FPS = (0.1, 100_000.0)
 #: m/s: the largest initial speed along an axis (ten times a rifle bullet's).
 MAX_SPEED = 1e4
-#: rad/s: the largest initial angular speed (about a million rpm).
-MAX_SPIN = 1e5
 #: m/s²: the largest gravity along an axis (a thousand g).
 MAX_GRAVITY = 1e4
 #: kg: the masses accepted, a milligram to a thousand tonnes: outside them the engines' contact
 #: solvers lose precision (pymunk turns a subnormal mass into NaN).
 MASS = (1e-6, 1e6)
-#: Recorded frames: about an hour of video at 30 fps.
-MAX_FRAMES = 100_000
 #: Physics steps per recorded frame; more only costs time (1e4 steps per frame at 30 fps is a
 #: 3 microsecond step).
 MAX_SUBSTEPS = 10_000
@@ -207,6 +201,21 @@ class Joint:
 BODY_UNITS: dict[str, str] = {"mass": "kg", "elasticity": "", "friction": "", "moment": "kg·m²"}
 
 
+#: The scene's gravity along y as an unknown (``--params gravity``): scenes are y-up, so this is
+#: minus g. The default range spans Earth's g with room for a wrong scale or clock (a ball toss
+#: filmed with a tape off by a few per cent); it is a typical span, not a limit, so a run may set
+#: another (``gravity=-2:2`` for a tilted table seen from above). The x component stays as the
+#: scene says: a horizontal pull is the same as a rotated camera, which is discovery's question.
+GRAVITY = Parameter(
+    "gravity",
+    -12.0,
+    -8.0,
+    unit="m/s²",
+    doc="gravity along y (minus g in a y-up scene)",
+    extensible=True,
+)
+
+
 def body_unknown(body: str, param: str, low: float, high: float) -> Parameter:
     """The declaration that ``body.param`` is unknown and lies somewhere in ``[low, high]``."""
     unit = BODY_UNITS.get(param, "") if isinstance(param, str) else ""  # validated later
@@ -263,11 +272,16 @@ class Scene:
         )
 
     def with_params(self, params: Mapping[str, float]) -> Scene:
-        """A copy with ``{"body.param": value}`` applied. Called once per simulation."""
+        """A copy with ``{"body.param": value}`` (and ``{"gravity": gy}``, :data:`GRAVITY`)
+        applied. Called once per simulation."""
         if not params:
             return self
         changes: dict[str, dict[str, float]] = {}
+        world: dict[str, object] = {}
         for key, value in params.items():
+            if key == GRAVITY.key:
+                world["gravity"] = (self.gravity[0], float(value))
+                continue
             body, _, param = key.rpartition(".")
             if param not in BODY_PARAMS:
                 raise SceneError(
@@ -283,7 +297,47 @@ class Scene:
         bodies = tuple(
             replace(b, **changes[b.name]) if b.name in changes else b for b in self.bodies
         )
-        return replace(self, bodies=bodies)
+        return replace(self, bodies=bodies, **world)  # type: ignore[arg-type]
+
+    def scaled(self, factor: float) -> Scene:
+        """A copy with every length multiplied by ``factor`` about the origin (positions,
+        velocities, gravity, shapes, statics, anchors) and the bounds kept: the scene as a
+        calibration off by ``1 / factor`` shows it in the same frame. Called for every point a run
+        simulates with a ``camera.scale`` (:func:`physbench.unknowns.simulate_seen`)."""
+        f = float(factor)
+
+        def v(p: Vec) -> Vec:
+            return (f * p[0], f * p[1])
+
+        def shape(sh: Shape) -> Shape:
+            if isinstance(sh, Circle):
+                return Circle(f * sh.radius)
+            if isinstance(sh, Box):
+                return Box(f * sh.width, f * sh.height)
+            return Polygon(tuple(v(p) for p in sh.points))
+
+        def static(st: Static) -> Static:
+            if isinstance(st, Segment):
+                return replace(st, a=v(st.a), b=v(st.b), radius=f * st.radius)
+            return replace(st, points=tuple(v(p) for p in st.points))
+
+        bodies = tuple(
+            replace(
+                b,
+                shape=shape(b.shape),
+                position=v(b.position),
+                velocity=v(b.velocity),
+                com_offset=v(b.com_offset),
+            )
+            for b in self.bodies
+        )
+        return replace(
+            self,
+            bodies=bodies,
+            statics=tuple(static(st) for st in self.statics),
+            joints=tuple(replace(j, anchor=v(j.anchor)) for j in self.joints),
+            gravity=v(self.gravity),
+        )
 
     def validate(self) -> Scene:
         """Check every value; raise :class:`SceneError` naming the first bad key. Returns self."""
@@ -384,6 +438,12 @@ def _check_param(key: str, param: str, value: float) -> None:
             raise SceneError(f"{param} must be > 0", key=key, value=value)
     elif not lo <= value <= hi:
         raise SceneError(f"{param} must lie in [{lo}, {hi}]", key=key, value=value)
+
+
+def check_body_param(key: str, param: str, value: float) -> None:
+    """Raise :class:`SceneError` naming ``key`` when ``value`` is not a value body parameter
+    ``param`` can take (a mass in :data:`MASS`, an elasticity in [0, 1], ...)."""
+    _check_param(key, param, value)
 
 
 def validate_scene(scene: Scene) -> None:

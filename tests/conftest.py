@@ -316,3 +316,44 @@ def huge_scene(tmp_path: Path) -> str:
         f"substeps = 10000\n{bodies}"
     )
     return str(path)
+
+
+def _texts_outside(fig: Any) -> list[str]:
+    """Every drawn text of ``fig`` (titles, axis and tick labels, legends, annotations, colour
+    bars) whose extent, drawn with Agg, reaches outside the figure: ``'text' (x0, y0, x1, y1) in
+    W x H``. Tick labels of ticks outside the view are left out: they are not drawn."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.text import Text
+
+    canvas = FigureCanvasAgg(fig)  # a figure closed after saving has lost its canvas
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    drawn: set[int] = set()
+    ticks: set[int] = set()
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            for tick in axis._update_ticks():  # the ticks inside the view: those drawn
+                drawn |= {id(tick.label1), id(tick.label2)}
+            for tick in [*axis.get_major_ticks(), *axis.get_minor_ticks()]:
+                ticks |= {id(tick.label1), id(tick.label2)}
+    width, height = fig.bbox.width, fig.bbox.height
+    out = []
+    for text in fig.findobj(match=Text):
+        if not (text.get_visible() and text.get_text().strip()):
+            continue
+        if id(text) in ticks and id(text) not in drawn:
+            continue
+        box = text.get_window_extent(renderer)
+        if box.x0 < -0.5 or box.y0 < -0.5 or box.x1 > width + 0.5 or box.y1 > height + 0.5:
+            out.append(
+                f"{text.get_text()!r} ({box.x0:.0f}, {box.y0:.0f}, {box.x1:.0f}, {box.y1:.0f}) "
+                f"in {width:.0f} x {height:.0f}"
+            )
+    return out
+
+
+@pytest.fixture
+def texts_outside() -> Callable[[Any], list[str]]:
+    """``texts_outside(fig)``: the texts of a figure that lie (partly) outside it (issue 28:
+    titles and legends were cut at the image's edge)."""
+    return _texts_outside

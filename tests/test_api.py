@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -180,6 +182,41 @@ def test_refine_is_the_loop_with_every_part_given() -> None:
     assert len(h) == 3 and h.keys == ("a.mass", "b.mass")
 
 
+def test_run_and_refine_take_scene_level_unknowns_as_the_command_line_does() -> None:
+    from physbench.components import create
+    from physbench.effects import LinearDrag
+    from physbench.observation import simulate_observation
+
+    h = physbench.run(
+        scene="three_circles",
+        params="mass+gravity=-11:-9+linear_drag.c=0:0.5",  # the words of run --params
+        effects="linear_drag",
+        iterations=2,
+        resolution=16,
+    )
+    assert h.keys == ("a.mass", "b.mass", "gravity", "linear_drag.c")
+    assert -11 <= h.truth["gravity"] <= -9 and h.meta["effects"] == ["linear_drag"]
+    sc = physbench.make_scene("three_circles")
+    sim, ren, drag = PymunkSimulator(), create("renderer", "raster", resolution=16), LinearDrag()
+    obs = simulate_observation(
+        sc, {"gravity": -9.5, "linear_drag.c": 0.3}, sim, ren, effects=[drag]
+    )
+    h = physbench.refine(
+        obs,
+        sc,
+        ["gravity", "linear_drag.c"],
+        sim,
+        ren,
+        create("estimator", "random"),
+        iterations=3,
+        effects=[drag],
+    )
+    assert h.keys == ("gravity", "linear_drag.c") and h.truth == {
+        "gravity": -9.5,
+        "linear_drag.c": 0.3,
+    }
+
+
 # ---------------------------------------------------------------- sweeps and their table
 
 
@@ -263,3 +300,71 @@ def test_discover_effects_names_the_hidden_drag(tmp_path: Path, slide: Scene) ->
     assert from_files.causes == ["linear_drag"]
     with pytest.raises(PhysbenchError, match=r"unknown settings \['efects'\].*effects"):
         physbench.discover_effects(rec, sc, efects=effects)
+
+
+# ---------------------------------------------------------------- sweeps from a script
+
+
+def _script(tmp_path: Path, body: str) -> subprocess.CompletedProcess[str]:
+    script = tmp_path / "sweep_script.py"
+    script.write_text(body)
+    return subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, cwd=tmp_path, timeout=300
+    )
+
+
+def test_a_sweep_outside_the_main_guard_is_refused_before_any_cell_runs(tmp_path: Path) -> None:
+    """Issue 28: the worker processes (spawn) run the script again, so an unguarded sweep failed
+    every cell with FolderBusyError tracebacks and the script exited 0."""
+    out = tmp_path / "out"
+    body = (
+        "import physbench\n"
+        f"res = physbench.sweep({TINY_SPEC!r}, {str(out)!r}, workers=1)\n"
+        "print('failed', res.failed)\n"
+    )
+    proc = _script(tmp_path, body)
+    assert proc.returncode != 0, proc.stdout + proc.stderr
+    err = proc.stderr
+    assert "sweep_script.py, line 2: a sweep on local worker processes" in err, err[-2000:]
+    assert 'if __name__ == "__main__":' in err and "executor='serial'" in err
+    assert "FolderBusyError" not in err and "WorkerDied" not in err
+    assert not out.exists()  # refused before anything ran or was written
+
+
+def test_a_sweep_whose_every_cell_fails_raises(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 28: a sweep with no finished cell returned as if fine."""
+    from physbench import experiment
+    from physbench.bench.runner import SweepFailedError
+
+    def broken(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("no simulation today")
+
+    monkeypatch.setattr(experiment, "run_config", broken)
+    with pytest.raises(SweepFailedError) as err:
+        physbench.sweep(TINY_SPEC, tmp_path, executor="serial")
+    message = str(err.value)
+    assert "all 4 cells failed (4 cells: RuntimeError: no simulation today)" in message
+    assert str(tmp_path / "cells") in message
+    assert err.value.result.failed == 4 and (tmp_path / "results.parquet").is_file()
+
+
+def test_non_finite_numbers_are_refused_by_every_api_entry(tmp_path: Path, slide: Scene) -> None:
+    """Issue 28: ``floor=nan`` was accepted and then discovery found nothing."""
+    nan = float("nan")
+    with pytest.raises(PhysbenchError, match=r"run setting blur = nan: expected a finite number"):
+        physbench.run(blur=nan)
+    with pytest.raises(PhysbenchError, match=r"floor = inf: expected a finite number >= 0 \(m\)"):
+        physbench.discover_effects(tmp_path / "rec.csv", slide, floor=float("inf"))
+    with pytest.raises(PhysbenchError, match=r"min_delta_bic = nan"):
+        physbench.discover_effects(tmp_path / "rec.csv", slide, min_delta_bic=nan)
+    with pytest.raises(PhysbenchError, match=r"noise = nan"):
+        physbench.sweep({**TINY_SPEC, "noise": nan}, tmp_path / "out", executor="serial")
+    with pytest.raises(PhysbenchError, match=r"seed = nan: expected a whole number in \[0, "):
+        physbench.make_scene("three_circles", seed=nan)  # type: ignore[arg-type]
+    with pytest.raises(PhysbenchError, match=r"seed = 1180591620717411303424: expected a whole"):
+        physbench.make_scene("three_circles", seed=2**70)
+    # an engine would abort the process on a NaN mass (Chipmunk's assertion)
+    with pytest.raises(PhysbenchError, match=r"mass = nan: must be a finite number"):
+        physbench.simulate("three_circles", params={"a.mass": nan})

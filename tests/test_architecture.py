@@ -19,6 +19,7 @@ LAYERS: dict[str, int] = {
     "physbench": 0,  # the package itself: __version__ (its lazy API forwarding is excepted)
     "physbench.errors": 0,
     "physbench.limits": 0,
+    "physbench.numeric": 0,
     "physbench.kinds": 0,
     "physbench.hookspecs": 0,
     "physbench.requirements": 0,
@@ -50,6 +51,7 @@ LAYERS: dict[str, int] = {
     "physbench.video": 2,
     "physbench.scenes": 2,
     "physbench.datasets": 2,
+    "physbench.examples": 2,
     # 3 orchestration: what runs components
     "physbench.loop": 3,
     "physbench.experiment": 3,
@@ -87,6 +89,7 @@ SAME_CONCEPT = {
     "bench": "sweeps; commands/bench.py is the command that runs one",
     "discover": "discovery; commands/discover.py is the command that runs it",
     "scenes": "the built-in scenes; commands/scenes.py is the command that lists them",
+    "datasets": "the shipped data sets; commands/datasets.py is the command that lists them",
     "simulators": "simulators; testing/simulators.py is their conformance kit",
     "estimators": "estimators; testing/estimators.py is their conformance kit",
     "effects": "effects; testing/effects.py is their conformance kit",

@@ -228,3 +228,25 @@ def test_the_script_keeps_its_status_and_output_when_it_skips_the_teardown(
         assert proc.stdout.startswith(said) and proc.stdout.endswith("\n"), proc.stdout
     else:
         assert "physbench bench: error: " + said in proc.stderr, proc.stderr
+
+
+def test_python_warnings_reach_stderr_as_one_physbench_line(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import warnings
+    from pathlib import Path
+
+    import physbench
+    from physbench.cli import warnings_as_lines
+
+    own = str(Path(physbench.__file__).parent / "estimators" / "resnet3d" / "weights.py")
+    before = warnings.showwarning
+    with warnings.catch_warnings(), warnings_as_lines("run"):
+        warnings.simplefilter("always")
+        warnings.warn_explicit("skipping weights 'w':\n  bad", UserWarning, own, 243)
+        warnings.warn_explicit("overflow encountered in matmul", RuntimeWarning, "/x/numpy.py", 1)
+    assert capsys.readouterr().err.splitlines() == [
+        "physbench run: warning: skipping weights 'w': bad",
+        "physbench run: warning: overflow encountered in matmul (RuntimeWarning)",
+    ]
+    assert warnings.showwarning is before  # restored afterwards

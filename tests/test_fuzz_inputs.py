@@ -1,5 +1,8 @@
 """Property tests: whatever a user hands physbench as a scene file, a recording or an observation,
-loading it either succeeds or raises a :class:`PhysbenchError`, never another exception.
+loading it either succeeds or raises a :class:`PhysbenchError`, never another exception; every
+numeric setting of the API (:class:`~physbench.experiment.RunConfig`,
+:class:`~physbench.discover.Settings`) and of a sweep spec is refused or finite (the command-line
+flags: tests/commands/test_argument_ranges.py).
 
 ``PHYSBENCH_FUZZ_SCALE`` multiplies the number of examples (``nox -s fuzz`` sets it to 10).
 """
@@ -8,13 +11,16 @@ from __future__ import annotations
 
 import contextlib
 import io
+import math
 import os
+import re
 import tempfile
 import zipfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -230,3 +236,84 @@ def test_observation_file_loads_or_raises_physbench_error(data: bytes) -> None:
             check_frames(obs.frames, obs.frames.shape)
         except PhysbenchError:
             pass
+
+
+# ------------------------------------------------- numeric settings of the API and of sweep specs
+
+
+def _numeric_fields(cls: type) -> list[str]:
+    """The fields of a settings dataclass that hold numbers (read from its annotations, so a new
+    one is covered without a change here)."""
+    from dataclasses import fields
+
+    return [f.name for f in fields(cls) if any(t in str(f.type) for t in ("int", "float"))]
+
+
+def _settings_classes() -> list[type]:
+    from physbench.discover import Settings
+    from physbench.experiment import RunConfig
+
+    return [RunConfig, Settings]
+
+
+NUMERIC_FIELDS = [(cls, name) for cls in _settings_classes() for name in _numeric_fields(cls)]
+#: Values that broke or silently switched off settings before (issue 28: a NaN floor).
+API_VALUES = [
+    math.nan, math.inf, -math.inf, 1e308, -1e308, 5e-324, 0, 0.0, -0.0, -1, 1, 0.5, 1.5, 2**63,
+    -(2**63), 10**30, True, False, "1", None, [math.nan],
+]  # fmt: skip
+
+
+def test_the_numeric_settings_are_found() -> None:
+    names = {f"{cls.__name__}.{name}" for cls, name in NUMERIC_FIELDS}
+    assert {"RunConfig.blur", "RunConfig.seed", "Settings.floor", "Settings.min_delta_bic"} <= names
+    assert len(names) >= 20
+
+
+def _built_or_refused(cls: type, name: str, value: Any) -> None:
+    """``cls(name=value)`` either raises a PhysbenchError or holds a finite number (or None)."""
+    try:
+        made = cls(**{name: value})
+    except PhysbenchError:
+        return
+    held = getattr(made, name)
+    values = held if isinstance(held, list | tuple) else [held]
+    for v in values:
+        assert v is None or (not isinstance(v, bool) and math.isfinite(v)), (cls, name, value)
+
+
+@pytest.mark.parametrize(
+    ("cls", "name"), NUMERIC_FIELDS, ids=[f"{c.__name__}.{n}" for c, n in NUMERIC_FIELDS]
+)
+def test_non_finite_settings_are_refused_by_name(cls: type, name: str) -> None:
+    for value in (math.nan, math.inf, -math.inf):
+        with pytest.raises(PhysbenchError, match=re.escape(name)):
+            cls(**{name: value})
+    for value in API_VALUES:
+        _built_or_refused(cls, name, value)
+
+
+@FUZZ
+@given(
+    st.sampled_from(NUMERIC_FIELDS),
+    st.one_of(st.sampled_from(API_VALUES), st.floats(), st.integers()),
+)
+def test_any_numeric_setting_is_refused_or_finite(field: tuple[type, str], value: Any) -> None:
+    _built_or_refused(*field, value)
+
+
+@FUZZ
+@given(
+    st.sampled_from(["blur", "noise", "resolution", "iterations", "seeds"]),
+    st.one_of(st.sampled_from(API_VALUES), st.floats(), st.integers(), st.lists(st.floats())),
+)
+def test_numeric_spec_axes_are_refused_or_finite(axis: str, value: Any) -> None:
+    from physbench.bench.spec import parse_spec
+
+    raw = {"estimators": ["random"], "seeds": 1, "iterations": 1, "scenes": ["three_circles"]}
+    try:
+        spec = parse_spec({**raw, axis: value})
+    except PhysbenchError:
+        return
+    held = spec.seeds if axis == "seeds" else spec.axes[axis]
+    assert all(not isinstance(v, bool) and math.isfinite(v) for v in held)

@@ -4,6 +4,7 @@ compare with simulated trajectories."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -206,7 +207,7 @@ def random_name(rng: np.random.Generator) -> str:
 
 def random_track(rng: np.random.Generator, with_angle: bool) -> Track:
     n = int(rng.integers(1, 12))
-    scale = 10.0 ** rng.integers(-300, 300)  # repr must carry any double
+    scale = 10.0 ** rng.integers(-300, 5)  # repr must carry any double within the limits (1e6)
     t = np.cumsum(rng.uniform(1e-9, 1.0, n)) - rng.uniform(0, 1e-9)
     values = [rng.normal(size=n) * scale for _ in range(3)]
     return Track(t, values[0], values[1], values[2] if with_angle else None)
@@ -379,3 +380,73 @@ def test_a_cell_over_the_csv_field_limit_is_a_recording_error() -> None:
     text = "t,body,x,y\n0,a,0,0\n0.1,a," + "9" * 140_000 + ",0\n"
     with pytest.raises(RecordingError, match=r"rec.csv: line 3: not readable as CSV .*131072"):
         parse_recordings(text, source="rec.csv")
+
+
+@pytest.mark.parametrize(
+    ("column", "cell", "limit"),
+    [
+        ("x", "1e300", r"\|x\| <= 1e\+06 m \(the largest coordinate"),
+        ("y", "-2e6", r"\|y\| <= 1e\+06 m"),
+        ("t", "1e300", r"t <= 1e\+06 s \(the longest a scene simulates: 100000 frames at 0.1"),
+        ("angle", "-1e12", r"\|angle\| <= 1e\+11 rad"),
+    ],
+)
+def test_values_beyond_the_scene_limits_are_refused_naming_the_limit(
+    column: str, cell: str, limit: str
+) -> None:
+    cells = {"t": "0.1", "body": "b", "x": "0.5", "y": "0.5", "angle": "0"}
+    cells[column] = cell
+    text = "t,body,x,y,angle\n0,b,0,0,0\n" + ",".join(cells.values()) + "\n"
+    with pytest.raises(RecordingError) as exc:
+        parse_recordings(text, source="rec.csv")
+    said = str(exc.value)
+    assert said.startswith(f"rec.csv: line 3 (data row 2), column {column!r}: {column} = ")
+    assert re.search(f"is beyond the scene limit {limit}", said), said
+
+
+def test_values_at_the_scene_limits_are_read() -> None:
+    from physbench.limits import MAX_ANGLE, MAX_COORDINATE, MAX_TIME
+
+    last = f"{MAX_TIME!r},b,{MAX_COORDINATE!r},{-MAX_COORDINATE!r},{MAX_ANGLE!r}"
+    text = f"t,body,x,y,angle\n0,b,0,0,0\n{last}\n"
+    (rec,) = parse_recordings(text)
+    assert rec.t_end == MAX_TIME and rec.track("b").angle[-1] == MAX_ANGLE
+
+
+def test_the_limits_are_the_scenes(tmp_path) -> None:
+    from physbench import limits, scene
+
+    assert scene.MAX_COORDINATE is limits.MAX_COORDINATE and scene.FPS is limits.FPS
+    longest = (limits.MAX_FRAMES - 1) / limits.FPS[0]  # the longest simulation
+    assert longest <= limits.MAX_TIME
+    assert limits.MAX_ANGLE >= limits.MAX_SPIN * limits.MAX_TIME
+
+
+def test_the_cli_refuses_an_out_of_range_recording_in_one_line_without_warnings(tmp_path) -> None:
+    # -W error: any warning (numpy's overflow among them) would end the run with a traceback.
+    import subprocess
+    import sys
+
+    (tmp_path / "rec.csv").write_text("t,body,x,y\n0,ball,0,47\n0.1,ball,1e300,46.9\n")
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-W",
+            "error",
+            "-m",
+            "physbench",
+            "discover",
+            "rec.csv",
+            "--scene",
+            "ball_drop",
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2 and done.stdout == "", done
+    assert done.stderr == (
+        "physbench discover: error: rec.csv: line 3 (data row 2), column 'x': x = 1e+300 m is "
+        "beyond the scene limit |x| <= 1e+06 m (the largest coordinate a scene has)\n"
+    )

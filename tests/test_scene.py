@@ -13,6 +13,7 @@ import pytest
 from physbench.errors import SceneError, UnknownNameError
 from physbench.scene import (
     BODY_PARAMS,
+    GRAVITY,
     Body,
     Box,
     Circle,
@@ -296,3 +297,28 @@ def test_polygon_geometry_matches_the_box_it_draws() -> None:
 def test_inertia_is_the_shapes_unless_the_moment_is_set() -> None:
     assert A.inertia() == 0.5 * 2.0 * 0.25
     assert dataclasses.replace(A, moment=0.125).inertia() == 0.125
+
+
+def test_with_params_sets_gravity_along_y_and_keeps_x() -> None:
+    tilted = dataclasses.replace(GOOD, gravity=(0.5, -9.81))
+    got = tilted.with_params({"gravity": -9.7, "a.mass": 2.0})
+    assert got.gravity == (0.5, -9.7) and got.bodies[0].mass == 2.0
+    assert GRAVITY.key == "gravity" and GRAVITY.extensible
+
+
+def test_scaled_multiplies_every_length_about_the_origin_and_keeps_the_bounds() -> None:
+    scene = dataclasses.replace(
+        GOOD,
+        statics=(
+            Segment((0.0, 0.0), (4.0, 0.0), radius=0.1),
+            StaticPolygon(((1, 1), (2, 1), (2, 2))),
+        ),
+        joints=(Joint("a", (1.0, 2.0)),),
+    )
+    half = scene.scaled(0.5)
+    assert half.bounds == scene.bounds and half.gravity == (0.0, -9.81 / 2)
+    assert half.bodies[0].shape == Circle(0.25) and half.bodies[0].position == (0.5, 0.5)
+    assert half.bodies[1].shape == Box(0.5, 0.25) and half.bodies[1].mass == B.mass
+    assert half.statics[0] == Segment((0.0, 0.0), (2.0, 0.0), radius=0.05)
+    assert half.statics[1].points == ((0.5, 0.5), (1.0, 0.5), (1.0, 1.0))
+    assert half.joints[0].anchor == (0.5, 1.0)

@@ -84,10 +84,10 @@ def compare(
     """Match the final rows of two long tables and test every configuration (see module doc)."""
     import pandas as pd
 
-    if not 0 < alpha < 1:
-        raise PhysbenchError(f"alpha = {alpha!r}: expected a level in (0, 1), e.g. 0.05")
-    if not min_ratio >= 1:
-        raise PhysbenchError(f"min_ratio = {min_ratio!r}: expected a ratio >= 1, e.g. 1.25")
+    from physbench import numeric
+
+    numeric.LEVEL.check(alpha, "alpha")
+    numeric.RATIO.check(min_ratio, "min_ratio")
     cols = list(MATCH)
     # tables written before the renderer columns existed ran the default renderer
     a = final_rows(upgrade(new))[[*cols, "status", "best_nmse"]]

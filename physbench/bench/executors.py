@@ -26,6 +26,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Generator, Hashable, Iterator, Sequence
+from pathlib import Path
 from typing import Any, Generic, Protocol, TypeVar
 
 from physbench.errors import PhysbenchError, counted
@@ -91,11 +92,16 @@ def start_worker(parent: int) -> None:
     (:func:`die_with_parent`) and, once its pool shuts it down, without the interpreter's
     teardown (:mod:`physbench.teardown`), which would otherwise keep a core busy after the cells
     are done. Its exit status is then always 0, which nothing reads: a worker that dies while it
-    works is told apart by its pool before it reaches that exit."""
+    works is told apart by its pool before it reaches that exit. A plugin that a built-in
+    shadows was named by the main process already; workers do not repeat it."""
+    import warnings
+
+    from physbench.plugins import PluginWarning
     from physbench.teardown import skip_at_exit
 
     die_with_parent(parent)
     skip_at_exit(lambda: 0)
+    warnings.simplefilter("ignore", PluginWarning)
 
 
 def how_it_died(exitcode: int | None) -> str:
@@ -475,14 +481,89 @@ class DaskExecutor:
         return f"dask ({self.address or 'LocalCluster'}, {counted(self.workers, 'worker')})"
 
 
+def _is_main_guard(node: Any) -> bool:
+    """Whether ``node`` (an AST node) is ``if __name__ == "__main__":`` (either order)."""
+    import ast
+
+    test = node.test if isinstance(node, ast.If) else None
+    if not (isinstance(test, ast.Compare) and len(test.ops) == 1):
+        return False
+    sides = [test.left, *test.comparators]
+    names = {s.id for s in sides if isinstance(s, ast.Name)}
+    texts = {s.value for s in sides if isinstance(s, ast.Constant)}
+    return isinstance(test.ops[0], ast.Eq) and names == {"__name__"} and texts == {"__main__"}
+
+
+def guarded(source: str, line: int) -> bool:
+    """Whether ``line`` of the Python ``source`` lies in the body of an
+    ``if __name__ == "__main__":`` block."""
+    import ast
+
+    return any(
+        _is_main_guard(node) and node.body[0].lineno <= line <= (node.body[-1].end_lineno or 0)
+        for node in ast.walk(ast.parse(source))
+    )
+
+
+def unguarded_main_call() -> tuple[str, int] | None:
+    """The script file and line from which this call was made, when a local worker process
+    would run that line again: Python's ``spawn`` start method (the only one that is safe with
+    threads, see :class:`ProcessExecutor`) starts every worker by running the main script anew,
+    under the name ``__mp_main__``, so whatever the script does outside
+    ``if __name__ == "__main__":`` happens again in each worker, a sweep included (which then
+    finds its own folder locked). ``None`` when the call is guarded, or when the main module is
+    not re-run (``python -c``, a notebook, ``python -m pkg``, the ``physbench`` command) or its
+    source cannot be read."""
+    main = sys.modules.get("__main__")
+    spec_name = getattr(getattr(main, "__spec__", None), "name", None) or ""
+    path = getattr(main, "__file__", None)
+    if main is None or not path or spec_name == "__main__" or spec_name.endswith(".__main__"):
+        return None
+    frame = sys._getframe(1)
+    while frame is not None and not (
+        frame.f_globals is vars(main) and frame.f_code.co_name == "<module>"
+    ):
+        frame = frame.f_back  # type: ignore[assignment]
+    if frame is None:  # not called while the script's top level runs
+        return None
+    try:
+        if guarded(Path(path).read_text(encoding="utf-8"), frame.f_lineno):
+            return None
+    except (OSError, SyntaxError, ValueError):
+        return None
+    return str(path), frame.f_lineno
+
+
+def check_main_guard(executor: str) -> None:
+    """Refuse, before any cell runs, a sweep on local worker processes started from a script's
+    top level outside ``if __name__ == "__main__":`` (:func:`unguarded_main_call`)."""
+    where = unguarded_main_call()
+    if where is None:
+        return
+    path, line = where
+    raise PhysbenchError(
+        f"{path}, line {line}: a sweep on local worker processes (executor {executor!r}) is "
+        'started outside `if __name__ == "__main__":`. Each worker process starts by running '
+        "this script again (Python's spawn start method), which would start the sweep again in "
+        'every worker. Put the script\'s work under `if __name__ == "__main__":` (as in '
+        "help(physbench.sweep)), or run the cells in this process with executor='serial'"
+    )
+
+
 def make_executor(name: str, *, workers: int | None = None, address: str | None = None) -> Executor:
-    """The executor ``name`` (one of :data:`NAMES`); ``workers`` defaults to all cores."""
-    if workers is not None and (isinstance(workers, bool) or workers < 1):
-        raise PhysbenchError(f"--workers {workers}: expected a whole number >= 1")
+    """The executor ``name`` (one of :data:`NAMES`); ``workers`` defaults to all cores. Local
+    worker processes (``processes``, a ``dask`` LocalCluster) are refused when the main script
+    would start the sweep again in each of them (:func:`check_main_guard`)."""
+    from physbench import numeric
+
+    if workers is not None and not numeric.WORKERS.accepts(workers):
+        raise PhysbenchError(f"--workers {workers!r}: expected {numeric.WORKERS.describe()}")
     if address and name != "dask":
         raise PhysbenchError(
             f"--address {address!r} names a Dask scheduler; it needs --executor dask (got {name!r})"
         )
+    if name == "processes" or (name == "dask" and not address):
+        check_main_guard(name)
     if name == "serial":
         return SerialExecutor()
     if name == "processes":

@@ -100,11 +100,15 @@ def _title(cfg: dict[str, Any], varying: Sequence[str]) -> str:
 
 def _save(fig: Figure, path: Path) -> Path:
     """PNG with a 128-colour palette: line plots lose nothing visible and shrink 2-4x (committed
-    files)."""
+    files); every text fitted inside the figure first
+    (:func:`~physbench.plotting.layout.fit_text`)."""
     import io
 
     from PIL import Image
 
+    from physbench.plotting.layout import fit_text
+
+    fit_text(fig)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI)
     _plt().close(fig)
@@ -175,13 +179,9 @@ def _legend_below(fig: Figure, axes: Sequence[Any]) -> None:
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             entries.setdefault(label, handle)
     if entries:
-        fig.legend(
-            list(entries.values()),
-            list(entries),
-            loc="outside lower center",
-            ncols=min(5, len(entries)),
-            fontsize="x-small",
-        )
+        from physbench.plotting.layout import legend_below
+
+        legend_below(fig, list(entries.values()), list(entries), ncols=5, fontsize="x-small")
 
 
 def _unknowns(scene: str, seed: int) -> dict[str, Parameter]:
@@ -211,7 +211,8 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
         if len(keys) != 1 or len(json.loads(next(iter(keys)))) != 2:
             continue
         kx, ky = json.loads(next(iter(keys)))
-        chosen = sorted(rows["seed"].unique())[:seeds]
+        every = sorted(rows["seed"].unique())
+        chosen = every[:seeds]
         ests = _groups(rows, ["estimator"])
         fig, axes = plt.subplots(
             1, len(ests), figsize=(3.3 * len(ests), 4.2), squeeze=False, layout="constrained"
@@ -245,9 +246,14 @@ def trajectories(df: pd.DataFrame, out: Path, *, seeds: int = 3) -> list[Path]:
             ax.set_xlabel(_param_label(kx, unknowns))
         axes[0, 0].set_ylabel(_param_label(ky, unknowns))
         _legend_below(fig, axes[0])
+        drawn = (
+            f"all {counted(len(every), 'seed')}"
+            if len(chosen) == len(every)
+            else f"the first {len(chosen)} of {len(every)} seeds (physbench plot --seeds N)"
+        )
         fig.suptitle(
             f"{_title(cfg, varying)}, {unknowns_label(str(cfg['unknowns']))}\n"
-            "hollow: start, star: best by image MSE, filled: truth",
+            f"{drawn}; hollow: start, star: best by image MSE, filled: truth",
             fontsize="small",
         )
         paths.append(_save(fig, out / _name("trajectories", cfg, varying, str(cfg["unknowns"]))))

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from physbench.bench.spec import Cell, Spec
 from physbench.bench.store import RESULTS, CellStore, atomic_write
+from physbench.errors import PhysbenchError, counted
 from physbench.experiment import RunConfig
 
 if TYPE_CHECKING:
@@ -120,6 +121,23 @@ class SweepResult:
     executor: str
     table: pd.DataFrame
     stats: pd.DataFrame
+
+
+class SweepFailedError(PhysbenchError):
+    """Every cell of a sweep failed (raised after the tables are written, which hold each cell's
+    error); ``result`` is what :func:`run_sweep` would have returned."""
+
+    def __init__(self, result: SweepResult, name: str) -> None:
+        self.result = result
+        errors = result.table.drop_duplicates("cell")["error"].fillna("no error recorded")
+        common = errors.astype(str).str.split("\n").str[0].str.slice(0, 300).value_counts()
+        shown = "; ".join(f"{counted(int(n), 'cell')}: {e}" for e, n in common.head(3).items())
+        more = f"; and {len(common) - 3} other errors" if len(common) > 3 else ""
+        super().__init__(
+            f"sweep {name!r}: all {counted(result.cells, 'cell')} failed ({shown}{more}); each "
+            f"cell's error and traceback are in {result.out / 'cells'}, the table in "
+            f"{result.out / RESULTS}"
+        )
 
 
 def assemble(cells: list[Cell], store: CellStore) -> pd.DataFrame:
@@ -229,7 +247,8 @@ def run_sweep(
     Before anything runs, refuses (:class:`~physbench.bench.stamp.StaleCellsError`) to keep
     finished cells whose stamp differs from now, unless ``allow_stale``. Holds the folder's lock
     throughout: another sweep writing ``out`` is refused (:class:`~.store.FolderBusyError`), or
-    waited for with ``wait``."""
+    waited for with ``wait``. A sweep whose every cell failed raises :class:`SweepFailedError`
+    once its tables are written."""
     from physbench.bench.executors import make_executor
 
     check_size(spec, 1 if executor == "serial" else workers)
@@ -263,6 +282,18 @@ def _import_tables() -> None:
     import physbench.posterior.scoring  # noqa: F401
 
     versions()  # for run.json
+
+
+def _log_run(spec: Spec, out: Path, entry: dict[str, Any], *, cells: int, failed: int) -> None:
+    """Add this invocation's ``entry`` to ``out/run.json`` and update its totals."""
+    log_path = out / "run.json"
+    try:
+        log = json.loads(log_path.read_text())
+    except (OSError, ValueError):
+        log = {"runs": []}
+    log.update(spec=spec.name, spec_path=spec.path, cells=cells, failed=failed, versions=versions())
+    log["runs"].append(entry)
+    atomic_write(log_path, (json.dumps(log, indent=1) + "\n").encode())
 
 
 def _run_locked(
@@ -339,15 +370,9 @@ def _run_locked(
     write_table(table, out)
     st = write_summary(table, out, title=spec.name)
     failed = int((table.drop_duplicates("cell")["status"] != "ok").sum())
-    log_path = out / "run.json"
-    try:
-        log = json.loads(log_path.read_text())
-    except (OSError, ValueError):
-        log = {"runs": []}
-    log.update(
-        spec=spec.name, spec_path=spec.path, cells=len(cells), failed=failed, versions=versions()
-    )
-    log["runs"].append(
+    _log_run(
+        spec,
+        out,
         {
             "started": started,
             "executor": ex.describe(),
@@ -358,9 +383,13 @@ def _run_locked(
             "kept_stale": len(stale),
             "wall_s": round(wall, 2),
             "command": command,
-        }
+        },
+        cells=len(cells),
+        failed=failed,
     )
-    atomic_write(log_path, (json.dumps(log, indent=1) + "\n").encode())
-    return SweepResult(
+    result = SweepResult(
         out, len(cells), len(todo), len(cells) - len(todo), failed, wall, ex.describe(), table, st
     )
+    if cells and failed == len(cells):
+        raise SweepFailedError(result, spec.name)
+    return result

@@ -23,12 +23,24 @@ a list::
                                      # camera renderer: the observation is filmed as an encoded
                                      # video, then tracked and segmented (the visual gap)
     unknowns = ["mass"]              # default for scenes that list none; each item is one set
+    effects = []                     # default for scenes that list none: none
 
     [[scenes]]
     name = "three_circles"           # a registered scene or a scene TOML (relative to this file)
     unknowns = ["mass", "elasticity", "mass+elasticity"]  # a set: also "mass,elasticity",
                                      # "mass elasticity" or ["mass", "elasticity"]
     bodies = ["a"]                   # optional: only these bodies' unknowns
+
+    [[scenes]]
+    name = "toss.toml"
+    effects = ["linear_drag"]        # simulated with the model and the observation, as
+                                     # `physbench run --effect` (NAME[:KEY=NUMBER,...])
+    unknowns = ["gravity", "linear_drag.c=0:0.5", "gravity+camera.scale"]
+                                     # scene-level keys and KEY=LOW:HIGH ranges, as `run --params`
+
+Unknowns are named as ``physbench run --params`` names them (:mod:`physbench.unknowns`): a body
+parameter by its name, a scene-level one (``gravity``, ``camera.scale``, ``camera.clock``, an
+effect's ``linear_drag.c``) by its key, either with an optional range ``KEY=LOW:HIGH``.
 
 Seeds: a cell's run seed *is* the seed value, so every configuration sees the same scene
 instances, truths and initial guesses (paired comparisons), and ``physbench run ... --seed S``
@@ -41,16 +53,16 @@ import functools
 import hashlib
 import itertools
 import json
-import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from physbench import numeric
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.experiment import RunConfig
-from physbench.limits import MAX_NOISE, MAX_RESOLUTION, MAX_SEED
+from physbench.limits import MAX_SEED
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 from physbench.unknowns import split_params
@@ -68,9 +80,10 @@ TOP_KEYS = (
     "renderer",
     "observer",
     "seeds",
+    "effects",
     *AXES,
 )
-SCENE_KEYS = ("name", "unknowns", "bodies")
+SCENE_KEYS = ("name", "unknowns", "bodies", "effects")
 #: Keys of an estimator or renderer table: ``{name = "...", label = "...", options = {...}}``.
 COMPONENT_KEYS = ("name", "label", "options")
 DEFAULTS: dict[str, Any] = {
@@ -114,6 +127,7 @@ class SceneSpec:
     path: str
     unknowns: tuple[tuple[str, ...], ...]
     bodies: tuple[str, ...] | None = None
+    effects: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -171,6 +185,7 @@ class Spec:
                                     options=dict(est.options),
                                     seed=seed,
                                     bodies=sc.bodies,
+                                    effects=sc.effects,
                                     renderer=ren.name,
                                     renderer_options=dict(ren.options),
                                     observer=None if obs.name == SHARP else obs.name,
@@ -242,6 +257,15 @@ def _seeds(value: Any, where: str) -> tuple[int, ...]:
     return tuple(seeds)
 
 
+#: The ranges of the numeric axes (:mod:`physbench.numeric`).
+NUMBERS = {
+    "blur": numeric.BLUR,
+    "noise": numeric.NOISE,
+    "resolution": numeric.RESOLUTION,
+    "iterations": numeric.COUNT,
+}
+
+
 def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
     def bad(v: Any, expected: str) -> SpecError:
         return SpecError(f"{where} = {v!r}: expected {expected}")
@@ -251,22 +275,10 @@ def _check_axis(name: str, values: list[Any], where: str) -> tuple[Any, ...]:
         if name in ("engine", "render_mode") or (name == "observe_engine" and v is not None):
             if not isinstance(v, str) or not v:
                 raise bad(v, "a name (string)")
-        elif name in ("blur", "noise"):
-            most = MAX_RESOLUTION if name == "blur" else MAX_NOISE
-            if (
-                isinstance(v, bool)
-                or not isinstance(v, int | float)
-                or not math.isfinite(v)
-                or not 0 <= v <= most
-            ):
-                raise bad(v, f"a finite number in [0, {most:g}]")
-            v = float(v)
-        elif name in ("resolution", "iterations") and (
-            isinstance(v, bool) or not isinstance(v, int) or v < 1
-        ):
-            raise bad(v, "a whole number >= 1")
-        elif name == "resolution" and v > MAX_RESOLUTION:
-            raise bad(v, f"a whole number in [1, {MAX_RESOLUTION}]")
+        elif name in NUMBERS:
+            if not NUMBERS[name].accepts(v):
+                raise bad(v, NUMBERS[name].describe())
+            v = float(v) if name in ("blur", "noise") else v
         out.append(v)
     if len(set(out)) != len(out):
         raise SpecError(f"{where} = {values!r}: values repeat")
@@ -319,7 +331,20 @@ def default_label(name: str, options: Mapping[str, Any]) -> str:
     return name + "(" + ", ".join(f"{k}={v}" for k, v in sorted(options.items())) + ")"
 
 
-def _scenes(value: Any, default_unknowns: Any, base: Path, where: str) -> tuple[SceneSpec, ...]:
+def _effects(value: Any, where: str) -> tuple[str, ...]:
+    """A scene's effects: a list of ``--effect`` texts (``NAME[:KEY=NUMBER,...]``)."""
+    items = _as_list(value)
+    if not all(isinstance(v, str) and v for v in items):
+        raise SpecError(
+            f"{where} = {value!r}: expected a list of effects such as "
+            '["linear_drag", "quadratic_drag:c=0.01"] (NAME[:KEY=NUMBER,...], as run --effect)'
+        )
+    return tuple(items)
+
+
+def _scenes(
+    value: Any, default_unknowns: Any, default_effects: Any, base: Path, where: str
+) -> tuple[SceneSpec, ...]:
     out = []
     for i, item in enumerate(_as_list(value)):
         at = f"{where}[{i}]"
@@ -356,7 +381,8 @@ def _scenes(value: Any, default_unknowns: Any, base: Path, where: str) -> tuple[
             or not bodies
         ):
             raise SpecError(f"{at}.bodies = {bodies!r}: expected a non-empty list of body names")
-        out.append(SceneSpec(name, path, sets, None if bodies is None else tuple(bodies)))
+        effects = _effects(item.get("effects", default_effects), f"{at}.effects")
+        out.append(SceneSpec(name, path, sets, None if bodies is None else tuple(bodies), effects))
     return tuple(out)
 
 
@@ -381,7 +407,11 @@ def parse_spec(
         raise SpecError(f"{_where(path, 'name')} = {name!r}: expected a non-empty string")
     description = str(data.get("description", ""))
     scenes = _scenes(
-        data["scenes"], data.get("unknowns", DEFAULTS["unknowns"]), base, _where(path, "scenes")
+        data["scenes"],
+        data.get("unknowns", DEFAULTS["unknowns"]),
+        data.get("effects", []),
+        base,
+        _where(path, "scenes"),
     )
     estimators = _components(data["estimators"], _where(path, "estimators"), "estimator")
     renderers = _components(
@@ -480,7 +510,7 @@ def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
     """Build every estimator and renderer once and look up every name, so a bad spec fails
     before anything runs; errors name the spec file and the key."""
     from physbench.components import make_estimator, make_observer, make_renderer
-    from physbench.experiment import config_space
+    from physbench.experiment import check_model, config_space
     from physbench.plugins import get_registry
     from physbench.render.sensor import SensorModel
     from physbench.scenes import resolve_scene
@@ -488,8 +518,7 @@ def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
     reg = get_registry()
     where = spec.path or spec.name
     try:
-        for est in spec.estimators:
-            make_estimator(est.name, est.options)
+        classes = [type(make_estimator(est.name, est.options)) for est in spec.estimators]
         for e in {*spec.axes["engine"], *(v for v in spec.axes["observe_engine"] if v is not None)}:
             reg.get("simulator", e)
         for i, ren in enumerate(spec.renderers):
@@ -522,10 +551,20 @@ def _check_names(spec: Spec, *, renderer_where: str = "") -> None:
         for sc in spec.scenes:
             scene = resolve_scene(sc.path, spec.seeds[0])
             for unknowns in sc.unknowns:
-                config_space(
-                    RunConfig(scene=sc.path, params=unknowns, bodies=sc.bodies, seed=spec.seeds[0]),
-                    scene,
+                config = RunConfig(
+                    scene=sc.path,
+                    params=unknowns,
+                    bodies=sc.bodies,
+                    seed=spec.seeds[0],
+                    effects=sc.effects,
                 )
+                space = config_space(config, scene)
+                for cls, obs in itertools.product(classes, spec.observers):
+                    check_model(
+                        replace(config, observer=None if obs.name == SHARP else obs.name),
+                        space,
+                        cls,
+                    )
     except UnknownNameError as exc:
         raise SpecError(f"{where}: {exc}") from None
     except SpecError:

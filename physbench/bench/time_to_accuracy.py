@@ -84,9 +84,11 @@ def threshold_for(scene: str, unknowns: str, threshold: float | None) -> tuple[f
 def check_threshold(threshold: float, what: str = "threshold") -> float:
     """``threshold`` if it is a finite normalized MSE > 0, else :class:`PhysbenchError` naming it
     as ``what`` (``--threshold`` for the command line)."""
-    if not (math.isfinite(threshold) and threshold > 0):
+    from physbench import numeric
+
+    if not numeric.POSITIVE.accepts(threshold):
         raise PhysbenchError(
-            f"{what} {threshold:g}: expected a finite normalized MSE > 0, e.g. 1e-3"
+            f"{what} {threshold!r}: expected a finite normalized MSE > 0, e.g. 1e-3"
         )
     return float(threshold)
 

@@ -8,7 +8,7 @@ The vocabulary (tests/commands/test_vocabulary.py walks every parser against it)
 - ``--out`` names the file or folder that holds a command's result; other files it can write
   have flags named for what they are (``--preview``, ``--plot``, ``--report``, ``--plate``,
   ``--track-out``, ``--save-observation``). Every file written is echoed as ``wrote PATH`` on
-  stderr.
+  stderr (not with ``-q``).
 - ``--json`` is a switch: the result as JSON on stdout, instead of the text. A JSON file goes
   through ``--out``.
 - ``--scene`` takes a registered name or a scene TOML file. It defaults to
@@ -16,19 +16,27 @@ The vocabulary (tests/commands/test_vocabulary.py walks every parser against it)
   required where it must describe given data (track, discover).
 - ``--params`` takes one set of unknowns spelled ``mass+elasticity``, ``mass,elasticity`` or
   ``mass elasticity`` (:func:`physbench.unknowns.split_params`).
-- ``-q/--quiet`` on every command that prints more than its result or shows progress; progress
-  goes to stderr and only on a terminal (:mod:`physbench.commands.console`).
+- ``-q/--quiet`` on every command that prints more than its result or shows progress: no
+  progress and no ``wrote PATH`` lines, only the result (errors and warnings still go to stderr);
+  progress goes to stderr and only on a terminal (:mod:`physbench.commands.console`).
+- ``--bodies`` takes body names spelled as ``--params`` spells unknowns (:func:`split_bodies`).
+- A text option never takes an empty value (:func:`refuse_empty_values`): ``--engine ''`` is an
+  error, not the default.
 """
 
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import math
-from collections.abc import Callable
+import re
+from collections.abc import Callable, Mapping
 from typing import Any
 
-from physbench.limits import MAX_RESOLUTION, MAX_SCENE_ARGUMENT, MAX_SEED
+from physbench import numeric
+from physbench.limits import MAX_SCENE_ARGUMENT
+from physbench.numeric import Number, finite, whole
 
 #: Kept here (not imported from physbench.render.base) so building a parser imports nothing heavy.
 RENDER_MODES = ("mark", "instance", "mask", "rgb")
@@ -44,60 +52,84 @@ SIZE_CHECK_HELP = (
 )
 
 
-def bounded_int(low: int, high: int | None = None) -> Callable[[str], int]:
+def bounded_int(low: int, high: int | None = None) -> Number:
     """An argparse ``type=`` that accepts whole numbers in ``[low, high]`` (no upper bound when
-    ``high`` is ``None``); the error names the value and the range."""
-    accepted = f"a whole number >= {low}" if high is None else f"a whole number in [{low}, {high}]"
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not {accepted}") from None
-        if value < low or (high is not None and value > high):
-            raise argparse.ArgumentTypeError(f"{value} is not {accepted}")
-        return value
-
-    parse.__name__ = "whole number"  # argparse names the type in its own messages
-    return parse
+    ``high`` is ``None``); the error names the value and the range (:mod:`physbench.numeric`)."""
+    return whole(low, high)
 
 
-def bounded_float(low: float, high: float) -> Callable[[str], float]:
+def bounded_float(low: float, high: float) -> Number:
     """An argparse ``type=`` that accepts finite numbers in ``[low, high]``; the error names the
-    value and the range."""
-    accepted = f"a finite number in [{low:g}, {high:g}]"
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not {accepted}") from None
-        if not (math.isfinite(value) and low <= value <= high):
-            raise argparse.ArgumentTypeError(f"{text} is not {accepted}")
-        return value
-
-    parse.__name__ = "number"
-    return parse
+    value and the range (:mod:`physbench.numeric`)."""
+    return finite(low, high)
 
 
 #: ``type=`` for counts that must be at least 1 (iterations, validation groups, intervals).
-positive_int = bounded_int(1)
+positive_int = numeric.COUNT
 #: ``type=`` for counts where 0 means "none" (threads, evaluation seeds).
-nonnegative_int = bounded_int(0)
+nonnegative_int = numeric.COUNT_OR_NONE
 #: ``type=`` for ``--seed``.
-seed_int = bounded_int(0, MAX_SEED)
+seed_int = numeric.SEED
 #: ``type=`` for ``--resolution``.
-resolution_int = bounded_int(1, MAX_RESOLUTION)
+resolution_int = numeric.RESOLUTION
 
 
 def scene_argument(text: str) -> str:
-    """``type=`` of ``--scene``: a name or path no longer than :data:`MAX_SCENE_ARGUMENT`."""
+    """``type=`` of ``--scene``: a name or path, not empty and no longer than
+    :data:`MAX_SCENE_ARGUMENT`."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is empty; expected a registered scene (see `physbench scenes`) or a scene "
+            ".toml file"
+        )
     if len(text) > MAX_SCENE_ARGUMENT:
         raise argparse.ArgumentTypeError(
             f"{text[:40]!r}... ({len(text)} characters) is longer than a scene name or path can "
             f"be; expected at most {MAX_SCENE_ARGUMENT} characters"
         )
     return text
+
+
+def _nonempty(action: argparse.Action) -> Callable[[str], str]:
+    """``type=`` of a text option: any text but an empty (or blank) one."""
+    expected = action.metavar if isinstance(action.metavar, str) else action.dest.upper()
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"{text!r} is empty; expected a non-empty {expected}")
+        return text
+
+    parse.__name__ = "text"
+    return parse
+
+
+def refuse_empty_values(p: argparse.ArgumentParser) -> None:
+    """Make every text option and argument of ``p`` refuse an empty value, which the commands
+    would otherwise read as "not given" and replace by a default (``--engine ''`` running pymunk,
+    ``--plot ''`` writing no plot). Options whose default is the empty text keep accepting it.
+    Called by :func:`physbench.cli.build_parser` on every command's parser."""
+    for action in p._actions:
+        if (
+            isinstance(action, argparse._StoreAction | argparse._AppendAction)
+            and action.type is None
+            and action.choices is None
+            and action.default != ""
+        ):
+            action.type = _nonempty(action)
+
+
+def split_bodies(items: list[str]) -> tuple[str, ...]:
+    """``--bodies``: body names spelled as ``--params`` spells unknowns, ``a b``, ``a+b``, ``a,b``
+    or as several words; no name twice."""
+    from physbench.errors import PhysbenchError
+
+    names = tuple(n for item in items for n in re.split(r"[\s,+]+", item.strip()) if n)
+    if not names or len(set(names)) != len(names):
+        raise PhysbenchError(
+            f"--bodies {' '.join(items)!r}: expected body names such as a, a+b, a,b or a b "
+            "(no repeats)"
+        )
+    return names
 
 
 def add_scene_argument(p: argparse.ArgumentParser, *, required: bool, help: str = "") -> None:
@@ -131,8 +163,14 @@ def add_params_argument(p: argparse.ArgumentParser, *, help: str = "") -> None:
 
 
 def add_quiet_argument(p: argparse.ArgumentParser, help: str) -> None:
-    """``-q/--quiet``: no progress display; ``help`` says what is still printed."""
-    p.add_argument("-q", "--quiet", action="store_true", help=f"no progress display; {help}")
+    """``-q/--quiet``: no progress display and no ``wrote PATH`` lines; ``help`` says what is still
+    printed."""
+    p.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        help=f"no progress display and no 'wrote' lines; {help}",
+    )
 
 
 def add_json_argument(p: argparse.ArgumentParser, what: str) -> None:
@@ -144,9 +182,30 @@ def add_json_argument(p: argparse.ArgumentParser, what: str) -> None:
     )
 
 
+def _finite(value: Any) -> bool:
+    """Whether every number in the JSON value ``value`` is finite."""
+    if isinstance(value, float):
+        return math.isfinite(value)
+    if isinstance(value, list):
+        return all(_finite(v) for v in value)
+    if isinstance(value, dict):
+        return all(_finite(v) for v in value.values())
+    return True
+
+
+class _NonFinite(Exception):
+    """JSON's NaN, Infinity or -Infinity in a ``KEY=VALUE`` value."""
+
+
+def _refuse_constant(name: str) -> float:
+    raise _NonFinite(name)
+
+
 def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
     """``["startup=5", "sampler=cmaes"]`` -> ``{"startup": 5, "sampler": "cmaes"}``: values parse
-    as JSON, else stay text. ``flag`` names the option in errors."""
+    as JSON, else stay text; a number that is not finite (``NaN``, ``Infinity``, ``1e999``) is
+    refused, as every numeric setting is (:mod:`physbench.numeric`). ``flag`` names the option in
+    errors."""
     from physbench.errors import PhysbenchError
 
     out: dict[str, Any] = {}
@@ -155,9 +214,16 @@ def parse_key_values(items: list[str], flag: str) -> dict[str, Any]:
         if not sep or not key.strip():
             raise PhysbenchError(f"{flag} {item!r}: expected KEY=VALUE, e.g. {flag} startup=5")
         try:
-            value = json.loads(raw)
-        except ValueError:
+            value = json.loads(raw, parse_constant=_refuse_constant)
+        except _NonFinite:
+            value = math.nan
+        except (ValueError, RecursionError):
             value = raw
+        if not _finite(value):
+            raise PhysbenchError(
+                f"{flag} {item!r}: {raw.strip()} is not a finite number; a value is a finite "
+                "number, text or JSON"
+            )
         out[key.strip()] = value
     return out
 
@@ -216,12 +282,51 @@ def add_renderer_arguments(
 
 
 def renderer_choice(args: argparse.Namespace) -> tuple[str, dict[str, Any]]:
-    """The renderer name (the default when not given) and its options from the parsed ``args``."""
+    """The renderer name (the default when not given) and its options from the parsed ``args``,
+    whose keys are checked against the options ``-R`` can set (:func:`check_renderer_options`)."""
     from physbench.render.base import DEFAULT_RENDERER
 
-    return args.renderer or DEFAULT_RENDERER, parse_key_values(
-        args.renderer_option, "--renderer-option"
-    )
+    name = args.renderer or DEFAULT_RENDERER
+    options = parse_key_values(args.renderer_option, "--renderer-option")
+    check_renderer_options(name, options)
+    return name, options
+
+
+#: The renderer keywords physbench sets itself: ``--resolution`` and ``--render-mode`` give them.
+STANDARD_RENDERER_KEYWORDS = ("resolution", "mode")
+
+
+def check_renderer_options(name: str, options: Mapping[str, Any]) -> None:
+    """Refuse a ``-R`` key the registered renderer ``name`` does not take, listing only the options
+    ``-R`` can set (:func:`physbench.components.options_of`: not ``resolution`` and ``mode``, which
+    have flags of their own and a message of their own in
+    :func:`~physbench.components.make_renderer`). A renderer whose options cannot be read from it
+    (``**kwargs`` without ``option_names()``), or an unknown name, is left to
+    :func:`~physbench.components.create`."""
+    from physbench.components import options_of, origin
+    from physbench.errors import OptionError, UnknownNameError
+    from physbench.plugins import get_registry
+
+    try:
+        cls = get_registry().get("renderer", name)
+    except UnknownNameError:
+        return  # said where the renderer is built, in the words of the command's setting
+    try:
+        params = inspect.signature(cls).parameters.values()
+    except (TypeError, ValueError):
+        return
+    if any(p.kind == p.VAR_KEYWORD for p in params) and not callable(
+        getattr(cls, "option_names", None)
+    ):
+        return
+    takes = options_of(cls, dict.fromkeys(STANDARD_RENDERER_KEYWORDS))
+    unknown = [k for k in options if k not in takes and k not in STANDARD_RENDERER_KEYWORDS]
+    if unknown:
+        key = unknown[0]
+        raise OptionError(
+            f"-R {key}={json.dumps(options[key])}: renderer {name!r} ({origin('renderer', name)}) "
+            f"has no option {key!r}; the options -R can set: {', '.join(takes) or 'none'}"
+        )
 
 
 def make_renderer_from(args: argparse.Namespace) -> Any:
@@ -248,8 +353,16 @@ def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
         help="a picture of the empty scene (default: the video's median)",
     )
     group.add_argument(
-        "--start", type=float, default=None, metavar="S", help="skip the video's first S seconds"
+        "--start",
+        type=numeric.SECONDS,
+        default=None,
+        metavar="S",
+        help="skip the video's first S seconds",
     )
     group.add_argument(
-        "--end", type=float, default=None, metavar="S", help="stop at S seconds into the video"
+        "--end",
+        type=numeric.SECONDS,
+        default=None,
+        metavar="S",
+        help="stop at S seconds into the video",
     )

@@ -11,6 +11,7 @@ import argparse
 import shlex
 import sys
 
+from physbench import numeric
 from physbench.commands.arguments import (
     SIZE_CHECK_HELP,
     add_quiet_argument,
@@ -41,7 +42,20 @@ the sweep goes on; --executor serial runs cells in this process, so such a cell 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.epilog = EPILOG + SIZE_CHECK_HELP
     p.formatter_class = argparse.RawDescriptionHelpFormatter
-    p.add_argument("spec", metavar="SPEC", help="sweep spec (TOML), e.g. benchmarks/smoke.toml")
+    p.add_argument(
+        "spec",
+        metavar="SPEC",
+        nargs="?",
+        default=None,
+        help="sweep spec (TOML), e.g. benchmarks/smoke.toml in a checkout; or --example NAME",
+    )
+    p.add_argument(
+        "--example",
+        metavar="NAME",
+        default=None,
+        help="run a spec that ships with physbench instead of a SPEC file: smoke (the quick "
+        "start's sweep, 240 cells, about 2 minutes on 2 cores)",
+    )
     p.add_argument(
         "--out",
         required=True,
@@ -57,7 +71,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--workers",
-        type=int,
+        type=numeric.WORKERS,
         default=None,
         metavar="N",
         help="worker processes (default: all cores)",
@@ -95,16 +109,34 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_quiet_argument(p, "no table: only the final line")
 
 
+def _spec_path(args: argparse.Namespace) -> str:
+    """The spec file: SPEC, or the shipped example --example names (exactly one of them)."""
+    from physbench.errors import PhysbenchError
+
+    if (args.spec is None) == (args.example is None):
+        raise PhysbenchError(
+            "give a sweep spec file (physbench bench SPEC --out DIR) or a shipped example "
+            f"(physbench bench --example NAME --out DIR), {'not both' if args.spec else 'one'}"
+        )
+    if args.example is None:
+        return str(args.spec)
+    from physbench.examples import example_path
+
+    return str(example_path(args.example))
+
+
 def main(args: argparse.Namespace) -> int:
     from physbench.bench.runner import run_sweep
     from physbench.bench.spec import load_spec, with_renderer
-    from physbench.commands.arguments import parse_key_values
+    from physbench.commands.arguments import check_renderer_options, parse_key_values
     from physbench.commands.console import show_progress, wrote
     from physbench.errors import counted
 
-    spec = load_spec(args.spec)
+    spec = load_spec(_spec_path(args))
     if args.renderer is not None or args.renderer_option:
         options = parse_key_values(args.renderer_option, "--renderer-option")
+        if args.renderer is not None or len(spec.renderers) == 1:
+            check_renderer_options(args.renderer or spec.renderers[0].name, options)
         spec = with_renderer(spec, args.renderer, options)
     command = ""
     if sys.argv[1:2] == ["bench"]:
@@ -134,7 +166,7 @@ def main(args: argparse.Namespace) -> int:
         from physbench.bench.tables import markdown, paper_layout
 
         print(markdown(paper_layout(res.stats)))
-    wrote(res.out)
+    wrote(res.out, args)
     print(
         f"{spec.name}: {counted(res.cells, 'cell')} ({res.ran} run, {res.skipped} already done, "
         f"{res.failed} failed) in {res.wall_s:.1f} s with {res.executor}; "

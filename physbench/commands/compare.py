@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 
+from physbench import numeric
 from physbench.commands.arguments import add_quiet_argument
 
 # The same defaults as physbench.bench.compare (argument parsing imports nothing heavy).
@@ -40,13 +41,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--alpha",
-        type=float,
+        type=numeric.LEVEL,
         default=ALPHA,
         help=f"significance level of the one-sided test (default: {ALPHA})",
     )
     p.add_argument(
         "--min-ratio",
-        type=float,
+        type=numeric.RATIO,
         default=MIN_RATIO,
         metavar="R",
         help="smallest geometric-mean error ratio new/baseline that counts as worse "

@@ -1,6 +1,6 @@
 """What a command tells its user besides its result, all on stderr so that stdout carries only
 the result (text or ``--json``): progress, shown on a terminal only, and ``wrote PATH`` for every
-file written."""
+file written; ``-q`` silences both."""
 
 from __future__ import annotations
 
@@ -47,6 +47,7 @@ def stages(args: argparse.Namespace, names: Sequence[str], desc: str) -> Iterato
         bar.close()
 
 
-def wrote(path: str | Path) -> None:
-    """Echo a file (or folder) a command wrote, even with ``-q``."""
-    print(f"wrote {path}", file=sys.stderr)
+def wrote(path: str | Path, args: argparse.Namespace) -> None:
+    """Echo a file (or folder) a command wrote, unless ``args`` ask for ``-q``."""
+    if not getattr(args, "quiet", False):
+        print(f"wrote {path}", file=sys.stderr)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 
+from physbench import numeric
 from physbench.commands.arguments import add_quiet_argument
 
 #: What ``plot`` rewrites besides figures and report (:mod:`physbench.bench.summary`).
@@ -40,14 +41,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--seeds",
-        type=int,
+        type=numeric.COUNT,
         default=3,
         metavar="N",
         help="seeds drawn in the trajectory plots (default: 3)",
     )
     p.add_argument(
         "--landscape-seeds",
-        type=int,
+        type=numeric.LANDSCAPE_SEEDS,
         default=3,
         metavar="N",
         help="scene instances averaged in the image-MSE landscape, which simulates "
@@ -55,38 +56,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--threshold",
-        type=float,
+        type=numeric.POSITIVE,
         default=None,
         metavar="NMSE",
         help="the normalized MSE the time-to-accuracy table and figures count to, on every row "
         "(default: the paper's NN value after 11 iterations, per row; rows the paper lacks are "
         "left out)",
     )
-    add_quiet_argument(p, "the files written and the final line")
+    add_quiet_argument(p, "only the final line")
 
 
 def main(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from physbench.errors import PhysbenchError, counted
-
-    if args.seeds < 1:
-        raise PhysbenchError(f"--seeds {args.seeds}: expected a whole number >= 1")
-    if args.landscape_seeds < 0:
-        raise PhysbenchError(
-            f"--landscape-seeds {args.landscape_seeds}: expected a whole number >= 0"
-        )
-    if args.threshold is not None:  # before reading the table
-        from physbench.bench.time_to_accuracy import check_threshold
-
-        check_threshold(args.threshold, "--threshold")
-
     from physbench.bench import plots, report
     from physbench.bench.store import atomic_write
     from physbench.bench.summary import write_summary
     from physbench.bench.tables import final_rows, read_results, win_rate_table
     from physbench.commands.console import stages, wrote
+    from physbench.errors import PhysbenchError, counted
 
     source = Path(args.dir)
     df = read_results(source)
@@ -117,10 +106,10 @@ def main(args: argparse.Namespace) -> int:
         page = report.build(df, out, figures, title=title, run_log=log, threshold=args.threshold)
     count = sum(len(v) for v in figures.values())
     for path in (p for group in figures.values() for p in group):
-        wrote(path)
-    wrote(out / "win_rate.csv")
+        wrote(path, args)
+    wrote(out / "win_rate.csv", args)
     for name in SUMMARIES:
-        wrote(out / name)
-    wrote(page)
+        wrote(out / name, args)
+    wrote(page, args)
     print(f"{counted(count, 'figure')} in {out / 'plots'}; report {page}")
     return 0

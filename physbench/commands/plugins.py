@@ -7,11 +7,17 @@ import argparse
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from physbench.plugins import Component
+    from physbench.plugins import Component, Registry
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="machine-readable output")
+    p.add_argument(
+        "--check",
+        action="store_true",
+        help="exit with status 1 when a plugin failed to load or two claim one name (without "
+        "it the listing always ends with status 0): for CI of a plugin package",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -55,7 +61,7 @@ def main(args: argparse.Namespace) -> int:
                 indent=2,
             )
         )
-        return 0
+        return _status_code(args, reg)
     head = ("KIND", "NAME", "PLUGIN", "PACKAGE", "VERSION", "STATUS")
     widths = [max(len(str(x)) for x in col) for col in zip(head, *rows, strict=True)]
     for r in (head, *rows):
@@ -68,7 +74,24 @@ def main(args: argparse.Namespace) -> int:
         print("\nName conflicts:")
         for c in reg.conflicts:
             print(f"  {c.describe()}")
-    return 0
+    return _status_code(args, reg)
+
+
+def _status_code(args: argparse.Namespace, reg: Registry) -> int:
+    """1 with ``--check`` when a plugin failed or a name conflict exists (said on stderr), else
+    0."""
+    import sys
+
+    if not args.check or not (reg.failed or reg.conflicts):
+        return 0
+    from physbench.errors import counted
+
+    print(
+        f"physbench plugins: check failed: {counted(len(reg.failed), 'plugin')} failed to load, "
+        f"{counted(len(reg.conflicts), 'name conflict')}",
+        file=sys.stderr,
+    )
+    return 1
 
 
 def _origin(c: Component) -> dict[str, str]:

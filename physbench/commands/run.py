@@ -64,13 +64,26 @@ def _add_problem_arguments(p: argparse.ArgumentParser) -> None:
         help="with an --observation file that carries its scene, that scene instance, which "
         "--scene must name",
     )
-    add_params_argument(p)
+    add_params_argument(
+        p,
+        help="or a scene-level key: gravity, camera.scale, camera.clock, an --effect's parameter "
+        "(linear_drag.c); KEY=LOW:HIGH gives any of them a range (gravity=-11:-9)",
+    )
+    p.add_argument(
+        "--effect",
+        action="append",
+        default=[],
+        metavar="NAME[:KEY=VALUE,...]",
+        help="simulate the model (and a simulated observation) with this effect, e.g. linear_drag "
+        "or linear_drag:c=0.3 (repeatable; see `physbench plugins`); --params may name its "
+        "parameters (linear_drag.c)",
+    )
     p.add_argument(
         "--bodies",
         nargs="+",
         default=None,
         metavar="BODY",
-        help="only these bodies' unknowns (default: all)",
+        help="only these bodies' unknowns: a, or a b, a+b, a,b (default: all)",
     )
     p.add_argument(
         "--iterations",
@@ -268,17 +281,13 @@ def _check_arguments(args: argparse.Namespace) -> None:
 
 def _build_config(args: argparse.Namespace) -> Any:
     """The checked :class:`~physbench.experiment.RunConfig` the flags describe."""
-    from physbench.commands.arguments import parse_key_values, renderer_choice
+    from physbench.commands.arguments import parse_key_values, renderer_choice, split_bodies
     from physbench.components import default_render_mode
     from physbench.experiment import RunConfig, check_config
     from physbench.unknowns import split_params
 
     params = split_params(args.params)
-    bodies = (
-        None
-        if args.bodies is None
-        else tuple(b for item in args.bodies for b in item.split(",") if b)
-    )
+    bodies = None if args.bodies is None else split_bodies(args.bodies)
     renderer, renderer_options = renderer_choice(args)
     config = RunConfig(
         scene=args.scene,
@@ -304,6 +313,7 @@ def _build_config(args: argparse.Namespace) -> Any:
         background=args.background,
         video_start=args.start,
         video_end=args.end,
+        effects=tuple(args.effect),
     )
     check_config(config)  # a bad name or option: fail before the progress bar appears
     return config
@@ -349,21 +359,22 @@ def _save_outputs(args: argparse.Namespace, history: Any) -> None:
     if args.save_observation:
         # numpy adds .npz to a name without it
         saved = str(args.save_observation)
-        wrote(saved if saved.endswith(".npz") else saved + ".npz")
+        wrote(saved if saved.endswith(".npz") else saved + ".npz", args)
     if args.plot:
         from physbench.plotting.convergence import plot_convergence, run_title
 
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         plot_convergence({f"{history.estimator}": [history]}, args.plot, title=run_title(history))
-        wrote(args.plot)
+        wrote(args.plot, args)
         if history.posterior is not None:
             from physbench.plotting.posterior import plot_posterior, posterior_path
 
-            wrote(str(plot_posterior(history.posterior, posterior_path(args.plot), history.truth)))
+            drawn = plot_posterior(history.posterior, posterior_path(args.plot), history.truth)
+            wrote(str(drawn), args)
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(history.to_json(indent=1) + "\n", encoding="utf-8")
-        wrote(args.out)
+        wrote(args.out, args)
 
 
 def _warn_about_result(history: Any) -> None:
@@ -374,7 +385,7 @@ def _warn_about_result(history: Any) -> None:
         print(
             f"physbench run: warning: {', '.join(history.at_bound)} ended at an end of "
             "its range: the range, not the data, may hold the estimate; widen the unknown's range "
-            "in the scene (a scene TOML's [[unknowns]]) and run again",
+            "(--params KEY=LOW:HIGH, or a scene TOML's [[unknowns]]) and run again",
             file=sys.stderr,
         )
     if history.fit is not None and history.fit.failed:
@@ -423,6 +434,26 @@ def _print_details(args: argparse.Namespace, history: Any) -> None:
             )
             for k, v in best.params.items()
         )
+    )
+    _explain_worse_than_initial(history)
+
+
+def _explain_worse_than_initial(history: Any) -> None:
+    """Say why, when the result ends further from the truth than the initial guess: the result
+    is the iterate that matches the frames best, and the truth is not in the frames."""
+    best, start = history.best_nmse, history.initial_nmse
+    if best is None or start is None or best <= start:
+        return
+    nearest = min(
+        (r for r in history.iterations if r.nmse is not None and not r.failed),
+        key=lambda r: r.nmse,
+    )
+    print(
+        f"note: the result (normalized MSE {best:.3e}) is further from the truth than the initial "
+        f"guess ({start:.3e}): an estimator sees only the frames, and iteration "
+        f"{history.best.iteration} matches them best (image MSE {history.best.loss:.3e}); "
+        f"iteration {nearest.iteration} came nearer the truth (normalized MSE "
+        f"{nearest.nmse:.3e}) but matched the frames less well (image MSE {nearest.loss:.3e})"
     )
 
 

@@ -13,6 +13,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from physbench.plotting.units import DIMENSIONLESS
     from physbench.plugins import get_registry
     from physbench.scene_toml import dumps_scene
 
@@ -30,10 +31,12 @@ def main(args: argparse.Namespace) -> int:
             f"    bodies: {bodies}" + (f"; test body: {scene.test_body}" if scene.test_body else "")
         )
         by_param: dict[str, list[str]] = {}
+        units: dict[str, str] = {}
         for u in scene.unknowns:
             by_param.setdefault(u.name, []).append(f"{u.owner} [{u.low:g}, {u.high:g}]")
+            units.setdefault(u.name, u.unit or DIMENSIONLESS)
         for param, items in by_param.items():
-            print(f"    unknown {param}: {', '.join(items)}")
+            print(f"    unknown {param} ({units[param]}): {', '.join(items)}")
         if not scene.unknowns:
             print("    unknowns: none")
     return 0

@@ -58,11 +58,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "an image, the clean plate a tracker takes as background",
     )
     p.add_argument("--preview", metavar="FILE.gif|png", help="write a picture of the run")
-    add_quiet_argument(p, "print only the files written")
+    add_quiet_argument(p, "no output but errors and warnings")
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
+    """``--set BODY.PARAM=VALUE`` items as ``{"a.mass": 3.5}``; a value must be a finite number."""
     from physbench.errors import PhysbenchError
+    from physbench.numeric import ANY
 
     out: dict[str, float] = {}
     for item in items:
@@ -70,35 +72,19 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
         try:
             if not sep or "." not in key:
                 raise ValueError
-            out[key.strip()] = float(value)
+            out[key.strip()] = float(ANY.parse(value))
         except ValueError:
             raise PhysbenchError(
-                f"--set {item!r}: expected BODY.PARAM=NUMBER, e.g. a.mass=3.5"
+                f"--set {item!r}: expected BODY.PARAM=NUMBER (a finite number), e.g. a.mass=3.5"
             ) from None
     return out
 
 
 def make_effects(items: list[str]) -> list:
     """Effect instances from ``--effect NAME[:KEY=VALUE,...]`` items."""
-    from physbench.components import create
-    from physbench.errors import PhysbenchError
+    from physbench.components import make_effect
 
-    out = []
-    for item in items:
-        name, _, rest = item.partition(":")
-        values: dict[str, float] = {}
-        for pair in filter(None, (p.strip() for p in rest.split(","))):
-            key, sep, value = pair.partition("=")
-            try:
-                if not sep or not key.strip():
-                    raise ValueError
-                values[key.strip()] = float(value)
-            except ValueError:
-                raise PhysbenchError(
-                    f"--effect {item!r}: expected NAME[:KEY=NUMBER,...], e.g. linear_drag:c=0.3"
-                ) from None
-        out.append(create("effect", name.strip(), values))
-    return out
+    return [make_effect(item) for item in items]
 
 
 def main(args: argparse.Namespace) -> int:
@@ -241,7 +227,7 @@ def _write_out(
             effects=np.array([repr(e) for e in effects], dtype=str),
             **traj.to_npz_dict(),
         )
-    wrote(args.out)
+    wrote(args.out, args)
 
 
 def _write_pictures(args: argparse.Namespace, scene: Any, traj: Any, camera: Any) -> None:
@@ -256,9 +242,11 @@ def _write_pictures(args: argparse.Namespace, scene: Any, traj: Any, camera: Any
         assert camera is not None
         Path(args.plate).parent.mkdir(parents=True, exist_ok=True)
         Image.fromarray(camera.plate(scene)).save(args.plate)
-        wrote(args.plate)
+        wrote(args.plate, args)
     if args.preview:
+        from physbench.commands.arguments import renderer_choice
         from physbench.render.preview import save_preview
 
-        save_preview(scene, traj, args.preview)
-        wrote(args.preview)
+        name, options = renderer_choice(args)
+        save_preview(scene, traj, args.preview, renderer=name, options=options)
+        wrote(args.preview, args)

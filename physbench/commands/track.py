@@ -8,6 +8,7 @@ from physbench.commands.arguments import (
     add_quiet_argument,
     add_scene_argument,
     add_video_input_arguments,
+    seed_int,
 )
 
 
@@ -22,13 +23,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         required=True,
         help="the filmed scene (its initial positions say where the bodies start)",
     )
-    p.add_argument("--seed", type=int, default=0, help="scene instance seed (default 0)")
+    p.add_argument("--seed", type=seed_int, default=0, help="scene instance seed (default 0)")
     p.add_argument("--out", required=True, metavar="REC.csv", help="write the recording here")
     p.add_argument(
         "--preview", metavar="FILE.mp4|.gif", help="write the video with the tracks drawn on"
     )
     add_video_input_arguments(p)
-    add_quiet_argument(p, "print only the files written")
+    add_quiet_argument(p, "no output but errors and warnings")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -67,8 +68,8 @@ def main(args: argparse.Namespace) -> int:
     write_recordings(args.out, result.recording)
     if not args.quiet:
         print(result.summary.format())
-    wrote(args.out)
+    wrote(args.out, args)
     if args.preview:
         write_overlay(args.preview, video, result.pixels, start=args.start, end=args.end)
-        wrote(args.preview)
+        wrote(args.preview, args)
     return 0

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from physbench import numeric
 from physbench.commands.arguments import (
     SIZE_CHECK_HELP,
     add_params_argument,
@@ -61,7 +62,9 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
         default=None,
         help="sequences per training step (default 16; --posterior: 256)",
     )
-    p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument(
+        "--lr", type=numeric.LEARNING_RATE, default=1e-3, help="learning rate (default 1e-3)"
+    )
     p.add_argument(
         "--widths",
         default="16,32,64,128",
@@ -81,7 +84,7 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--minutes",
-        type=float,
+        type=numeric.NON_NEGATIVE,
         default=0.0,
         help="wall-clock budget of this session (a resumed run gets it afresh); training ends at "
         "this or --samples, whichever comes first (default: none)",
@@ -91,15 +94,31 @@ def _add_training_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--blur-max",
-        type=float,
+        type=numeric.BLUR,
         default=0.0,
         help="augment: blur half the observed sequences by sigma ~ U(0, this) pixels (default 0: "
         "off)",
     )
     p.add_argument(
+        "--near",
+        type=numeric.SHARE,
+        default=0.0,
+        help="share of a sample group's simulations drawn near another one's parameters (each "
+        "unknown moved by N(0, --near-scale) of its range), for pairs as close as the loop's "
+        "second correction sees (default 0: every simulation from the prior, as the first)",
+    )
+    p.add_argument(
+        "--near-scale",
+        type=numeric.LEVEL,
+        default=0.05,
+        help="spread of --near simulations, as a share of each unknown's range (default 0.05)",
+    )
+    p.add_argument(
         "--init",
         default="",
-        help="fine-tune: start from these weights (.safetensors) instead of a fresh network",
+        help="fine-tune: start from these weights (.safetensors) instead of a fresh network; "
+        "their --widths must match, --resolution and --frames may differ (a bigger input from "
+        "the same tensors); training draws scene instances after the ones they were trained on",
     )
 
 
@@ -191,10 +210,12 @@ def main(args: argparse.Namespace) -> int:
         resolution=args.resolution,
         frames=args.frames,
         blur_max=args.blur_max,
+        near=args.near,
+        near_scale=args.near_scale,
     )
     check_size(spec, args.samples, scene, args.minutes)
     path, meta = _train(args, spec, widths)
-    _print_trained(path, meta)
+    _print_trained(args, path, meta)
     if args.eval_seeds:
         _print_held_out(path, args.eval_seeds)
     return 0
@@ -316,12 +337,12 @@ def _say_resuming(checkpoint: Any, samples: int) -> None:
     )
 
 
-def _print_trained(path: Any, meta: dict[str, Any]) -> None:
+def _print_trained(args: argparse.Namespace, path: Any, meta: dict[str, Any]) -> None:
     """The files written and the training's result line."""
     from physbench.commands.console import wrote
 
-    wrote(path)
-    wrote(path.with_suffix(".json"))
+    wrote(path, args)
+    wrote(path.with_suffix(".json"), args)
     print(
         f"weights: {path} (+ {path.with_suffix('.json').name}); validation MSE of normalised Δp: "
         f"{meta['val_mse']:.3g}; "
@@ -348,7 +369,7 @@ def _posterior(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from physbench.commands.arguments import DEFAULT_SCENE, renderer_choice
-    from physbench.commands.console import wrote
+    from physbench.commands.console import show_progress, wrote
     from physbench.components import make_renderer
     from physbench.errors import PhysbenchError
     from physbench.estimators.npe.estimator import NPEEstimator
@@ -386,9 +407,9 @@ def _posterior(args: argparse.Namespace) -> int:
     check_size(spec, samples, resolve_scene(scene_name, 0))
     cfg = NPETrainConfig(samples=samples, batch=batch, lr=args.lr, threads=args.threads)
     out = Path(args.out or f"runs/train/npe/{weights_name(spec)}")
-    path, meta = train(spec, None, cfg, out, progress=not args.quiet)
-    wrote(path)
-    wrote(path.with_suffix(".json"))
+    path, meta = train(spec, None, cfg, out, progress=show_progress(args))
+    wrote(path, args)
+    wrote(path.with_suffix(".json"), args)
     t = meta["training"]
     print(
         f"npe weights: {path} (+ {path.with_suffix('.json').name}); validation NLL in logit-unit "

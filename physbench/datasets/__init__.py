@@ -41,14 +41,49 @@ def load(name: str, **options: object) -> list[DatasetRun]:
     return loaders[name](**options)
 
 
+def describe(name: str) -> str:
+    """One line on data set ``name``: the first line of its module's docstring."""
+    import sys
+
+    loader = _loaders().get(name)
+    if loader is None:
+        raise UnknownNameError("data set", name, _loaders())
+    doc = sys.modules[loader.__module__].__doc__ or ""
+    return doc.strip().split("\n\n")[0].replace("\n", " ")
+
+
+def select(spec: str) -> list[DatasetRun]:
+    """The runs ``spec`` names: ``NAME`` (every run of data set NAME, as :func:`load` gives
+    them) or ``NAME/RUN`` (the runs named RUN or ``RUN/...``, e.g. ``ball_drops/whiffle_ball_1``
+    for both drops of that ball); called for ``physbench datasets`` and ``discover --dataset``.
+    A RUN that matches none lists the runs there are."""
+    name, _, run = spec.partition("/")
+    runs = load(name)
+    if not run:
+        return runs
+    chosen = [r for r in runs if r.name == run or r.name.startswith(run.rstrip("/") + "/")]
+    if not chosen:
+        groups = list(dict.fromkeys(r.name.partition("/")[0] for r in runs))
+        shown = ", ".join(groups[:20]) + (
+            f", ... ({len(groups)} in all)" if len(groups) > 20 else ""
+        )
+        raise DatasetError(
+            f"{spec!r}: data set {name!r} has no run {run!r}; its runs: {shown} (see "
+            f"`physbench datasets {name}`)"
+        )
+    return chosen
+
+
 __all__ = [
     "DATA_ENV",
     "DatasetError",
     "DatasetRun",
     "data_dir",
     "dataset_names",
+    "describe",
     "load",
     "oscillation_centre",
     "oscillation_periods",
+    "select",
     "swing_peaks",
 ]

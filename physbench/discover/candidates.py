@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from physbench.errors import UnknownNameError
+from physbench.errors import PhysbenchError, UnknownNameError
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
@@ -130,10 +130,19 @@ def candidates_for(
             eff = factory(**options) if factory else create("effect", name, options)
             eff.setup(scene, {})
         except Exception as exc:  # an effect that cannot describe this scene is not a candidate
-            skipped.append((name, f"{type(exc).__name__}: {exc}"))
+            skipped.append((name, _reason(name, exc)))
             continue
         out.append(spec)
     return out, skipped
+
+
+def _reason(name: str, exc: Exception) -> str:
+    """Why effect ``name`` is no candidate, in words: the sentence of physbench's own error
+    (without the effect's name, which the list already shows); for any other exception (a
+    plugin's bug) also its type, which is all a traceback-less line can tell about it."""
+    if isinstance(exc, PhysbenchError):
+        return str(exc).removeprefix(f"effect {name!r} ")
+    return f"it could not be set up on this scene ({type(exc).__name__}: {exc})"
 
 
 def start_values(effect: Effect, scene: Scene) -> dict[str, float]:

@@ -543,7 +543,14 @@ def score(label: str, causes: tuple[str, ...], model: Model, fr: FitResult) -> S
     reason, when it does not simulate there)."""
     try:
         r = model.residuals("held")
-        held, why = rms(r), ""
+        with np.errstate(over="ignore", invalid="ignore"):
+            held, why = rms(r), ""
     except SimulationError as exc:
-        r, held, why = np.zeros(0), math.inf, str(exc)
+        r, held, why = np.zeros(0), math.inf, str(exc) or type(exc).__name__
+    if not math.isfinite(held) and not why:  # the message that quotes it names what failed
+        why = (
+            f"the RMS of its {r.size} held-out residuals is {held}"
+            if r.size
+            else "no held-out residual"
+        )
     return Scored(label, causes, model, fr, held, int(r.size), why)

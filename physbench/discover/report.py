@@ -80,8 +80,12 @@ class _Report:
     ext: str
 
     def save(self, fig: Any, name: str, caption: str) -> tuple[str, str]:
-        """Lay out, write and close ``fig``; returns its file name and caption."""
-        fig.tight_layout()
+        """Lay out (every text inside the figure), write and close ``fig``; returns its file name
+        and caption."""
+        from physbench.plotting.layout import fit_text
+
+        fig.set_layout_engine("tight")
+        fit_text(fig)
         fig.savefig(self.out / name, dpi=self.dpi)
         self.plt.close(fig)
         return name, caption

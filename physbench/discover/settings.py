@@ -11,7 +11,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from physbench import numeric
 from physbench.discover.data import DiscoverError
+
+#: A continuation horizon: a share of each fitted part.
+HORIZON = numeric.finite(0, 1, low_open=True)
 
 
 @dataclass(frozen=True)
@@ -53,26 +57,33 @@ class Settings:
     ambiguity: float = 0.05
 
     def __post_init__(self) -> None:
-        for name, v in (("min_gain", self.min_gain), ("ambiguity", self.ambiguity)):
-            if isinstance(v, bool) or not isinstance(v, int | float) or not 0 <= v < 1:
-                raise DiscoverError(f"{name} = {v!r}: expected a number in [0, 1)")
-        counts = {
-            "max_causes": self.max_causes,
-            "shortlist": self.shortlist,
-            "max_nfev": self.max_nfev,
-            "base_max_nfev": self.base_max_nfev,
-            "budget": self.budget,
-            "quick_budget": self.quick_budget,
-            "screen": self.screen,
+        """Refuse a setting outside its range (:mod:`physbench.numeric`): NaN and the
+        infinities included, which would switch a threshold off."""
+        checks: dict[str, numeric.Number] = {
+            "holdout": numeric.HOLDOUT,
+            "lead": numeric.SHARE,
+            "estimator_iterations": numeric.COUNT,
+            "seed": numeric.SEED,
+            "min_gain": numeric.SHARE,
+            "ambiguity": numeric.SHARE,
+            "min_delta_bic": numeric.NON_NEGATIVE,
+            "max_causes": numeric.COUNT,
+            "shortlist": numeric.COUNT,
+            "max_nfev": numeric.COUNT,
+            "base_max_nfev": numeric.COUNT,
+            "budget": numeric.COUNT,
+            "quick_budget": numeric.COUNT,
+            "screen": numeric.COUNT,
+            "diff_step": numeric.POSITIVE,
         }
-        for name, n in counts.items():
-            if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-                raise DiscoverError(f"{name} = {n!r}: expected a whole number >= 1")
-        if self.floor is not None and (
-            isinstance(self.floor, bool)
-            or not isinstance(self.floor, int | float)
-            or self.floor < 0
-        ):
-            raise DiscoverError(f"floor = {self.floor!r}: expected a number >= 0 (metres) or None")
-        if not isinstance(self.min_delta_bic, int | float) or self.min_delta_bic < 0:
-            raise DiscoverError(f"min_delta_bic = {self.min_delta_bic!r}: expected a number >= 0")
+        for name, number in checks.items():
+            number.check(getattr(self, name), name, DiscoverError)
+        if self.floor is not None:
+            numeric.FLOOR.check(self.floor, "floor", DiscoverError)
+        if self.horizons is not None:
+            if isinstance(self.horizons, str) or not isinstance(self.horizons, Sequence):
+                raise DiscoverError(
+                    f"horizons = {self.horizons!r}: expected a list of shares in (0, 1]"
+                )
+            for h in self.horizons:
+                HORIZON.check(h, "horizons", DiscoverError)

@@ -39,8 +39,8 @@ def format_interval(
     value: float, interval: tuple[float, float] | None, unit: str = "", *, words: bool = True
 ) -> str:
     """``value`` with its 90 % interval, rounded to the interval's precision:
-    ``0.30 N·m (90 % interval [0.27, 0.33])``, or ``0.30 [0.27, 0.33]`` without ``words``; the
-    bare value when there is no interval."""
+    ``0.30 N·m (90 % interval [0.27, 0.33])``, or ``0.30 [0.27, 0.33] N·m`` without ``words``;
+    the bare value (and unit) when there is no interval."""
     u = f" {unit}" if unit else ""
     lo, hi = interval if interval is not None else (math.nan, math.nan)
     half = (hi - lo) / 2
@@ -52,16 +52,16 @@ def format_interval(
     else:
         nums = [f"{x:.{digits}f}" for x in (value, lo, hi)]
     band = f"[{nums[1]}, {nums[2]}]"
-    return f"{nums[0]}{u} ({LEVEL * 100:g} % interval {band})" if words else f"{nums[0]} {band}"
+    return f"{nums[0]}{u} ({LEVEL * 100:g} % interval {band})" if words else f"{nums[0]} {band}{u}"
 
 
-def params_text(c: CandidateResult, *, units: bool = True) -> str:
-    """``c``'s parameters with their 90 % intervals (with units and words, or compact for the
+def params_text(c: CandidateResult, *, words: bool = True) -> str:
+    """``c``'s parameters with their 90 % intervals and units (in words, or compact for the
     table)."""
     parts = []
     for k, v in c.params.items():
-        u = _unit(c.name, k) if units else ""
-        parts.append(f"{k} = {format_interval(v, c.intervals.get(k), u, words=units)}")
+        u = _unit(c.name, k)
+        parts.append(f"{k} = {format_interval(v, c.intervals.get(k), u, words=words)}")
     return ", ".join(parts)
 
 
@@ -99,11 +99,13 @@ def text(disc: Discovery) -> str:
         f"({b.fit.k} fitted parameters, {b.fit.n} fitted and {b.heldout_n} held-out residuals)"
     )
     shown = {k: v for k, v in b.summary()["params"].items()}
+    units = {p.key: p.unit for p in b.model.params}
     if shown:
         lines.append(
             "  fitted: "
             + ", ".join(
-                f"{k} = {format_interval(v, b.fit.intervals.get(k))}" for k, v in shown.items()
+                f"{k} = {format_interval(v, b.fit.intervals.get(k), units.get(k, ''))}"
+                for k, v in shown.items()
             )
         )
     lines.append("")
@@ -188,7 +190,7 @@ def table(disc: Discovery) -> str:
         rows.append(
             f"{c.round:>5}  {c.effect:<32} {c.heldout_error:>18.5g} {c.gain:>+8.1%} "
             f"{c.delta_criterion:>+9.1f}  "
-            f"{verdict:<8}  {params_text(c, units=False)}"
+            f"{verdict:<8}  {params_text(c, words=False)}"
         )
     if any(c.at_bound for c in disc.candidates):
         rows.append("* a parameter at the end of its range: the true value may lie beyond it")

@@ -128,13 +128,13 @@ def convergence_figure(
         ax.grid(True, which="both", alpha=0.3)
     axes[-1, 0].set_xlabel(XLABEL)
     axes[-1, 0].xaxis.get_major_locator().set_params(integer=True)
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(
-        handles, labels, loc="outside lower center", ncols=min(4, len(labels)), fontsize="small"
-    )
     if title:
         fig.suptitle(title, fontsize="medium")
-    return fig
+    from physbench.plotting.layout import fit_text, legend_below
+
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    legend_below(fig, handles, labels, ncols=4, fontsize="small")
+    return fit_text(fig)
 
 
 def plot_convergence(

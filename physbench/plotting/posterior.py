@@ -49,14 +49,16 @@ def posterior_figure(
         ax.set_xlim(lo, hi)
         ax.set_yticks([])
         ax.set_xlabel(k + (" (not determined)" if k in undetermined else ""), fontsize="small")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncols=4, fontsize="small")
     state = "" if posterior.complete else " (incomplete)"
     fig.suptitle(
         title or f"posterior ({posterior.method}{state}, {len(posterior)} samples)",
         fontsize="medium",
     )
-    return fig
+    from physbench.plotting.layout import fit_text, legend_below
+
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    legend_below(fig, handles, labels, ncols=4, fontsize="small")
+    return fit_text(fig)
 
 
 def plot_posterior(

@@ -16,6 +16,7 @@ import numpy as np
 
 from physbench.errors import SimulationError
 from physbench.metrics import image_mse
+from physbench.unknowns import simulate_seen
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
@@ -66,10 +67,10 @@ def probe(
 
     def frames(params: Mapping[str, float]) -> np.ndarray | None:
         try:
-            traj = simulator.simulate(scene, dict(params), effects=effects)
+            seen, traj = simulate_seen(simulator, scene, params, effects)
         except SimulationError:
             return None
-        return renderer.render(scene, traj)
+        return renderer.render(seen, traj)
 
     ref = frames(base)
     if ref is None:

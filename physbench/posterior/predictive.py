@@ -36,6 +36,7 @@ import numpy as np
 
 from physbench.errors import PhysbenchError, SimulationError
 from physbench.posterior.likelihood import estimate_noise
+from physbench.unknowns import simulate_seen
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
@@ -179,10 +180,10 @@ def check(
     frames = []
     for draw in _draws(posterior, draws, rng):
         try:
-            traj = simulator.simulate(scene, draw, effects=effects)
+            seen, traj = simulate_seen(simulator, scene, draw, effects)
         except SimulationError:
             continue
-        frames.append(np.asarray(renderer.render(scene, traj), dtype=np.float32).ravel())
+        frames.append(np.asarray(renderer.render(seen, traj), dtype=np.float32).ravel())
     k = len(frames)
     if k < 3:
         return None

@@ -89,8 +89,10 @@ def _render(
     *,
     focus: str | None = None,
     out: np.ndarray | None = None,
+    traj: Trajectory | None = None,
 ) -> np.ndarray:
-    traj = probe_trajectory(scene, frames)
+    """``ren``'s frames of ``scene`` along ``traj`` (default: :func:`probe_trajectory`)."""
+    traj = probe_trajectory(scene, frames) if traj is None else traj
     try:
         return ren.render(scene, traj, focus=focus, out=out)
     except Exception as exc:
@@ -269,6 +271,86 @@ def check_out(cls: type[Renderer], **options: Any) -> None:
             )
 
 
+#: Where the kit's disc starts, ends and rests for :func:`check_follows_trajectory` (m): it moves
+#: right and up by 0.6 m, about five pixels at the kit's resolution; the third place is apart
+#: from both.
+MOTION = ((1.0, 1.5), (1.6, 2.1), (3.2, 0.6))
+
+
+def _resting(scene: Scene, at: tuple[float, float]) -> Trajectory:
+    """Every frame of ``scene`` (one body) at ``at``, unrotated and at rest."""
+    t = np.arange(scene.frames) / scene.fps
+    states = np.zeros((scene.frames, 1, 6))
+    states[:, 0, :2] = at
+    return Trajectory(scene.body_names, t, states)
+
+
+def _moving(scene: Scene, start: tuple[float, float], end: tuple[float, float]) -> Trajectory:
+    """``scene``'s one body moving at constant velocity from ``start`` (frame 0) to ``end`` (the
+    last frame)."""
+    t = np.arange(scene.frames) / scene.fps
+    v = (np.subtract(end, start)) / t[-1]
+    states = np.zeros((scene.frames, 1, 6))
+    states[:, 0, :2] = np.asarray(start) + t[:, None] * v
+    states[:, 0, 3:5] = v
+    return Trajectory(scene.body_names, t, states)
+
+
+def _centroid(weight: np.ndarray) -> tuple[float, float]:
+    """(row, column) of the centre of mass of a (H, W) weight."""
+    total = float(weight.sum())
+    rows, cols = np.indices(weight.shape)
+    return float((rows * weight).sum()) / total, float((cols * weight).sum()) / total
+
+
+def check_follows_trajectory(cls: type[Renderer], **options: Any) -> None:
+    """In every mode each frame shows the trajectory's pose at that frame: a disc moving right
+    and up (:data:`MOTION`) ends nearer the render of the disc resting at its last pose than at
+    its first (a renderer that draws every frame at the initial pose fails here), and that
+    picture lies to the right of and above the first (columns grow and rows shrink: the world's
+    ``y`` points up, image rows run down)."""
+    scene = alone(probe_scene(), "disc")
+    start, end, elsewhere = MOTION
+    for mode in _modes(cls):
+        ren = _build(cls, options, mode)
+        last = np.asarray(_render(cls, ren, scene, traj=_moving(scene, start, end)))[-1]
+        rest = {
+            p: np.asarray(_render(cls, ren, scene, traj=_resting(scene, p)))[-1].astype(float)
+            for p in MOTION
+        }
+        to_end, to_start = _mean_far(last, rest[end]), _mean_far(last, rest[start])
+        if not to_end < to_start:
+            raise ConformanceError(
+                f"{label(cls)}: mode {mode!r}: the last frame of a disc moving from {start} to "
+                f"{end} m is no nearer the disc resting at {end} (mean difference {to_end:.3g}) "
+                f"than at {start} ({to_start:.3g}); each frame must show the trajectory's pose "
+                "at that frame"
+            )
+        # A pose's blob: where its picture differs from both other poses' pictures.
+        r0, c0 = _centroid(_blob(rest[start], rest[end], rest[elsewhere]))
+        r1, c1 = _centroid(_blob(rest[end], rest[start], rest[elsewhere]))
+        if not (c1 > c0 and r1 < r0):
+            raise ConformanceError(
+                f"{label(cls)}: mode {mode!r}: a disc moved right and up from {start} to {end} m, "
+                f"but its picture moved {c1 - c0:+.1f} columns and {r1 - r0:+.1f} rows; columns "
+                "must grow with x and rows shrink with y (the world's y points up, image rows run "
+                "down)"
+            )
+
+
+def _blob(here: np.ndarray, *others: np.ndarray) -> np.ndarray:
+    """(H, W) weight of where the (C, H, W) picture ``here`` differs from every one of
+    ``others``."""
+    weight = np.ones(here.shape[1:])
+    for other in others:
+        weight *= np.abs(here - other).sum(axis=0)
+    return weight
+
+
+def _mean_far(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.abs(np.asarray(a, dtype=float) - b).mean())
+
+
 def _far(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(np.asarray(a, dtype=float) - b).max())
 
@@ -365,6 +447,7 @@ CHECKS = (
     check_frames,
     check_deterministic,
     check_out,
+    check_follows_trajectory,
     check_marking,
     check_channel_layout,
     check_bad_options,

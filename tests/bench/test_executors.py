@@ -58,8 +58,9 @@ def test_worker_counts_and_addresses_are_kept_and_described() -> None:
 @pytest.mark.parametrize(
     ("name", "kwargs", "message"),
     [
-        ("processes", {"workers": 0}, "--workers 0: expected a whole number >= 1"),
-        ("serial", {"workers": True}, "--workers True: expected a whole number >= 1"),
+        ("processes", {"workers": 0}, "--workers 0: expected a whole number in [1, 512]"),
+        ("serial", {"workers": True}, "--workers True: expected a whole number in [1, 512]"),
+        ("processes", {"workers": 10**9}, "--workers 1000000000: expected a whole number in"),
         (
             "processes",
             {"address": "tcp://x:1"},
@@ -76,7 +77,33 @@ def test_worker_counts_and_addresses_are_kept_and_described() -> None:
 def test_bad_settings_are_named(name: str, kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(PhysbenchError) as err:
         make_executor(name, **kwargs)  # type: ignore[arg-type]
-    assert str(err.value) == message
+    assert str(err.value).startswith(message)
+
+
+SCRIPT = """\
+import physbench
+
+def main():
+    physbench.sweep(SPEC, OUT)
+
+if __name__ == "__main__":
+    main()  # guarded
+    physbench.sweep(SPEC, OUT)  # guarded too
+else:
+    main()  # the workers' re-run reaches this
+main()  # unguarded
+"""
+
+
+@pytest.mark.parametrize(
+    ("line", "guarded_"), [(4, False), (7, True), (8, True), (10, False), (11, False)]
+)
+def test_a_line_is_guarded_inside_the_main_block_only(line: int, guarded_: bool) -> None:
+    from physbench.bench.executors import guarded
+
+    assert guarded(SCRIPT, line) is guarded_
+    reversed_test = SCRIPT.replace('__name__ == "__main__"', "'__main__' == __name__")
+    assert guarded(reversed_test, line) is guarded_
 
 
 def test_serial_maps_in_order() -> None:

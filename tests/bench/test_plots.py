@@ -248,3 +248,69 @@ def test_no_coverage_figure_without_posteriors(calibrated_sweep, tmp_path: Path)
     old = read_table(Path(__file__).resolve().parents[2] / "results" / "baseline")
     assert plots.coverage(old, tmp_path) == []
     assert not list(tmp_path.iterdir())
+
+
+# ---------------------------------------------- issue 28: no text is cut at the figure's edge
+
+
+@pytest.fixture(scope="module")
+def committed_figures(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """Every figure ``plot_all`` draws for a slice of the committed resnet3d sweep: long
+    estimator labels (``resnet3d(threads=1)``), the paper's two reference lines, 4 of its seeds
+    (more than the 3 trajectories draw), three unknown sets of three_circles side by side."""
+    from physbench.bench import plots
+
+    df = read_table(Path(__file__).resolve().parents[2] / "results" / "resnet3d")
+    df = df[
+        df["scene"].isin(["three_circles", "bouncing_balls"])
+        & (df["blur"] == 0)
+        & (df["bodies"] == "all")
+        & (df["seed"] < 4)
+    ]
+    drawn: dict[str, Any] = {}
+    save = plots._save
+
+    def keep(fig: Any, path: Path) -> Path:
+        drawn[path.name] = fig
+        return save(fig, path)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(plots, "_save", keep)
+        # no landscape: it simulates (the `figures` sweep draws one, checked too)
+        plot_all(df, tmp_path_factory.mktemp("committed"), seeds=3, landscape_seeds=0)
+    return drawn
+
+
+def test_no_text_of_a_sweep_figure_lies_outside_it(
+    figures: dict[str, Any], committed_figures: dict[str, Any], texts_outside: Any
+) -> None:
+    kinds = {name.split("_")[0] for name in {**figures, **committed_figures}}
+    assert kinds == {"convergence", "trajectories", "landscape", "win", "time"}, kinds
+    for name, fig in {**figures, **committed_figures}.items():
+        assert texts_outside(fig) == [], name
+    legend = committed_figures["convergence_three_circles.png"].legends[0]
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert "resnet3d(threads=1)" in labels and "paper Hyperopt (11 it.)" in labels
+
+
+def test_the_coverage_figure_fits_too(calibrated_sweep, tmp_path: Path, texts_outside) -> None:
+    from physbench.bench import plots
+
+    drawn: list[Any] = []
+    save = plots._save
+
+    def keep(fig: Any, path: Path) -> Path:
+        drawn.append(fig)
+        return save(fig, path)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(plots, "_save", keep)
+        assert plots.coverage(calibrated_sweep.table, tmp_path)
+    assert [texts_outside(fig) for fig in drawn] == [[]]
+
+
+def test_the_trajectories_say_how_many_seeds_they_draw(committed_figures: dict[str, Any]) -> None:
+    title = committed_figures["trajectories_three_circles_mass.png"].get_suptitle()
+    assert "the first 3 of 4 seeds (physbench plot --seeds N)" in title.replace("\n", " ")
+    legend = committed_figures["trajectories_three_circles_mass.png"].legends[0]
+    assert [t.get_text() for t in legend.get_texts()] == ["seed 0", "seed 1", "seed 2"]

@@ -4,6 +4,7 @@ tests/commands/test_bench.py)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -229,3 +230,71 @@ def test_renderer_override() -> None:
     two = parse_spec({**GOOD, "renderer": [DEFAULT_RENDERER, "blocks"]})
     with pytest.raises(SpecError, match=r"the spec has 2 renderers .*; name the one to run"):
         with_renderer(two, None, {"gain": 0.5})
+
+
+TOSS = """
+name = "toss"
+bounds = [0.0, 0.0, 4.0, 3.0]
+frames = 20
+
+[[bodies]]
+name = "ball"
+shape = { kind = "circle", radius = 0.1 }
+position = [0.5, 0.5]
+velocity = [2.5, 5.0]
+mass = 0.2
+"""
+
+
+def _toss_spec(tmp_path: Path, **change: object) -> dict[str, object]:
+    (tmp_path / "toss.toml").write_text(TOSS, encoding="utf-8")
+    scene = {
+        "name": "toss.toml",
+        "effects": ["linear_drag:c=0.1"],
+        "unknowns": ["gravity", "linear_drag.c=0:0.5+camera.scale"],
+    }
+    return {"estimators": ["random"], "seeds": 2, "iterations": 2, "scenes": [scene], **change}
+
+
+def test_scene_level_unknowns_and_effects_in_a_spec(tmp_path: Path) -> None:
+    from physbench.api import sweep
+
+    spec = parse_spec(_toss_spec(tmp_path), base=tmp_path)
+    cells = spec.cells()
+    assert [c.config.params for c in cells[::2]] == [
+        ("gravity",),
+        ("linear_drag.c=0:0.5", "camera.scale"),
+    ]
+    assert {c.config.effects for c in cells} == {("linear_drag:c=0.1",)}
+    table = sweep(spec, tmp_path / "out", executor="serial").table
+    assert len(table) == 4 * 2 and (table["status"] == "ok").all()  # 4 cells, 2 iterations each
+    keys = {k for p in table["params"] for k in json.loads(p)}
+    assert keys == {"gravity", "linear_drag.c", "camera.scale"}
+    assert table["best_nmse"].notna().all()  # the truth of every scene-level unknown is known
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (
+            {"estimators": ["resnet3d"]},
+            "estimator 'resnet3d' corrects one marked body at a time, so it cannot fit gravity",
+        ),
+        (
+            {"observer": "camera"},
+            "an observer camera films the scene's own physics with its true calibration; it "
+            "cannot show linear_drag:c=0.1",
+        ),
+        ({"effects": "linear_drag"}, None),
+    ],
+)
+def test_a_spec_refuses_what_its_estimators_or_observers_cannot_take(
+    tmp_path: Path, change: dict[str, object], message: str | None
+) -> None:
+    data = _toss_spec(tmp_path, **change)
+    if message is None:  # a top-level default for scenes that list none
+        data["scenes"] = [{"name": "toss.toml", "unknowns": ["linear_drag.c"]}]
+        assert parse_spec(data, base=tmp_path).cells()[0].config.effects == ("linear_drag",)
+        return
+    with pytest.raises(SpecError, match=message):
+        parse_spec(data, base=tmp_path)

@@ -122,7 +122,6 @@ def test_cli_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
             "cannot write results there",
         ),
         ([str(spec), "--executor", "serial", "--address", "tcp://x:1"], "needs --executor dask"),
-        ([str(spec), "--workers", "0"], "--workers 0: expected a whole number >= 1"),
     ]
     for argv, message in cases:
         if "--out" not in argv:
@@ -331,3 +330,52 @@ def test_a_sweep_this_machine_cannot_finish_is_refused_at_once(
     assert err.startswith("physbench bench: error: this sweep (2000000 cells, 2 at a time; ")
     assert "of compute, more than the 24 h limit; make the seeds, estimators, axes or " in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_sweep_whose_every_cell_fails_exits_non_zero(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 28: every cell failed, yet ``bench`` exited 0."""
+    from physbench import experiment
+
+    def broken(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("no simulation today")
+
+    monkeypatch.setattr(experiment, "run_config", broken)
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "s"\nestimators = ["random"]\nseeds = 2\niterations = 1\nresolution = 16\n'
+        'scenes = ["three_circles"]\n'
+    )
+    argv = ["bench", str(spec), "--out", str(tmp_path / "o"), "--executor", "serial"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "physbench bench: error: sweep 's': all 2 cells failed" in err
+    assert "RuntimeError: no simulation today" in err
+
+
+def test_a_shipped_example_runs_by_name(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 28: the quick start's benchmarks/smoke.toml does not exist for a wheel user."""
+    from physbench.bench.spec import load_spec
+    from physbench.examples import example_names, example_path
+
+    assert "smoke" in example_names()
+    spec = load_spec(example_path("smoke"))
+    assert spec.name == "smoke" and len(spec.cells()) == 240
+    for argv, message in (
+        (["--example", "nope"], "unknown example spec 'nope'; known example specs: smoke"),
+        ([str(example_path("smoke")), "--example", "smoke"], "not both"),
+        ([], "give a sweep spec file"),
+    ):
+        assert main(["bench", *argv, "--out", str(tmp_path / "o")]) == 2
+        assert message in capsys.readouterr().err
+
+
+def test_the_shipped_smoke_spec_is_the_benchmarks_one() -> None:
+    import tomllib
+
+    from physbench.examples import example_path
+
+    root = Path(__file__).resolve().parents[2]
+    shipped = tomllib.loads(example_path("smoke").read_text(encoding="utf-8"))
+    assert shipped == tomllib.loads((root / "benchmarks" / "smoke.toml").read_text("utf-8"))

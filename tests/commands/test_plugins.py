@@ -211,3 +211,88 @@ def test_a_plugin_calling_sys_exit_at_import_is_recorded_as_failed(
     finally:
         reset_registry()
         sys.modules.pop("pb_quitter", None)
+
+
+# ------------------------------------------------ issue 28: failures shown where they matter
+
+
+@pytest.fixture
+def fresh_registry(monkeypatch: pytest.MonkeyPatch):  # type: ignore[no-untyped-def]
+    """Rebuild the registry for the environment a test sets, and after it."""
+    from physbench.plugins import reset_registry
+
+    reset_registry()
+    yield monkeypatch
+    reset_registry()
+
+
+def test_an_unknown_name_says_which_plugin_failed_to_load_and_why(
+    capsys: pytest.CaptureFixture[str], fresh_registry: pytest.MonkeyPatch
+) -> None:
+    """``PHYSBENCH_PLUGINS=badsq physbench run --renderer badsq`` said only "unknown renderer"."""
+    fresh_registry.setenv("PHYSBENCH_PLUGINS", "badsq")
+    assert main(["run", "--renderer", "badsq", "--iterations", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown renderer 'badsq'; known renderers: camera, raster" in err
+    assert (
+        "1 plugin failed to load and may have provided it: badsq (named in PHYSBENCH_PLUGINS): "
+        "ModuleNotFoundError: No module named 'badsq' (see `physbench plugins`)"
+    ) in err
+
+
+def test_no_failure_no_hint(
+    capsys: pytest.CaptureFixture[str], fresh_registry: pytest.MonkeyPatch
+) -> None:
+    fresh_registry.delenv("PHYSBENCH_PLUGINS", raising=False)
+    assert main(["run", "--renderer", "badsq", "--iterations", "1"]) == 2
+    assert "failed to load" not in capsys.readouterr().err
+
+
+SHADOW = """
+from physbench.hookspecs import hookimpl
+from physbench.render.raster import RasterRenderer
+
+class Shadow(RasterRenderer):
+    name = "raster"
+
+@hookimpl
+def register_renderers():
+    return [Shadow]
+"""
+
+
+def test_a_plugin_shadowed_by_a_builtin_is_named_once_in_run(
+    capsys: pytest.CaptureFixture[str],
+    plugin,  # type: ignore[no-untyped-def]
+) -> None:
+    """A plugin's renderer called ``raster`` was silently ignored by ``run``."""
+    plugin("pb_shadow", SHADOW)
+    assert main(["run", "--iterations", "2", "--resolution", "16", "--estimator", "random"]) == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert warned == [
+        "physbench run: warning: renderer 'raster' is physbench's own; the one of plugin "
+        "'pb_shadow' (PHYSBENCH_PLUGINS -) is ignored: rename it in that package or uninstall it"
+    ]
+
+
+@pytest.mark.parametrize("json_flag", [[], ["--json"]])
+def test_plugins_check_fails_on_a_failed_plugin_or_a_conflict(
+    capsys: pytest.CaptureFixture[str],
+    fresh_registry: pytest.MonkeyPatch,
+    plugin,  # type: ignore[no-untyped-def]
+    json_flag: list[str],
+) -> None:
+    fresh_registry.delenv("PHYSBENCH_PLUGINS", raising=False)
+    assert main(["plugins", "--check", *json_flag]) == 0  # built-ins alone pass
+    capsys.readouterr()
+    fresh_registry.setenv("PHYSBENCH_PLUGINS", "badsq")
+    from physbench.plugins import reset_registry
+
+    reset_registry()
+    assert main(["plugins", *json_flag]) == 0  # a listing without --check
+    assert main(["plugins", "--check", *json_flag]) == 1
+    err = capsys.readouterr().err
+    assert "physbench plugins: check failed: 1 plugin failed to load, 0 name conflicts" in err
+    plugin("pb_shadow", SHADOW)  # a conflict alone, with no failure
+    assert main(["plugins", "--check", *json_flag]) == 1
+    assert "0 plugins failed to load, 1 name conflict" in capsys.readouterr().err

@@ -17,7 +17,11 @@ def test_scenes_lists_unknowns(capsys) -> None:
         "ball_drop",
     ):
         assert name in out
-    assert "unknown mass:" in out
+    # issue 28: every range says its unit
+    assert "unknown mass (kg): a [2, 8], b [2, 8]" in out
+    assert "unknown moment (kg·m²): arm [1e-05, 0.001]" in out
+    assert "unknown elasticity (dimensionless): a [0.4, 1], b [0.4, 1]" in out
+    assert all("(" in line for line in out.splitlines() if line.strip().startswith("unknown "))
 
 
 def test_toml_of_one_scene_round_trips(capsys) -> None:  # type: ignore[no-untyped-def]

@@ -16,7 +16,8 @@ from physbench.cli import main
         (["--params", "mass", "--renderer", "nope"], "unknown renderer 'nope'"),
         (
             ["--params", "mass", "-R", "colour=red"],
-            "renderer 'raster' (physbench's own) does not take option 'colour'; its options: none",
+            "renderer 'raster' (physbench's own) has no option 'colour'; the options -R can set: "
+            "none",
         ),
         (["--params", "mass", "--widths", "1,2"], "--widths '1,2': expected 4 positive integers"),
         (["--params", "mass", "--resolution", "4096"], "--resolution 4096: expected 8..512"),

@@ -20,15 +20,16 @@ from physbench.cli import COMMANDS, build_parser, main
 from physbench.unknowns import split_params
 
 #: commands that write files: all take --out for their result
-WRITERS = {"run", "simulate", "track", "train", "bench", "plot", "discover"}
+WRITERS = {"run", "simulate", "track", "train", "bench", "plot", "discover", "datasets"}
 #: the only other flags that name a file or folder to write
 NAMED_OUTPUTS = {"--preview", "--plot", "--report", "--plate", "--track-out", "--save-observation"}
 #: listings, instant, that print only their result
-LISTINGS = {"scenes", "plugins"}
+LISTINGS = {"scenes", "plugins", "datasets"}
 #: commands with --json, and what it prints
 JSON = {"run", "discover", "plugins"}
-#: --scene is required where it must describe given data, else defaults to three_circles
-SCENE_REQUIRED = {"track": True, "discover": True, "run": False, "simulate": False, "train": False}
+#: --scene is required where it must describe given data, else defaults to three_circles;
+#: discover needs it with a RECORDING, not with a shipped --dataset (which brings its scenes)
+SCENE_REQUIRED = {"track": True, "discover": None, "run": False, "simulate": False, "train": False}
 
 
 def subparser(name: str) -> argparse.ArgumentParser:
@@ -76,6 +77,7 @@ REQUIRED: dict[str, list[str]] = {
     "bench": ["spec.toml", "--out", "o"],
     "plot": ["o"],
     "compare": ["a", "b"],
+    "datasets": [],
     "discover": ["r.csv", "--scene", "s.toml"],
     "track": ["v.mp4", "--scene", "s.toml", "--out", "r.csv"],
 }
@@ -96,8 +98,10 @@ def test_json_is_a_switch_for_stdout(name: str) -> None:
 def test_scene_takes_a_name_or_a_toml_file(name: str) -> None:
     action = options(name)["--scene"]
     assert action.metavar == "NAME|FILE" and ".toml file" in action.help
-    assert action.required is SCENE_REQUIRED[name]
-    if not action.required:
+    assert action.required is bool(SCENE_REQUIRED[name])
+    if SCENE_REQUIRED[name] is None:
+        assert action.default is None and "required with RECORDING" in action.help
+    elif not action.required:
         assert action.default is None and "(default: three_circles)" in action.help
     rest = [a for a in REQUIRED[name] if a not in ("--scene", "s.toml")]
     for value in ("ball_drop", "drop.toml"):
@@ -249,6 +253,9 @@ def test_plot_reports_its_stages_and_echoes_its_files(
     assert written and all(Path(p).is_file() for p in written)
     assert {str(out / "report.html"), str(out / "win_rate.csv")} <= set(written)
     assert captured.out.count("\n") == 1  # the summary line only
+    assert main([*argv, "-q"]) == 0  # quiet: the summary line alone, no 'wrote' lines
+    captured = capsys.readouterr()
+    assert captured.err == "" and captured.out.count("\n") == 1, captured
 
 
 def test_train_is_quiet_in_a_pipe_and_says_where_it_resumes(
@@ -281,16 +288,25 @@ def test_run_echoes_every_file_it_writes(
     # the plot goes into a folder that does not exist yet: it is created
     plot, out, obs = tmp_path / "new" / "c.png", tmp_path / "h.json", tmp_path / "o.npz"
     argv = [*RUN, "--plot", str(plot), "--out", str(out), "--save-observation", str(obs)]
-    assert main([*argv, "-q"]) == 0
+    assert main(argv) == 0
     captured = capsys.readouterr()
     for path in (plot, out, obs):
         assert path.is_file() and f"wrote {path}\n" in captured.err
     assert "wrote" not in captured.out  # stdout holds only the result
     assert json.loads(out.read_text())["iterations"]
-
-
-def test_simulate_echoes_on_stderr(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    out = tmp_path / "s.npz"
-    assert main(["simulate", "--out", str(out), "--resolution", "16", "-q"]) == 0
+    assert main([*argv, "-q"]) == 0  # quiet: the final line alone
     captured = capsys.readouterr()
-    assert captured.out == "" and captured.err == f"wrote {out}\n"
+    assert captured.err == "" and captured.out.startswith("normalized min MSE after 3 iterations")
+    assert captured.out.count("\n") == 1
+
+
+def test_simulate_echoes_on_stderr_and_is_silent_with_q(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "s.npz"
+    assert main(["simulate", "--out", str(out), "--resolution", "16"]) == 0
+    captured = capsys.readouterr()
+    assert f"wrote {out}" not in captured.out and captured.err == f"wrote {out}\n"
+    out.unlink()
+    assert main(["simulate", "--out", str(out), "--resolution", "16", "-q"]) == 0
+    assert capsys.readouterr() == ("", "") and out.is_file()

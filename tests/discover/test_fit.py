@@ -93,3 +93,27 @@ def test_discovery_fits_run_through_the_loops_guarded_driver(plugin, slide, nois
     model = start_model(problem_for(runs, "pymunk", settings), settings)
     with pytest.raises(EstimatorError, match=r"estimator 'wild' proposed .* = 1000000000\.0 in"):
         estimator_fit(model, model.free_keys()[:1], "wild", iterations=3)
+
+
+class _Residuals:
+    """A stand-in model whose held-out residuals are given."""
+
+    def __init__(self, r: list[float]) -> None:
+        self.r = np.asarray(r)
+
+    def residuals(self, part: str) -> np.ndarray:
+        return self.r
+
+
+@pytest.mark.parametrize(("r", "says"), [([1e300, 1.0], "residuals is inf"), ([], "no held-out")])
+def test_a_held_out_error_that_is_no_number_says_why_without_warnings(
+    r: list[float], says: str
+) -> None:
+    import warnings
+
+    from physbench.discover.fit import score
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's overflow would raise here
+        scored = score("base", (), _Residuals(r), None)  # type: ignore[arg-type]
+    assert not np.isfinite(scored.heldout) and says in scored.failure, scored.failure

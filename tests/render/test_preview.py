@@ -116,3 +116,28 @@ def test_the_scale_bar_takes_a_round_length_of_at_most_a_quarter_of_the_width(
     width: float, length: float
 ) -> None:
     assert scale_length(width) == pytest.approx(length)
+
+
+@pytest.mark.parametrize("suffix", [".gif", ".png"])
+def test_simulate_previews_with_the_chosen_renderer(tmp_path, suffix: str) -> None:
+    from PIL import Image
+
+    from physbench.cli import main
+
+    def picture(*argv: str) -> np.ndarray:
+        path = tmp_path / f"p{len(argv)}{suffix}"
+        assert main(["simulate", "--resolution", "16", "-q", "--preview", str(path), *argv]) == 0
+        with Image.open(path) as im:
+            return np.asarray(im.convert("RGB"), dtype=float)
+
+    raster = picture()
+    camera = picture("--renderer", "camera", "-R", "noise=0")
+
+    # The raster preview draws bodies on white; the camera's is its own footage, a textured wall
+    # (white only in the caption band below it).
+    def white(img: np.ndarray) -> float:
+        return float((img == 255).all(axis=2).mean())
+
+    assert white(raster) > 0.6 and white(camera) < 0.3, (white(raster), white(camera))
+    if suffix == ".png":  # snapshots side by side, each as wide as the preview
+        assert camera.shape[1] > 2 * raster.shape[1]

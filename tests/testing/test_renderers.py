@@ -23,6 +23,7 @@ from physbench.testing.renderers import (
     check_bad_options,
     check_channel_layout,
     check_deterministic,
+    check_follows_trajectory,
     check_frames,
     check_marking,
     check_out,
@@ -81,6 +82,21 @@ class BlobRenderer(Renderer):
             return frames
         out[...] = frames
         return out
+
+
+class InitialPoseOnly(BlobRenderer):
+    """Draws every frame at the trajectory's first pose: a still picture of frame 0."""
+
+    def draw(self, scene: Scene, traj: Trajectory, focus: str | None) -> np.ndarray:
+        still = np.repeat(traj.states[:1], traj.frames, axis=0)
+        return super().draw(scene, Trajectory(traj.bodies, traj.times, still), focus)
+
+
+class UpsideDown(BlobRenderer):
+    """Puts the world's y = ymin in the top row: a picture flipped upside down."""
+
+    def draw(self, scene: Scene, traj: Trajectory, focus: str | None) -> np.ndarray:
+        return np.ascontiguousarray(super().draw(scene, traj, focus)[:, :, ::-1])
 
 
 class WrongShape(BlobRenderer):
@@ -304,7 +320,8 @@ def test_checks_follow_the_declared_modes() -> None:
             CachesByFrameCount,
             check_deterministic,
             "rendering the probe scene after rendering another scene changes the frames",
-            ("check_marking", "check_channel_layout"),  # lone renders come from the cache too
+            # lone renders and the moving disc's poses come from the cache too
+            ("check_marking", "check_channel_layout", "check_follows_trajectory"),
         ),
         (IgnoresOut, check_out, r"render\(out=buffer\) returned a new array", ()),
         (KeepsStalePixels, check_out, "differ from a plain render", ()),
@@ -349,6 +366,22 @@ def test_checks_follow_the_declared_modes() -> None:
             SquareOnlyWithoutRenderError,
             check_shape,
             r"resolution=\(20, 28\) raised TypeError: .*raise physbench.render.base.RenderError",
+            (),
+        ),
+        (
+            InitialPoseOnly,
+            check_follows_trajectory,
+            r"mode 'mark': the last frame of a disc moving from \(1.0, 1.5\) to \(1.6, 2.1\) m "
+            r"is no nearer the disc resting at \(1.6, 2.1\) \(mean difference 0.0\d+\) than at "
+            r"\(1.0, 1.5\) \(0\); each frame must show the trajectory's pose",
+            (),
+        ),
+        (
+            UpsideDown,
+            check_follows_trajectory,
+            r"mode 'mark': a disc moved right and up from \(1.0, 1.5\) to \(1.6, 2.1\) m, but its "
+            r"picture moved \+\d\.\d columns and \+\d\.\d rows; columns must grow with x and rows "
+            "shrink with y",
             (),
         ),
         (RgbHidesBlock, check_frames, "mode 'rgb': body 'block' does not show", ()),

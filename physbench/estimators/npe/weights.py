@@ -7,12 +7,17 @@ searched first (a separate variable: resnet3d would warn about every npe sidecar
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any
 
 from physbench.errors import PhysbenchError
-from physbench.estimators.resnet3d.weights import read, read_sidecar, save
+from physbench.estimators.resnet3d.weights import (
+    empty_folder,
+    named_dirs,
+    read,
+    read_sidecar,
+    save,
+)
 
 __all__ = ["SHIPPED", "find", "load", "save"]
 
@@ -20,32 +25,54 @@ SHIPPED = Path(__file__).with_name("weights")
 
 
 def search_dirs() -> list[Path]:
-    extra = [Path(p) for p in os.environ.get("PHYSBENCH_NPE_WEIGHTS", "").split(os.pathsep) if p]
-    return [*extra, SHIPPED]
+    return [*named_dirs("PHYSBENCH_NPE_WEIGHTS"), SHIPPED]
 
 
 def find(scene: str, params: tuple[str, ...]) -> Path:
     """The first npe weights trained for ``scene`` and exactly the unknowns ``params``; called by
-    the estimator's start when no ``weights`` option names a file."""
+    the estimator's start when no ``weights`` option names a file. A ``PHYSBENCH_NPE_WEIGHTS``
+    folder without any npe weights is an error, not a silent fall-back to the shipped ones."""
     want = sorted(params)
+    named = named_dirs("PHYSBENCH_NPE_WEIGHTS")
+    found: list[tuple[Path, dict[str, Any]]] = []
+    for d in [*named, SHIPPED]:
+        here, skipped = _scan(d)
+        if not here and d in named:
+            raise empty_folder(
+                "PHYSBENCH_NPE_WEIGHTS", d, "npe", skipped, "physbench train --posterior"
+            )
+        found += here
     have = []
-    for d in search_dirs():
-        for side in sorted(d.glob("*.json")) if d.is_dir() else []:
-            try:
-                meta = read_sidecar(side)
-            except PhysbenchError:
-                continue
-            if meta.get("kind") != "npe" or not side.with_suffix(".safetensors").is_file():
-                continue
-            trained = meta.get("data", {})
-            have.append(f"{trained.get('scene')}[{'+'.join(trained.get('params', []))}]")
-            if trained.get("scene") == scene and sorted(trained.get("params", [])) == want:
-                return side.with_suffix(".safetensors")
+    for path, trained in found:
+        have.append(f"{trained.get('scene')}[{'+'.join(trained.get('params', []))}]")
+        if trained.get("scene") == scene and sorted(trained.get("params", [])) == want:
+            return path
     raise PhysbenchError(
         f"no npe weights for scene {scene!r} with parameters {'+'.join(want)}; available: "
         f"{', '.join(have) or 'none'}. Train them with `physbench train --posterior --scene "
         f"{scene} --params {','.join(want)}` and put the output folder on PHYSBENCH_NPE_WEIGHTS."
     )
+
+
+def _scan(folder: Path) -> tuple[list[tuple[Path, dict[str, Any]]], list[str]]:
+    """The npe weights in ``folder`` (path, the sidecar's ``data``), and why each other pair
+    there was passed over."""
+    found, skipped = [], []
+    for side in sorted(folder.glob("*.json")) if folder.is_dir() else []:
+        st = side.with_suffix(".safetensors")
+        if not st.is_file():
+            continue
+        try:
+            meta = read_sidecar(side)
+        except PhysbenchError as exc:
+            skipped.append(f"{str(st)!r}: {exc}")
+            continue
+        if meta.get("kind") != "npe":
+            skipped.append(f"{str(st)!r}: its sidecar's kind is {meta.get('kind')!r}, not 'npe'")
+            continue
+        trained = meta.get("data")
+        found.append((st, trained if isinstance(trained, dict) else {}))
+    return found, skipped
 
 
 def load(path: str | Path) -> tuple[list[Any], dict[str, Any]]:

@@ -44,6 +44,8 @@ _DATA_KEYS = _DATA_REQUIRED | {
     "scene_options",
     "blur_max",
     "blur_prob",
+    "near",
+    "near_scale",
 }
 
 
@@ -170,6 +172,10 @@ def _data(c: _Check, data: object) -> tuple[str, ...]:
         c.number(d["blur_max"], "data.blur_max", 0.0, math.inf)
     if "blur_prob" in d:
         c.number(d["blur_prob"], "data.blur_prob", 0.0, 1.0)
+    if "near" in d:
+        c.number(d["near"], "data.near", 0.0, 1.0)
+    if "near_scale" in d:
+        c.number(d["near_scale"], "data.near_scale", 0.0, 1.0)
     return tuple(params)
 
 

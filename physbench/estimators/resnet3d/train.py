@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -42,7 +42,11 @@ class TrainConfig:
     device: str = "cpu"  # "cuda" trains on a GPU; the weights are the same either way
     # Wall-clock budget of this session (0 = none); training stops at whichever budget ends first.
     minutes: float = 0.0
-    init: str = ""  # start from these weights (fine-tuning) instead of a fresh network
+    # Start from these weights (fine-tuning) instead of a fresh network. Their widths, blocks,
+    # dropout and outputs must be this network's; resolution and frames may differ (convolutions
+    # and a global average pool: the same tensors take any input size). Training then draws its
+    # scene instances after the ones those weights were trained on.
+    init: str = ""
 
     def __post_init__(self) -> None:
         for name, low, high in (
@@ -92,6 +96,50 @@ def _ranges(spec: DataSpec) -> dict[str, list[float]]:
     return {u.name: [u.low, u.high] for u in space.unknowns}
 
 
+def init_groups(meta: dict[str, Any]) -> int:
+    """Training groups to skip when fine-tuning from weights whose sidecar is ``meta``: those
+    weights' own training drew groups from the start, one group per sample seen at most (a group
+    holds many samples), plus the groups their own ``--init`` skipped; 0 where the sidecar does
+    not say."""
+    t = meta.get("training")
+    if not isinstance(t, dict):
+        return 0
+    n = 0
+    for key in ("first_group", "samples_seen"):
+        v = t.get(key, 0)
+        if isinstance(v, int) and not isinstance(v, bool) and v > 0:
+            n += v
+    return n
+
+
+def _init(path: str, net: Any, net_cfg: NetConfig, load: bool) -> int:
+    """``--init``: check that the weights at ``path`` fit ``net_cfg`` (only the input's resolution
+    and frames may differ), load them into ``net`` where ``load`` (not when a checkpoint will
+    replace them), and return the first training group (:func:`init_groups`)."""
+    state, meta = weights.load(path)
+    same_input = {"resolution": net_cfg.resolution, "frames": net_cfg.frames}
+    if replace(NetConfig.from_dict(meta["net"]), **same_input) != net_cfg:
+        raise PhysbenchError(
+            f"--init {path!r} has architecture {meta['net']}, expected {net_cfg.to_dict()} "
+            "(only resolution and frames may differ)"
+        )
+    if load:
+        net.load_state_dict({k: v.float() for k, v in state.items()})
+    return init_groups(meta)
+
+
+def _starting_point(
+    net: Any, vx: np.ndarray, vy: np.ndarray, out: Path, history: list[dict[str, Any]]
+) -> float:
+    """A fine-tune's starting point on this run's validation set: its curve's origin, and the best
+    so far (saved as such), so that a fine-tune that only gets worse keeps the weights it started
+    from. Returns that validation error."""
+    val = evaluate_net(net, vx, vy)
+    history.append({"samples": 0, "train_loss": None, "val_mse": val, "wall_s": 0.0})
+    weights.save(out / "best.safetensors", dict(net.state_dict()), {"samples": 0, "val_mse": val})
+    return val
+
+
 def _optimizer_tensors(opt: Any) -> tuple[dict[str, Any], dict[str, Any]]:
     sd = opt.state_dict()
     tensors = {f"opt.{i}.{k}": v for i, st in sd["state"].items() for k, v in st.items()}
@@ -135,6 +183,156 @@ def evaluate_net(net: Any, x: np.ndarray, y: np.ndarray, batch: int = 64) -> flo
     return err / y.size
 
 
+@dataclass
+class _Session:
+    """A training session's state: the net and optimiser on their device, and how far training
+    got (samples seen, best validation MSE, learning curve, wall seconds of earlier sessions)."""
+
+    net: Any
+    opt: Any
+    device: Any
+    checkpoint: Path
+    first_group: int = 0
+    seen: int = 0
+    best: float = float("inf")
+    history: list[dict[str, Any]] = field(default_factory=list)
+    wall0: float = 0.0
+
+
+def _start(net_cfg: NetConfig, cfg: TrainConfig, out: Path, resume: bool) -> _Session:
+    """The net and optimiser, from ``cfg.init`` weights or a checkpoint in ``out`` when resuming
+    (its optimiser state, samples, curve and time included)."""
+    import torch
+
+    if cfg.threads:
+        torch.set_num_threads(cfg.threads)
+    torch.manual_seed(cfg.seed)
+    device = torch.device(cfg.device)
+    if device.type == "cuda":
+        torch.backends.cudnn.benchmark = True
+    net = build_net(net_cfg).to(device)
+    opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    s = _Session(net, opt, device, out / "checkpoint.safetensors")
+    resuming = resume and s.checkpoint.is_file()
+    # Training groups start here: after the groups the --init weights saw.
+    s.first_group = _init(cfg.init, net, net_cfg, not resuming) if cfg.init else 0
+    if resuming:
+        tensors, meta = weights.read(s.checkpoint)
+        net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
+        _load_optimizer(
+            opt, {k: v for k, v in tensors.items() if k.startswith("opt.")}, meta["optimizer"]
+        )
+        s.seen, s.best, s.history, s.wall0 = (
+            meta["samples"],
+            meta["best_val"],
+            meta["history"],
+            meta["wall_s"],
+        )
+    return s
+
+
+def _save_checkpoint(s: _Session, out: Path, val: float, ema: float, wall: float) -> None:
+    """Record a validation point on the curve, keep the best weights, write the checkpoint."""
+    s.history.append(
+        {"samples": s.seen, "train_loss": ema, "val_mse": val, "wall_s": round(wall, 1)}
+    )
+    if val < s.best:
+        s.best = val
+        weights.save(
+            out / "best.safetensors", dict(s.net.state_dict()), {"samples": s.seen, "val_mse": val}
+        )
+    tensors, groups = _optimizer_tensors(s.opt)
+    weights.save(
+        s.checkpoint,
+        {**{f"net.{k}": v for k, v in s.net.state_dict().items()}, **tensors},
+        {
+            "samples": s.seen,
+            "best_val": s.best,
+            "history": s.history,
+            "wall_s": wall,
+            "optimizer": groups,
+        },
+    )
+
+
+def _optimise(
+    s: _Session,
+    spec: DataSpec,
+    cfg: TrainConfig,
+    validation: tuple[np.ndarray, np.ndarray],
+    out: Path,
+    progress: bool,
+) -> None:
+    """Train until :func:`progress_fraction` reaches 1, validating and checkpointing every
+    ``cfg.eval_every`` samples and at the end."""
+    import torch
+    from tqdm import tqdm
+
+    loader = torch.utils.data.DataLoader(
+        _pairs_dataset(spec, s.first_group + s.seen),
+        batch_size=cfg.batch,
+        num_workers=cfg.workers,
+        persistent_workers=cfg.workers > 0,
+        prefetch_factor=4 if cfg.workers else None,
+        pin_memory=s.device.type == "cuda",
+    )
+    bar = tqdm(
+        total=cfg.samples, initial=s.seen, disable=not progress, unit="sample", dynamic_ncols=True
+    )
+    t0, ema, next_eval = time.perf_counter(), 0.0, s.seen + cfg.eval_every
+    s.net.train()
+    it = iter(loader)
+    first = True
+    while progress_fraction(cfg, s.seen, s.wall0 + time.perf_counter() - t0) < 1.0:
+        x, y = next(it)
+        x, y = x.to(s.device, non_blocking=True), y.to(s.device, non_blocking=True)
+        for group in s.opt.param_groups:
+            group["lr"] = learning_rate(cfg, s.seen, s.wall0 + time.perf_counter() - t0)
+        loss = torch.nn.functional.mse_loss(s.net(x), y)
+        s.opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(s.net.parameters(), 1.0)
+        s.opt.step()
+        s.seen += len(x)
+        ema = loss.item() if first else 0.98 * ema + 0.02 * loss.item()
+        first = False
+        bar.update(len(x))
+        wall = s.wall0 + time.perf_counter() - t0
+        if s.seen >= next_eval or progress_fraction(cfg, s.seen, wall) >= 1.0:
+            next_eval += cfg.eval_every
+            val = evaluate_net(s.net, *validation)
+            _save_checkpoint(s, out, val, ema, s.wall0 + time.perf_counter() - t0)
+        rate = bar.format_dict.get("rate") or 0
+        bar.set_postfix(loss=f"{ema:.4f}", val=f"{s.best:.4f}", rate=f"{rate:.0f}/s")
+    bar.close()
+
+
+def _sidecar(s: _Session, spec: DataSpec, net_cfg: NetConfig, cfg: TrainConfig) -> dict[str, Any]:
+    """What the shipped weights record: the data, the net, the ranges, the training run."""
+    import torch
+
+    import physbench
+
+    return {
+        "scene": spec.instance(0).name,  # what the estimator looks weights up by
+        "data": spec.to_dict(),
+        "net": net_cfg.to_dict(),
+        "ranges": _ranges(spec),
+        "normalization": "target = (p_observed - p_simulated) / (high - low), per parameter of "
+        "the marked body",
+        "training": {
+            **asdict(cfg),
+            "first_group": s.first_group,
+            "samples_seen": s.seen,
+            "wall_s": round(s.history[-1]["wall_s"], 1) if s.history else 0.0,
+        },
+        "val_mse": s.best,
+        "history": s.history,
+        "physbench_version": physbench.__version__,
+        "torch_version": torch.__version__,
+    }
+
+
 def train(
     spec: DataSpec,
     net_cfg: NetConfig,
@@ -145,131 +343,23 @@ def train(
     progress: bool = True,
 ) -> tuple[Path, dict[str, Any]]:
     """Train (or resume) into ``out``; returns the final weights path and its sidecar."""
-    import torch
-    from tqdm import tqdm
-
-    import physbench
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    if cfg.threads:
-        torch.set_num_threads(cfg.threads)
-    torch.manual_seed(cfg.seed)
-    device = torch.device(cfg.device)
-    if device.type == "cuda":
-        torch.backends.cudnn.benchmark = True
-    net = build_net(net_cfg).to(device)
-    opt = torch.optim.AdamW(net.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
-    ckpt = out / "checkpoint.safetensors"
-    seen, best, history, wall0 = 0, float("inf"), [], 0.0
-    if cfg.init and not (resume and ckpt.is_file()):
-        state, meta = weights.load(cfg.init)
-        if NetConfig.from_dict(meta["net"]) != net_cfg:
-            raise PhysbenchError(
-                f"--init {cfg.init!r} has architecture {meta['net']}, expected {net_cfg.to_dict()}"
-            )
-        net.load_state_dict({k: v.float() for k, v in state.items()})
-    if resume and ckpt.is_file():
-        tensors, meta = weights.read(ckpt)
-        net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
-        _load_optimizer(
-            opt, {k: v for k, v in tensors.items() if k.startswith("opt.")}, meta["optimizer"]
-        )
-        seen, best, history, wall0 = (
-            meta["samples"],
-            meta["best_val"],
-            meta["history"],
-            meta["wall_s"],
-        )
-    if cfg.minutes > 0 and wall0 > 0:
+    s = _start(net_cfg, cfg, out, resume)
+    if cfg.minutes > 0 and s.wall0 > 0:
         # ``minutes`` is this session's budget: the time horizon of the schedule ends that long
         # after what earlier sessions spent (their time counted against it, a resumed run with
         # --minutes 10 after 10 minutes stopped at once).
-        cfg = replace(cfg, minutes=cfg.minutes + wall0 / 60.0)
+        cfg = replace(cfg, minutes=cfg.minutes + s.wall0 / 60.0)
     vx, vy = validation_set(spec, cfg.val_groups)
-    loader = torch.utils.data.DataLoader(
-        _pairs_dataset(spec, seen),
-        batch_size=cfg.batch,
-        num_workers=cfg.workers,
-        persistent_workers=cfg.workers > 0,
-        prefetch_factor=4 if cfg.workers else None,
-        pin_memory=device.type == "cuda",
-    )
-    bar = tqdm(
-        total=cfg.samples, initial=seen, disable=not progress, unit="sample", dynamic_ncols=True
-    )
-    t0, ema, next_eval = time.perf_counter(), None, seen + cfg.eval_every
-    net.train()
-    it = iter(loader)
-    while progress_fraction(cfg, seen, wall0 + time.perf_counter() - t0) < 1.0:
-        x, y = next(it)
-        x, y = x.to(device, non_blocking=True), y.to(device, non_blocking=True)
-        wall = wall0 + time.perf_counter() - t0
-        for group in opt.param_groups:
-            group["lr"] = learning_rate(cfg, seen, wall)
-        loss = torch.nn.functional.mse_loss(net(x), y)
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(net.parameters(), 1.0)
-        opt.step()
-        seen += len(x)
-        value = loss.item()
-        ema = value if ema is None else 0.98 * ema + 0.02 * value
-        bar.update(len(x))
-        if (
-            seen >= next_eval
-            or progress_fraction(cfg, seen, wall0 + time.perf_counter() - t0) >= 1.0
-        ):
-            next_eval += cfg.eval_every
-            val = evaluate_net(net, vx, vy)
-            wall = wall0 + time.perf_counter() - t0
-            history.append(
-                {"samples": seen, "train_loss": ema, "val_mse": val, "wall_s": round(wall, 1)}
-            )
-            if val < best:
-                best = val
-                weights.save(
-                    out / "best.safetensors",
-                    dict(net.state_dict()),
-                    {"samples": seen, "val_mse": val},
-                )
-            tensors, groups = _optimizer_tensors(opt)
-            weights.save(
-                ckpt,
-                {**{f"net.{k}": v for k, v in net.state_dict().items()}, **tensors},
-                {
-                    "samples": seen,
-                    "best_val": best,
-                    "history": history,
-                    "wall_s": wall,
-                    "optimizer": groups,
-                },
-            )
-        bar.set_postfix(
-            loss=f"{ema:.4f}", val=f"{best:.4f}", rate=f"{bar.format_dict.get('rate') or 0:.0f}/s"
-        )
-    bar.close()
+    if cfg.init and s.seen == 0:
+        s.best = _starting_point(s.net, vx, vy, out, s.history)
+    _optimise(s, spec, cfg, (vx, vy), out, progress)
     best_state, _ = weights.read(out / "best.safetensors")
-    meta = {
-        "scene": spec.instance(0).name,  # what the estimator looks weights up by
-        "data": spec.to_dict(),
-        "net": net_cfg.to_dict(),
-        "ranges": _ranges(spec),
-        "normalization": "target = (p_observed - p_simulated) / (high - low), per parameter of "
-        "the marked body",
-        "training": {
-            **asdict(cfg),
-            "samples_seen": seen,
-            "wall_s": round(history[-1]["wall_s"], 1) if history else 0.0,
-        },
-        "val_mse": best,
-        "history": history,
-        "physbench_version": physbench.__version__,
-        "torch_version": torch.__version__,
-    }
+    meta = _sidecar(s, spec, net_cfg, cfg)
     # Shipped weights are int8 per output channel (a quarter of the size; loading dequantises).
     final = weights.save(
         out / weights_name(spec), weights.quantize(best_state), {**meta, "storage": weights.INT8}
     )
-    (out / "train_log.json").write_text(json.dumps(history, indent=1))
+    (out / "train_log.json").write_text(json.dumps(s.history, indent=1))
     return final, meta

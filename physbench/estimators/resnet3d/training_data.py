@@ -47,6 +47,12 @@ class DataSpec:
     # the render resolution, the blur of the loop's observation model.
     blur_max: float = 0.0
     blur_prob: float = 0.5
+    # Pairs aimed at a later correction: with probability ``near`` a simulation of a group is drawn
+    # near another one's parameters (each unknown moved by N(0, ``near_scale``) of its range,
+    # clipped), so the group holds pairs as close as the loop's second step sees; 0: every
+    # simulation from the prior, as the loop's first step sees them.
+    near: float = 0.0
+    near_scale: float = 0.05
 
     def instance(self, seed: int, **options: Any) -> Scene:
         """Called for each sample group, validation group and evaluation run: the scene instance
@@ -106,7 +112,12 @@ class PairMaker:
         for _ in range(spec.group * 2):
             if len(sims) == spec.group:
                 break
-            p = space.sample(rng)
+            if sims and self.spec.near > 0 and rng.random() < self.spec.near:
+                base = space.to_unit(sims[int(rng.integers(len(sims)))][0])
+                moved = base + rng.normal(0.0, self.spec.near_scale, base.shape)
+                p = space.from_unit(np.clip(moved, 0.0, 1.0))
+            else:
+                p = space.sample(rng)
             try:
                 traj = self.sim.simulate(scene, p)
             except SimulationError:
@@ -117,18 +128,28 @@ class PairMaker:
             if spec.blur_max > 0
             else [f for _, f in sims]
         )
-        xs, ys = [], []
-        for body in space.bodies:
-            sub = space.subset(body)
-            scale = sub.high - sub.low
-            for i, (pi, _) in enumerate(sims):
-                for j, (pj, fj) in enumerate(sims):
-                    if i != j:
-                        xs.append(
-                            make_input(observed[i][body], fj[body], spec.frames, spec.resolution)
-                        )
-                        ys.append((sub.to_vector(pi) - sub.to_vector(pj)) / scale)
-        return np.stack(xs), np.asarray(ys, dtype=np.float32)
+        pairs = [
+            (b, i, j) for b in space.bodies for i in range(len(sims)) for j in range(len(sims))
+        ]
+        pairs = [(b, i, j) for b, i, j in pairs if i != j]
+        subs = {b: space.subset(b) for b in space.bodies}
+        xs: np.ndarray | None = None  # allocated once the first sample gives its shape
+        ys = []
+        for k, (body, i, j) in enumerate(pairs):
+            sub = subs[body]
+            obs, sim = observed[i][body], sims[j][1][body]
+            if xs is None:
+                first = make_input(obs, sim, spec.frames, spec.resolution)
+                xs = np.empty((len(pairs), *first.shape), np.float32)
+                xs[0] = first
+            else:
+                make_input(obs, sim, spec.frames, spec.resolution, out=xs[k])
+            ys.append(
+                (sub.to_vector(sims[i][0]) - sub.to_vector(sims[j][0])) / (sub.high - sub.low)
+            )
+        if xs is None:
+            raise ValueError(f"scene instance {seed}: no pair of simulations to train on")
+        return xs, np.asarray(ys, dtype=np.float32)
 
     def _blurred(
         self, frames: dict[str, np.ndarray], rng: np.random.Generator

@@ -213,27 +213,66 @@ def dequantize(tensors: dict[str, Any], where: str = "weights") -> dict[str, Any
     return out
 
 
+def named_dirs(variable: str) -> list[Path]:
+    """The folders the path list in the environment ``variable`` names, in order."""
+    return [Path(p) for p in os.environ.get(variable, "").split(os.pathsep) if p]
+
+
 def search_dirs() -> list[Path]:
-    extra = [Path(p) for p in os.environ.get("PHYSBENCH_WEIGHTS", "").split(os.pathsep) if p]
-    return [*extra, SHIPPED]
+    return [*named_dirs("PHYSBENCH_WEIGHTS"), SHIPPED]
+
+
+def empty_folder(
+    variable: str, folder: Path, what: str, skipped: list[str], train: str = "physbench train"
+) -> PhysbenchError:
+    """The error for a folder that ``variable`` names but that holds no valid ``what`` weights:
+    named on purpose, it is a mistake (a typo, a training that wrote elsewhere), not a reason to
+    fall back silently to the shipped weights. ``skipped``: why each file there was refused;
+    ``train``: the command that writes such weights."""
+    if not folder.exists():
+        why = "which does not exist"
+    elif not folder.is_dir():
+        why = "which is not a folder"
+    elif skipped:
+        why = f"which holds no valid {what} weights ({'; '.join(skipped)})"
+    else:
+        why = f"which holds no {what} weights (no NAME.safetensors with its NAME.json)"
+    return PhysbenchError(
+        f"{variable} names {str(folder)!r}, {why}; point {variable} at the output folder of "
+        f"`{train}`, or take this folder off it"
+    )
+
+
+def _scan(folder: Path) -> tuple[list[WeightsInfo], list[str]]:
+    """The weights in ``folder``, and why each other pair there was refused."""
+    found, skipped = [], []
+    for side in sorted(folder.glob("*.json")) if folder.is_dir() else []:
+        st = side.with_suffix(".safetensors")
+        if not st.is_file():
+            continue
+        try:
+            meta = sidecar.check(read_sidecar(side), f"weights sidecar {str(side)!r}")
+        except PhysbenchError as exc:
+            skipped.append(f"{str(st)!r}: {exc}")
+            continue
+        found.append(WeightsInfo(st, meta))
+    return found, skipped
 
 
 def available() -> list[WeightsInfo]:
     """Every weights file found, searched folders first to last; called by :func:`find` and
     listings. A file whose sidecar is not a weights sidecar is skipped with a warning naming it,
-    so one bad file in a ``PHYSBENCH_WEIGHTS`` folder does not break lookups of the others."""
+    so one bad file in a ``PHYSBENCH_WEIGHTS`` folder does not break lookups of the others; a
+    ``PHYSBENCH_WEIGHTS`` folder without any valid weights is an error (:func:`empty_folder`)."""
     out = []
-    for d in search_dirs():
-        for side in sorted(d.glob("*.json")) if d.is_dir() else []:
-            st = side.with_suffix(".safetensors")
-            if not st.is_file():
-                continue
-            try:
-                meta = sidecar.check(read_sidecar(side), f"weights sidecar {str(side)!r}")
-            except PhysbenchError as exc:
-                warnings.warn(f"skipping weights {str(st)!r}: {exc}", UserWarning, stacklevel=2)
-                continue
-            out.append(WeightsInfo(st, meta))
+    named = named_dirs("PHYSBENCH_WEIGHTS")
+    for d in [*named, SHIPPED]:
+        found, skipped = _scan(d)
+        if not found and d in named:
+            raise empty_folder("PHYSBENCH_WEIGHTS", d, "resnet3d", skipped)
+        for why in skipped:
+            warnings.warn(f"skipping weights {why}", UserWarning, stacklevel=2)
+        out.extend(found)
     return out
 
 

@@ -109,6 +109,45 @@ def test_init_fine_tunes_from_weights_and_refuses_another_architecture(tmp_path:
         )
 
 
+def test_init_may_change_the_input_size_and_draws_new_instances(tmp_path: Path) -> None:
+    from physbench.estimators.resnet3d.train import init_groups
+
+    cfg = TrainConfig(samples=16, batch=8, eval_every=16, val_groups=1, workers=0, threads=1)
+    first, meta = train(TINY_DATA, TINY, cfg, tmp_path / "a", progress=False)
+    assert meta["training"]["first_group"] == 0 and init_groups(meta) == 16
+    # A bigger input (resolution and frames) from the same tensors; lr = 0 keeps them.
+    big_net = NetConfig(**{**TINY.to_dict(), "resolution": 32, "frames": 8})
+    big_data = DataSpec(
+        "three_circles", ("mass",), render_resolution=32, resolution=32, frames=8, group=3
+    )
+    big, big_meta = train(
+        big_data,
+        big_net,
+        TrainConfig(**{**cfg.__dict__, "lr": 0.0, "init": str(first)}),
+        tmp_path / "b",
+        progress=False,
+    )
+    a, b = weights.load(first)[0], weights.load(big)[0]
+    assert all(torch.allclose(a[k], b[k], atol=1e-6) for k in a)
+    assert big_meta["net"]["resolution"] == 32 and big_meta["net"]["frames"] == 8
+    # The curve starts at the weights it was given, measured on this run's validation set.
+    assert [h["samples"] for h in big_meta["history"]] == [0, 16]
+    assert big_meta["history"][0]["val_mse"] == pytest.approx(big_meta["history"][1]["val_mse"])
+    # Its instances come after the 16 groups the first run may have drawn; a chain adds up.
+    assert big_meta["training"]["first_group"] == 16 and init_groups(big_meta) == 32
+
+
+def test_init_groups_reads_only_whole_numbers() -> None:
+    from physbench.estimators.resnet3d.train import init_groups
+
+    assert init_groups({}) == 0
+    assert init_groups({"training": "x"}) == 0
+    assert init_groups({"training": {"samples_seen": 1000}}) == 1000
+    assert init_groups({"training": {"samples_seen": 10, "first_group": 5}}) == 15
+    assert init_groups({"training": {"samples_seen": True, "first_group": -3}}) == 0
+    assert init_groups({"training": {"samples_seen": 2.5}}) == 0
+
+
 def test_a_time_budget_counts_only_this_sessions_time(tmp_path: Path) -> None:
     import json
 

@@ -42,3 +42,20 @@ def test_blur_augmentation_blurs_the_observed_half_only() -> None:
         return float(np.abs(np.diff(x, axis=-1)).sum() + np.abs(np.diff(x, axis=-2)).sum())
 
     assert tv(blurred[0][:, :, :frames]) < 0.95 * tv(sharp[0][:, :, :frames])
+
+
+def test_near_pairs_are_as_close_as_a_second_correction() -> None:
+    """``near``: simulations drawn near another's parameters give small targets; ``near = 0``
+    leaves the samples of a spec exactly as before (no extra random draws)."""
+    prior = PairMaker(TINY_DATA).group(777)
+    assert np.array_equal(prior[1], PairMaker(DataSpec(**TINY_DATA.__dict__)).group(777)[1])
+    near = DataSpec(**{**TINY_DATA.__dict__, "near": 1.0, "near_scale": 0.02})
+    x, y = PairMaker(near).group(777)
+    assert x.shape == prior[0].shape and np.all(np.abs(y) <= 1)
+    # Every simulation after the first is within a few spreads of an earlier one: each body's
+    # targets include pairs far smaller than prior pairs typically are.
+    assert np.median(np.abs(y)) < 0.1 < np.median(np.abs(prior[1]))
+    assert DataSpec.from_dict(near.to_dict()) == near
+    assert (
+        DataSpec.from_dict({k: v for k, v in TINY_DATA.to_dict().items() if k != "near"}).near == 0
+    )

@@ -9,6 +9,7 @@ import hashlib
 import json
 import os
 import pickle
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -184,16 +185,64 @@ def test_a_bad_file_in_a_search_folder_is_skipped_with_a_warning_naming_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     (tmp_path / "good").mkdir()
-    (tmp_path / "bad").mkdir()
+    (tmp_path / "mixed").mkdir()
     good = write(tmp_path / "good")
-    bad = write(tmp_path / "bad", side="{not json")
+    bad = write(tmp_path / "mixed", side="{not json")
+    other = tmp_path / "mixed" / "other.safetensors"  # a valid file beside it: no error
+    other.write_bytes(good.read_bytes())
+    other.with_suffix(".json").write_text(good.with_suffix(".json").read_text())
     monkeypatch.setattr(weights, "SHIPPED", tmp_path / "none")
-    monkeypatch.setenv("PHYSBENCH_WEIGHTS", f"{tmp_path / 'bad'}:{tmp_path / 'good'}")
+    monkeypatch.setenv("PHYSBENCH_WEIGHTS", f"{tmp_path / 'mixed'}:{tmp_path / 'good'}")
     with pytest.warns(UserWarning, match=rf"skipping weights '{bad}'.*not valid JSON"):
         found = weights.find("three_circles", ("mass",))
-    assert found.path == good
+    assert found.path == other  # the first folder's valid file
     with pytest.raises(PhysbenchError, match="not valid JSON"):  # asked for by name, it fails
         weights.load(bad)
+
+
+@pytest.mark.parametrize(
+    ("make", "why"),
+    [
+        (lambda d: None, "which does not exist"),
+        (lambda d: d.mkdir(), r"which holds no resnet3d weights \(no NAME.safetensors"),
+        (lambda d: d.write_text("x"), "which is not a folder"),
+        (
+            lambda d: (d.mkdir(), write(d, side="{not json")),
+            r"which holds no valid resnet3d weights \('.*w.safetensors': .*not valid JSON",
+        ),
+    ],
+)
+def test_a_named_folder_without_valid_weights_is_an_error_not_a_fall_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, make: Any, why: str
+) -> None:
+    folder = tmp_path / "mine"
+    make(folder)
+    monkeypatch.setenv("PHYSBENCH_WEIGHTS", str(folder))
+    with pytest.raises(PhysbenchError) as exc:  # the shipped weights would have served
+        weights.find("three_circles", ("mass",))
+    said = str(exc.value)
+    assert said.startswith(f"PHYSBENCH_WEIGHTS names {str(folder)!r}, "), said
+    assert re.search(why, said) and said.endswith("or take this folder off it"), said
+
+
+def test_the_cli_says_a_skipped_file_in_one_physbench_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from physbench.cli import main
+
+    write(tmp_path)  # tiny valid weights for three_circles mass, found before the shipped ones
+    (tmp_path / "other.safetensors").write_bytes(VALID_BYTES)
+    (tmp_path / "other.json").write_text("{not json")
+    monkeypatch.setenv("PHYSBENCH_WEIGHTS", str(tmp_path))
+    argv = ["run", "--estimator", "resnet3d", "--iterations", "1", "--resolution", "32", "-q"]
+    assert main(argv) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        f"physbench run: warning: skipping weights '{tmp_path / 'other.safetensors'}': "
+        f"weights sidecar '{tmp_path / 'other.json'}' is not valid JSON (Expecting "
+        "property name enclosed in double quotes: line 1 column 2 (char 1)); expected the object "
+        "physbench train writes beside NAME.safetensors"
+    ], err
 
 
 # --- the estimator -----------------------------------------------------------------------------
@@ -328,3 +377,5 @@ def test_any_damaged_pair_loads_or_raises_a_physbench_error(
             weights.available()
         except UserWarning as w:
             assert "skipping weights" in str(w)
+        except PhysbenchError as exc:  # the folder named holds nothing valid
+            assert f"PHYSBENCH_WEIGHTS names {str(tmp_path)!r}" in str(exc)
