@@ -20,9 +20,10 @@ observations of three_circles (model pymunk) the plain image MSE to the predicti
 65 % of the runs whose 90 % interval missed the truth, this statistic 89 % (40 draws, 38 seeds;
 ``benchmarks/npe_checks.py`` has the full measurement). It is a statistic of the data alone, so
 it also works for posteriors whose width comes from the method rather than from pixel noise
-(``npe`` on noise-free frames). Cost: ``K`` simulations and renders, and ``K`` frame sets in
-memory. Called by :func:`~physbench.experiment.run_config` after the loop when the estimator
-returned a posterior.
+(``npe`` on noise-free frames). Cost: ``K`` simulations and renders, with the ``K`` frame sets
+held in memory up to :data:`MEMORY` bytes; beyond (ball_drop's 26:1 world renders 12.8 million
+values per draw at 64 px) each draw is simulated a second time instead. Called by
+:func:`~physbench.experiment.run_config` after the loop when the estimator returned a posterior.
 """
 
 from __future__ import annotations
@@ -50,6 +51,11 @@ if TYPE_CHECKING:
 DRAWS = 59
 #: The check fails at a p-value at or below this.
 ALPHA = 0.05
+#: The most bytes of simulated frames the check holds; more, and it simulates each draw again
+#: for its second pass rather than keeping them.
+MEMORY = 256 * 2**20
+#: Pixels handled at once (bounds the temporaries of the per-pixel moments).
+CHUNK = 2**20
 #: Added to each pixel's predictive variance: the variance of an 8-bit camera's rounding,
 #: (1/255)^2 / 12.
 PIXEL_VARIANCE = (1.0 / 255.0) ** 2 / 12.0
@@ -139,9 +145,49 @@ def _moments(mu: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
     return m1, np.maximum(m2 - m1 * m1, 0.0)
 
 
-def _chi(x: np.ndarray, mean: np.ndarray, var: np.ndarray) -> float:
-    """Mean over pixels of ``(x - mean)^2 / (var + PIXEL_VARIANCE)``."""
-    return float(np.mean(np.square(x - mean) / (np.maximum(var, 0.0) + PIXEL_VARIANCE)))
+class _Sums:
+    """Per-pixel sums over the draws of the replicates' mean, squared mean and noise variance
+    (:func:`_moments`), and the chi-square statistics computed from them, in chunks of
+    :data:`CHUNK` pixels."""
+
+    def __init__(self, size: int, sigma: float) -> None:
+        self.sigma, self.k = sigma, 0
+        self.s1, self.s2, self.sv = np.zeros(size), np.zeros(size), np.zeros(size)
+
+    def add(self, frames: np.ndarray) -> None:
+        for c in range(0, frames.size, CHUNK):
+            m, v = _moments(frames[c : c + CHUNK].astype(np.float64), self.sigma)
+            self.s1[c : c + CHUNK] += m
+            self.s2[c : c + CHUNK] += m * m
+            self.sv[c : c + CHUNK] += v
+        self.k += 1
+
+    def chi(self, x: np.ndarray) -> float:
+        """The statistic of ``x`` (the observation) against all draws."""
+        k, total = self.k, 0.0
+        for c in range(0, x.size, CHUNK):
+            s1, s2, sv = self.s1[c : c + CHUNK], self.s2[c : c + CHUNK], self.sv[c : c + CHUNK]
+            var = (s2 - s1 * s1 / k) / (k - 1) + sv / k
+            total += _chi_sum(x[c : c + CHUNK].astype(np.float64), s1 / k, var)
+        return total / x.size
+
+    def chi_without(self, frames: np.ndarray, rng: np.random.Generator) -> float:
+        """The statistic of a replicate of ``frames`` (its frames plus the observation model's
+        noise) against the other draws."""
+        k, total = self.k, 0.0
+        for c in range(0, frames.size, CHUNK):
+            mu = frames[c : c + CHUNK].astype(np.float64)
+            mi, vi = _moments(mu, self.sigma)
+            s1, s2, sv = self.s1[c : c + CHUNK], self.s2[c : c + CHUNK], self.sv[c : c + CHUNK]
+            m = (s1 - mi) / (k - 1)
+            var = (s2 - mi * mi - (k - 1) * m * m) / (k - 2) + (sv - vi) / (k - 1)
+            total += _chi_sum(_replicate(mu, self.sigma, rng), m, var)
+        return total / frames.size
+
+
+def _chi_sum(x: np.ndarray, mean: np.ndarray, var: np.ndarray) -> float:
+    """Sum over pixels of ``(x - mean)^2 / (var + PIXEL_VARIANCE)``."""
+    return float(np.sum(np.square(x - mean) / (np.maximum(var, 0.0) + PIXEL_VARIANCE)))
 
 
 def _noise(observation: np.ndarray, stated: float | None) -> tuple[float, str]:
@@ -175,32 +221,38 @@ def check(
         raise PhysbenchError(f"predictive check draws = {draws!r}: expected a whole number >= 2")
     t0 = time.perf_counter()
     rng = np.random.default_rng([seed, 29])
-    obs = np.asarray(observation, dtype=np.float64).ravel()
+    obs = np.asarray(observation, dtype=np.float32).ravel()
     sigma, source = _noise(obs, noise)
-    frames = []
-    for draw in _draws(posterior, draws, rng):
+
+    def frames(draw: dict[str, float]) -> np.ndarray | None:
         try:
             seen, traj = simulate_seen(simulator, scene, draw, effects)
         except SimulationError:
+            return None
+        return np.asarray(renderer.render(seen, traj), dtype=np.float32).ravel()
+
+    picked = _draws(posterior, draws, rng)
+    keep = draws * obs.size * 4 <= MEMORY
+    sums = _Sums(obs.size, sigma)
+    kept, good = [], []
+    for draw in picked:  # first pass: the predictive mean and variance
+        f = frames(draw)
+        if f is None:
             continue
-        frames.append(np.asarray(renderer.render(seen, traj), dtype=np.float32).ravel())
-    k = len(frames)
+        sums.add(f)
+        good.append(draw)
+        if keep:
+            kept.append(f)
+    k = len(good)
     if k < 3:
         return None
-    s1, s2, sv = np.zeros(obs.size), np.zeros(obs.size), np.zeros(obs.size)
-    for f in frames:
-        m, v = _moments(f.astype(np.float64), sigma)
-        s1 += m
-        s2 += m * m
-        sv += v
-    residual = _chi(obs, s1 / k, (s2 - s1 * s1 / k) / (k - 1) + sv / k)
+    residual = sums.chi(obs)
     spread = np.empty(k)
-    for i, f in enumerate(frames):
-        mu = f.astype(np.float64)
-        mi, vi = _moments(mu, sigma)
-        m = (s1 - mi) / (k - 1)
-        v = (s2 - mi * mi - (k - 1) * m * m) / (k - 2) + (sv - vi) / (k - 1)
-        spread[i] = _chi(_replicate(mu, sigma, rng), m, v)
+    for i, draw in enumerate(good):  # second pass: each replicate against the others
+        f = kept[i] if keep else frames(draw)
+        if f is None:
+            raise SimulationError(f"the predictive check's draw {draw} no longer simulates")
+        spread[i] = sums.chi_without(f, rng)
     p = (1 + int(np.count_nonzero(spread >= residual))) / (k + 1)
     return PredictiveCheck(
         p=p,
