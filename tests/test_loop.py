@@ -344,7 +344,7 @@ def test_a_fit_far_above_the_noise_floor_is_flagged_one_at_the_floor_is_not() ->
     wrong = {"a.mass": 1.0, "b.mass": 10.0}
     bad = _run(Scripted([wrong]), iterations=2, initial=wrong, obs=noisy)  # never near the truth
     assert bad.fit is not None and bad.fit.failed and bad.fit.noise_ratio > 10
-    assert (bad.fit.describe() or "").startswith("the fit failed: its best image MSE")
+    assert (bad.fit.describe() or "").startswith("the fit looks failed: its best image MSE")
     again = History.from_dict(json.loads(bad.to_json()))
     assert again.fit == bad.fit
     # Frames stated noise-free have no noise floor to compare with.

@@ -10,6 +10,8 @@
   and unknown set after a given number of iterations. ``scene_ratio`` is the run's best image MSE
   over the median of that estimator on held-out seeds of the same row, in the same setting
   (a :class:`Reference`); above :data:`SCENE_FACTOR` the fit is far from what the scene allows.
+  The image MSE does not see everything the parameters do (a mass that moves few pixels), so a
+  flagged fit may still be near the truth, and a fit off in such a direction goes unflagged.
   The references ship in ``failure_reference.json`` beside this module, written by
   ``benchmarks/resnet3d_failures.py`` (see that script for the seeds and setting).
 
@@ -30,8 +32,12 @@ import numpy as np
 
 #: The fit failed when its best image MSE exceeds the noise floor this many times.
 NOISE_FACTOR = 10.0
-#: The fit failed when its best image MSE exceeds the reference median this many times.
-SCENE_FACTOR = 100.0
+#: The fit failed when its best image MSE exceeds the reference median this many times. Set on
+#: resnet3d's Table 1 rows (benchmarks/resnet3d_failures.py, 200 held-out seeds per row, each
+#: judged against the other half's median): of the iterates whose normalized MSE is above 100
+#: times their row's median, 1,441 of 1,468 have an image MSE above 30 times it, while 23 of the
+#: 1,600 runs end above it with a normalized MSE of 0.3 to 26 times the median.
+SCENE_FACTOR = 30.0
 REFERENCES = Path(__file__).with_name("failure_reference.json")
 
 
@@ -131,10 +137,10 @@ class FitCheck:
                 f"other seeds of the scene ({self.reference:.3g})"
             )
         return (
-            f"the fit failed: its best image MSE {self.min_loss:.3g} is "
+            f"the fit looks failed: its best image MSE {self.min_loss:.3g} is "
             + " and ".join(why)
-            + "; the estimate is not to be trusted (more iterations, a restart from a global "
-            "design, or another estimator may find the fit)"
+            + "; the estimate may be far off (more iterations, a restart from a global design, "
+            "or another estimator may find the fit)"
         )
 
     def to_dict(self) -> dict[str, Any]:
