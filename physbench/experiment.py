@@ -13,21 +13,23 @@ and the engine that made it.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from physbench.components import create, make_estimator, make_observer, make_renderer
 from physbench.errors import PhysbenchError, UnknownNameError
 from physbench.estimators.base import DEFAULT_ESTIMATOR
+from physbench.posterior.predictive import DRAWS as PREDICTIVE_DRAWS
 from physbench.render.base import DEFAULT_RENDERER
 from physbench.simulators.base import DEFAULT_SIMULATOR
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
     from physbench.estimators.base import CorrectionEstimator
-    from physbench.loop import History, Iteration
+    from physbench.loop import History, Iteration, Restart
     from physbench.observation import Observation
+    from physbench.posterior.failure import Reference
     from physbench.render.base import Renderer
     from physbench.scene import Scene
     from physbench.simulators.base import Simulator
@@ -35,6 +37,8 @@ if TYPE_CHECKING:
 
 #: The scene of a run that names none (and observes no file that carries one).
 DEFAULT_SCENE = "three_circles"
+#: Estimators whose runs restart from a global design by default (``RunConfig.restart``).
+RESTART_BY_DEFAULT: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -86,6 +90,14 @@ class RunConfig:
     video_end: float | None = None
     effects: tuple[str, ...] = ()
     allow_gaps: bool = False
+    #: Posterior draws the posterior predictive check simulates after the loop, for an
+    #: estimator that returns a posterior (:mod:`physbench.posterior.predictive`; 0: no check).
+    predictive_draws: int = PREDICTIVE_DRAWS
+    #: Restart from a global design while the fit looks failed (:class:`~physbench.loop.Restart`
+    #: at the failure threshold of :mod:`physbench.posterior.failure`; it needs a shipped
+    #: reference for the run's row and setting). ``None``: on for the estimators in
+    #: :data:`RESTART_BY_DEFAULT`.
+    restart: bool | None = None
 
     def __post_init__(self) -> None:
         """Refuse a numeric setting outside its range (:mod:`physbench.numeric`), NaN and the
@@ -98,6 +110,7 @@ class RunConfig:
             "blur": numeric.BLUR,
             "noise": numeric.NOISE,
             "resolution": numeric.RESOLUTION,
+            "predictive_draws": numeric.COUNT_OR_NONE,
         }
         for name, number in checks.items():
             number.check(getattr(self, name), f"run setting {name}")
@@ -118,6 +131,9 @@ class RunConfig:
         d["observer_options"] = dict(self.observer_options)
         for key in _LATER:
             if not d[key]:
+                del d[key]
+        for key, default in _LATER_DEFAULTS.items():
+            if d[key] == default:
                 del d[key]
         return d
 
@@ -153,7 +169,10 @@ _LATER = (
     "video_end",
     "effects",
     "allow_gaps",
+    "restart",
 )
+#: Settings added later with a default that is not empty: omitted while at that default.
+_LATER_DEFAULTS: dict[str, Any] = {"predictive_draws": PREDICTIVE_DRAWS}
 
 
 def _check_observation(config: RunConfig) -> None:
@@ -302,6 +321,12 @@ def check_config(config: RunConfig) -> ParamSpace:
     from physbench.plugins import get_registry
 
     _check_observation(config)
+    draws = config.predictive_draws
+    if isinstance(draws, bool) or not isinstance(draws, int) or draws == 1 or draws < 0:
+        raise PhysbenchError(
+            f"predictive draws = {draws!r}: expected 0 (no posterior predictive check) or a "
+            "whole number >= 2"
+        )
     observed = load_observed(config)
     reg = get_registry()
     try:
@@ -436,6 +461,45 @@ def _record_settings(history: History, config: RunConfig, observed: Observation 
         history.meta.update(observe_effects=list(observed.effects))
 
 
+def _reference(config: RunConfig, observed: Observation | None, scene: Scene) -> Reference | None:
+    """What the run's estimator reaches on other seeds of this row in this setting
+    (:func:`physbench.posterior.failure.reference`): only for a simulated observation of every
+    body's unknowns, with the estimator's default weights."""
+    from physbench.posterior import failure
+
+    if observed is not None or config.video or config.observer or config.bodies is not None:
+        return None
+    if config.effects:
+        return None
+    if config.options.get("weights"):
+        return None
+    setting = {
+        "engine": model_engine(config),
+        "observe_engine": config.observer_engine,
+        "renderer": config.renderer,
+        "renderer_options": dict(config.renderer_options),
+        "resolution": config.resolution,
+        "render_mode": config.render_mode,
+        "blur": config.blur,
+        "noise": config.noise,
+    }
+    params, iterations = config.params, config.iterations
+    return failure.reference(config.estimator, scene.name, params, iterations, setting)
+
+
+def _restart(config: RunConfig, reference: Reference | None) -> Restart | None:
+    """The restart rule of ``config``: at the failure threshold of the row's reference."""
+    from physbench.loop import Restart
+    from physbench.posterior.failure import SCENE_FACTOR
+
+    wanted = (
+        config.restart if config.restart is not None else config.estimator in RESTART_BY_DEFAULT
+    )
+    if not wanted or reference is None:
+        return None
+    return Restart(threshold=SCENE_FACTOR * reference.median)
+
+
 def _with_known_truth(
     observed: Observation, space: ParamSpace, notice: Callable[[str], None] | None
 ) -> Observation:
@@ -471,7 +535,9 @@ def run_config(
     ``callback`` receives each iteration's record; ``save_observation`` writes the frames used.
     ``probe``: first check that every unknown changes the rendered frames
     (:mod:`physbench.posterior.identifiability`; the unseen are in ``History.unseen``, and
-    ``notice`` receives one sentence about them before the loop starts)."""
+    ``notice`` receives one sentence about them before the loop starts). An estimator's
+    posterior is then checked against the observation (``config.predictive_draws``
+    simulations; :mod:`physbench.posterior.predictive`, in ``History.predictive``)."""
     _check_observation(config)
     from physbench.loop import draw_problem, refine
     from physbench.observation import save_observation as save_obs
@@ -495,6 +561,7 @@ def run_config(
     if save_observation:
         save_obs(save_observation, obs)
     unseen = _probe(scene, space, simulator, renderer, initial, notice, effects) if probe else ()
+    reference = _reference(config, observed, scene)
     history = refine(
         obs,
         scene,
@@ -507,7 +574,26 @@ def run_config(
         initial=initial,
         effects=effects,
         callback=callback,
+        restart=_restart(config, reference),
     )
     history.unseen = unseen
+    if history.fit is not None and reference is not None:
+        history.fit = replace(
+            history.fit, reference=reference.median, reference_seeds=reference.seeds
+        )
+    if history.posterior is not None and config.predictive_draws:
+        from physbench.posterior import predictive
+
+        history.predictive = predictive.check(
+            history.posterior,
+            obs.frames,
+            scene,
+            simulator,
+            renderer,
+            noise=obs.noise,
+            draws=config.predictive_draws,
+            seed=config.seed,
+            effects=effects,
+        )
     _record_settings(history, config, observed)
     return history

@@ -27,6 +27,8 @@ from physbench.estimators.base import Step, Task
 from physbench.metrics import image_mse
 from physbench.observation import Observation, expected_shape, validate
 from physbench.plugins import guard
+from physbench.posterior.failure import FitCheck
+from physbench.posterior.predictive import PredictiveCheck
 from physbench.posterior.samples import Posterior
 from physbench.unknowns import Params, ParamSpace, scene_parameters, simulate_seen
 
@@ -117,6 +119,15 @@ class History:
     #: How sure the estimator is (:meth:`CorrectionEstimator.posterior`); ``None`` for an
     #: estimator that gives a point only.
     posterior: Posterior | None = None
+    #: Whether the model reproduces the observation at the posterior's draws
+    #: (:mod:`physbench.posterior.predictive`); ``None`` when not checked (no posterior).
+    predictive: PredictiveCheck | None = None
+    #: Whether the fit failed: its best image MSE against the noise floor and against what the
+    #: estimator reaches on other seeds of the scene (:mod:`physbench.posterior.failure`).
+    fit: FitCheck | None = None
+    #: The iterations that simulated a point of the restart design instead of the estimator's
+    #: proposal (:class:`Restart`).
+    restarts: tuple[int, ...] = ()
 
     def __len__(self) -> int:
         return len(self.iterations)
@@ -168,6 +179,11 @@ class History:
             "unseen": list(self.unseen),
             "at_bound": list(self.at_bound),
             "posterior": None if self.posterior is None else self.posterior.to_dict(),
+            "predictive": (
+                None if self.predictive is None else self.predictive.to_dict(timings=timings)
+            ),
+            "fit": None if self.fit is None else self.fit.to_dict(),
+            "restarts": list(self.restarts),
             "meta": {k: v for k, v in self.meta.items() if timings or not k.startswith("t_")},
             "iterations": recs,
         }
@@ -194,6 +210,11 @@ class History:
             unseen=tuple(d.get("unseen", ())),
             at_bound=tuple(d.get("at_bound", ())),
             posterior=None if d.get("posterior") is None else Posterior.from_dict(d["posterior"]),
+            predictive=(
+                None if d.get("predictive") is None else PredictiveCheck.from_dict(d["predictive"])
+            ),
+            fit=None if d.get("fit") is None else FitCheck.from_dict(d["fit"]),
+            restarts=tuple(d.get("restarts", ())),
         )
 
     def to_frame(self) -> pd.DataFrame:
@@ -314,14 +335,16 @@ def drive(
     *,
     seed: int,
     visit: Callable[[int, Params, Evaluation, float], None],
+    redirect: Callable[[int, Params], Params] | None = None,
 ) -> Driven:
     """The one place that calls an estimator: :meth:`~CorrectionEstimator.start` once with
     ``task``, then for each of ``task.iterations`` iterations ``evaluate`` the current point, show
     the estimator the :class:`~physbench.estimators.base.Step` and check its proposal (keys,
     ranges), then :meth:`~CorrectionEstimator.posterior`. Every call is guarded (what a third
     party's component raises names it). ``visit(k, params, evaluation, t_estimator)`` receives
-    each iteration once its proposal is checked. The image loop (:func:`refine`) and discovery's
-    black-box fits both run through here."""
+    each iteration once its proposal is checked; ``redirect(k, proposal)``, when given, then
+    names the point simulated next (the loop's restarts, :class:`Restart`). The image loop
+    (:func:`refine`) and discovery's black-box fits both run through here."""
     name = type(estimator).name or type(estimator).__name__
     t = time.perf_counter()
     with guard("estimator", estimator, "start()"):
@@ -337,11 +360,65 @@ def drive(
         t_estimator = time.perf_counter() - t
         nxt = _check_proposal(name, task.space, proposal, k)
         visit(k, params, ev, t_estimator)
-        params = nxt
+        params = nxt if redirect is None else redirect(k, nxt)
     with guard("estimator", estimator, "posterior()"):
         posterior = estimator.posterior()
     _check_posterior(name, task.space, posterior)
     return Driven(t_start, posterior)
+
+
+@dataclass(frozen=True)
+class Restart:
+    """Restart from a global design when the fit looks failed (``refine(restart=...)``).
+
+    From iteration ``after`` on, at most once every ``every`` iterations, while the best image
+    MSE so far is above ``threshold``, the loop simulates the next point of a Latin hypercube of
+    ``points`` points over the unknowns' ranges (:mod:`physbench.estimators.design`) instead of
+    the estimator's proposal. The estimator is shown that point's simulation and goes
+    on from there, which suits correctors that propose from the step they are shown (resnet3d);
+    a model-based optimiser just sees one more point. The best iterate is still the one with the
+    lowest image MSE of the whole run, and ``History.restarts`` lists the iterations that
+    simulated a design point."""
+
+    threshold: float
+    after: int = 3
+    every: int = 3
+    points: int = 8
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.threshold) and self.threshold > 0):
+            raise PhysbenchError(f"restart threshold {self.threshold!r}: expected a number > 0")
+        for name in ("after", "every", "points"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise PhysbenchError(f"restart {name} = {v!r}: expected a whole number >= 1")
+
+
+def _redirect(
+    restart: Restart, space: ParamSpace, seed: int, records: list[Iteration], done: list[int]
+) -> Callable[[int, Params], Params]:
+    """The loop's restart rule (:class:`Restart`) as :func:`drive`'s ``redirect``; appends to
+    ``done`` the iterations that will simulate a design point."""
+    from physbench.estimators.design import startup_design
+
+    design = startup_design("lhs", restart.points, len(space), np.random.default_rng([seed, 37]))
+    used = [0]
+
+    def redirect(k: int, proposal: Params) -> Params:
+        last = done[-1] if done else -restart.every
+        if (
+            k + 1 < restart.after
+            or k + 1 - last < restart.every
+            or used[0] >= restart.points
+            or records[-1].best_loss <= restart.threshold
+        ):
+            return proposal
+        point = space.from_unit(design[used[0]])
+        used[0] += 1
+        done.append(k + 1)
+        return point
+
+    return redirect
 
 
 def _checked_iterations(iterations: object) -> int:
@@ -415,6 +492,19 @@ def image_objective(
     return evaluate
 
 
+def _fit(obs: Observation, min_loss: float, best: np.ndarray) -> FitCheck:
+    """The best image MSE against the pixel noise's own, when the noise level is known: stated
+    by the observation model, or estimated from the frames above an 8-bit step (frames without
+    noise leave the measure out)."""
+    from physbench.posterior.failure import noise_floor
+    from physbench.posterior.likelihood import NOISE_FLOOR, estimate_noise
+
+    sigma = obs.noise if obs.noise is not None else estimate_noise(obs.frames)
+    if not sigma or sigma <= NOISE_FLOOR:
+        return FitCheck(min_loss)
+    return FitCheck(min_loss, noise_floor=noise_floor(best, sigma))
+
+
 def refine(
     observation: Observation | np.ndarray,
     scene: Scene,
@@ -428,6 +518,7 @@ def refine(
     initial: Mapping[str, float] | None = None,
     effects: Sequence[Effect] = (),
     callback: Callable[[Iteration], None] | None = None,
+    restart: Restart | None = None,
 ) -> History:
     """Run ``iterations`` iterations of the correction loop and return the :class:`History`.
 
@@ -440,6 +531,9 @@ def refine(
     with that stream's estimator seed. ``renderer`` is the *model* renderer
     (sharp); an observation model (blur, noise) belongs to whoever made ``observation``.
     ``callback`` is called with each :class:`Iteration` as it completes (progress displays).
+    ``restart``: restart from a global design while the fit looks failed (:class:`Restart`;
+    ``None``: never). ``History.fit`` holds the best image MSE against the pixel noise's
+    (:mod:`physbench.posterior.failure`).
     """
     iterations = _checked_iterations(iterations)
     space = _space(scene, unknowns, effects)
@@ -465,10 +559,13 @@ def refine(
         noise=obs.noise,
     )
     records: list[Iteration] = []
+    best_frames: list[np.ndarray] = []
 
     def visit(k: int, params: Params, ev: Evaluation, t_estimator: float) -> None:
         nmse = None if truth is None else space.normalized_mse(params, truth)
         best = k if k == 0 or ev.loss < records[-1].best_loss else records[-1].best_iteration
+        if best == k:
+            best_frames[:] = [ev.frames]
         held = records[best] if best < k else None  # ties keep the earlier iterate
         rec = Iteration(
             k,
@@ -490,10 +587,15 @@ def refine(
     evaluate = image_objective(
         obs, scene, space, simulator, renderer, per_object=per_object, effects=effects
     )
-    driven = drive(estimator, task, evaluate, seed=derive_seeds(seed).estimator, visit=visit)
+    restarts: list[int] = []
+    redirect = None if restart is None else _redirect(restart, space, seed, records, restarts)
+    est_seed = derive_seeds(seed).estimator
+    driven = drive(estimator, task, evaluate, seed=est_seed, visit=visit, redirect=redirect)
     return History(
         iterations=records,
         posterior=driven.posterior,
+        restarts=tuple(restarts),
+        fit=_fit(obs, records[-1].best_loss, best_frames[0]),
         keys=space.keys,
         estimator=name,
         at_bound=space.at_bound(records[records[-1].best_iteration].params),
@@ -501,11 +603,18 @@ def refine(
         initial=first,
         truth=truth,
         options=dict(estimator.options),
-        meta={
-            "scene": scene.name,
-            "simulator": type(simulator).name,
-            "per_object": per_object,
-            "observation": obs.source,
-            "t_start": driven.t_start,
-        },
+        meta=_meta(scene, simulator, per_object, obs, driven),
     )
+
+
+def _meta(
+    scene: Scene, simulator: Simulator, per_object: bool, obs: Observation, driven: Driven
+) -> dict[str, Any]:
+    """What a history records about the run's setting in ``meta``."""
+    return {
+        "scene": scene.name,
+        "simulator": type(simulator).name,
+        "per_object": per_object,
+        "observation": obs.source,
+        "t_start": driven.t_start,
+    }

@@ -59,7 +59,14 @@ class CountingSimulator(ToySimulator):
 
 
 def _run(  # type: ignore[no-untyped-def]
-    estimator, *, iterations: int = 6, params=("mass",), sim=None, obs=None, seed: int = 0
+    estimator,
+    *,
+    iterations: int = 6,
+    params=("mass",),
+    sim=None,
+    obs=None,
+    seed: int = 0,
+    **kwargs,
 ):
     t = toy_task(params, seed=seed)
     return refine(
@@ -71,6 +78,7 @@ def _run(  # type: ignore[no-untyped-def]
         estimator,
         iterations=iterations,
         seed=seed,
+        **kwargs,
     )
 
 
@@ -320,3 +328,49 @@ def test_an_estimate_at_an_end_of_its_range_is_flagged() -> None:
     assert space.at_bound({a: ranges[0].low, b: ranges[1].high}) == (a, b)
     inside = {a: ranges[0].low + 0.01 * (ranges[0].high - ranges[0].low), b: at_edge[b]}
     assert space.at_bound(inside) == ()
+
+
+def test_a_fit_far_above_the_noise_floor_is_flagged_one_at_the_floor_is_not() -> None:
+    from physbench.render.sensor import SensorModel
+
+    t = toy_task(("mass",), seed=0)
+    truth = dict(t.observation.truth or {})
+    noisy = simulate_observation(
+        t.scene, truth, t.simulator, t.renderer, sensor=SensorModel(noise=0.02, seed=0)
+    )
+    good = _run(Scripted([truth]), iterations=3, obs=noisy)
+    assert good.fit is not None and good.fit.noise_ratio == pytest.approx(1.0, abs=0.1)
+    assert not good.fit.failed and good.fit.describe() is None
+    wrong = {"a.mass": 1.0, "b.mass": 10.0}
+    bad = _run(Scripted([wrong]), iterations=2, initial=wrong, obs=noisy)  # never near the truth
+    assert bad.fit is not None and bad.fit.failed and bad.fit.noise_ratio > 10
+    assert (bad.fit.describe() or "").startswith("the fit looks failed: its best image MSE")
+    again = History.from_dict(json.loads(bad.to_json()))
+    assert again.fit == bad.fit
+    # Frames stated noise-free have no noise floor to compare with.
+    sharp = simulate_observation(t.scene, truth, t.simulator, t.renderer, sensor=SensorModel())
+    clean = _run(Scripted([wrong]), iterations=2, obs=sharp)
+    assert clean.fit is not None and clean.fit.noise_floor is None and not clean.fit.failed
+
+
+def test_a_restart_simulates_design_points_while_the_fit_looks_failed() -> None:
+    from physbench.loop import Restart
+
+    t = toy_task(("mass",), seed=0)
+    wrong = {"a.mass": 1.0, "b.mass": 10.0}
+    sim = CountingSimulator()
+    est = Scripted([wrong])  # stuck: proposes the same wrong point for ever
+    h = _run(est, iterations=10, sim=sim, initial=wrong, restart=Restart(threshold=1e-12))
+    assert h.restarts == (3, 6, 9)  # from iteration `after` on, once every `every` iterations
+    for k in range(10):
+        moved = sim.calls[k] != wrong
+        assert moved == (k in h.restarts), k  # the rest simulate the estimator's proposal
+        assert est.steps[k].params == sim.calls[k]  # the estimator sees what was simulated
+    assert len({tuple(sim.calls[k].values()) for k in h.restarts}) == 3
+    assert all(t.space.contains(sim.calls[k]) for k in h.restarts)
+    # A threshold no loss exceeds: the same run as without a restart.
+    same = _run(Scripted([wrong]), iterations=10, initial=wrong, restart=Restart(threshold=10.0))
+    plain = _run(Scripted([wrong]), iterations=10, initial=wrong)
+    assert same.restarts == () and same.to_dict(timings=False) == plain.to_dict(timings=False)
+    with pytest.raises(PhysbenchError, match="restart every = 0"):
+        Restart(threshold=1.0, every=0)

@@ -379,7 +379,9 @@ def _save_outputs(args: argparse.Namespace, history: Any) -> None:
 
 
 def _warn_about_result(history: Any) -> None:
-    """Warn on stderr of estimates at a range's end and of incomplete or uninformed posteriors."""
+    """Warn on stderr of estimates at a range's end, of a failed fit, of incomplete or uninformed
+    posteriors, of an observation outside a learned posterior's training data and of one the
+    model does not reproduce."""
     if history.at_bound:
         print(
             f"physbench run: warning: {', '.join(history.at_bound)} ended at an end of "
@@ -387,9 +389,18 @@ def _warn_about_result(history: Any) -> None:
             "(--params KEY=LOW:HIGH, or a scene TOML's [[unknowns]]) and run again",
             file=sys.stderr,
         )
+    if history.fit is not None and history.fit.failed:
+        print(f"physbench run: warning: {history.fit.describe()}", file=sys.stderr)
     post = history.posterior
     if post is not None and not post.complete:
         print(f"physbench run: warning: incomplete posterior: {post.note}", file=sys.stderr)
+    if post is not None and post.domain is not None and not post.domain.inside:
+        print(f"physbench run: warning: {post.domain.describe(post.method)}", file=sys.stderr)
+    check = history.predictive
+    if check is not None and not check.reproduced:
+        from physbench.posterior.predictive import warning
+
+        print(f"physbench run: warning: {warning(check.p)}", file=sys.stderr)
     if post is not None and post.undetermined():
         print(
             f"physbench run: warning: the data do not determine {', '.join(post.undetermined())}: "
@@ -453,6 +464,8 @@ def _print_posterior(history: Any) -> None:
         print(f"posterior ({history.posterior.method}, {len(history.posterior)} samples):")
         for line in history.posterior.describe(history.truth):
             print("  " + line)
+        if history.predictive is not None:
+            print("  " + history.predictive.describe())
 
 
 def _print_final_line(args: argparse.Namespace, history: Any) -> None:

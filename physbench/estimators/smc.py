@@ -149,17 +149,20 @@ class SMCEstimator(CorrectionEstimator):
             moves, sweep = MAX_MOVES, 0
             while sweep < moves:
                 chol = np.linalg.cholesky(scale * cov)
-                accepted = tried = 0
+                accepted = 0
                 for i in range(n):
                     prop = self.units[i] + chol @ self.rng.standard_normal(d)
                     if np.any(prop < 0) or np.any(prop > 1):
                         continue  # zero prior density: rejected without a simulation
-                    tried += 1
                     ll = yield prop
                     if math.log(self.rng.random()) < beta * (ll - self.loglik[i]):
                         self.units[i], self.loglik[i] = prop, ll
                         accepted += 1
-                rate = accepted / max(tried, 1)
+                # A proposal outside the range is a rejection too. Counting only the simulated
+                # ones, a flat likelihood accepts all of them, the proposal grows until nearly
+                # every one falls outside, and sweeps that cost no simulation repeat the same
+                # particles into the pool (1,247,552 samples from 6,000 simulations).
+                rate = accepted / n
                 # Keep the acceptance near 0.25: shrink or grow the proposal.
                 scale *= math.exp(rate - 0.25)
                 if sweep == 0:
@@ -172,7 +175,7 @@ class SMCEstimator(CorrectionEstimator):
                         )
                     )
                 sweep += 1
-                if self.moved_at_one:
+                if self.moved_at_one and accepted:  # a sweep where nothing moved adds nothing
                     self.pool.append(self.units.copy())
             if self.beta >= 1 and not self.moved_at_one:
                 self.moved_at_one = True
@@ -181,14 +184,16 @@ class SMCEstimator(CorrectionEstimator):
 
     def posterior(self) -> Posterior | None:
         """Called once after the run: the particles of every sweep since the likelihood was fully
-        on (or the current ones, marked incomplete, when the budget ran out before)."""
+        on; or, marked incomplete with the reason, the current ones when the budget ran out
+        before, or the first population's particles simulated so far, tempered as far as they
+        allow, when it ran out before that population was complete."""
         from physbench.posterior.samples import Posterior
 
-        if self.space is None:
+        if self.space is None or self.evaluations < 2:
             return None
         n = self.options["particles"]
         if self.evaluations < n:
-            return None  # not even the first population: nothing to report
+            return self._first_population()
         complete = self.beta >= 1 and self.moved_at_one
         if complete:
             note = ""
@@ -203,20 +208,57 @@ class SMCEstimator(CorrectionEstimator):
                 f"{self.evaluations} simulations: the intervals are too wide; give more "
                 "iterations"
             )
-
         return Posterior.from_unit(
             self.space,
             np.concatenate(self.pool) if self.pool else self.units,
             self.name,
             complete=complete,
             note=note,
-            extra={
-                "noise": self.sigma,
-                "beta": self.beta,
-                "stages": float(self.stages),
-                "simulations_to_posterior": float(self.converged_at),
-            },
+            extra=self._extra(self.beta),
         )
+
+    def _first_population(self) -> Posterior:
+        """The particles simulated before the budget ran out, resampled at the largest
+        tempering ``beta`` they support: between the prior and the posterior, marked
+        incomplete with the number of iterations the first population needs."""
+        from physbench.posterior.samples import Posterior
+
+        m, n = self.evaluations, self.options["particles"]
+        loglik = self.loglik[:m]
+        if np.isfinite(loglik).any():
+            beta = next_beta(loglik, 0.0)
+            idx = systematic_resample(beta * loglik, np.random.default_rng([m, 31]))
+        else:  # every simulation failed: nothing to weight them by
+            beta, idx = 0.0, np.arange(m)
+        weighted = (
+            "weighted by their likelihood"
+            if beta >= 1
+            else f"tempered only to beta = {beta:.3g} of 1, so the intervals are too wide"
+        )
+        note = (
+            f"too few iterations for {n} particles: {m} of the first population were simulated "
+            f"({weighted}), too few to trust the intervals. smc needs at "
+            f"least {n + 1} iterations (the initial guess and one simulation per particle) to "
+            "finish its first population, and thousands to reach the posterior (about 5,000 on "
+            f"three_circles mass): give --iterations {n + 1} or more, or fewer particles than "
+            "iterations (-o particles=N, N >= 8)"
+        )
+        return Posterior.from_unit(
+            self.space,
+            self.units[:m][idx],
+            self.name,
+            complete=False,
+            note=note,
+            extra=self._extra(beta),
+        )
+
+    def _extra(self, beta: float) -> dict[str, float]:
+        return {
+            "noise": self.sigma,
+            "beta": beta,
+            "stages": float(self.stages),
+            "simulations_to_posterior": float(self.converged_at),
+        }
 
 
 @hookimpl

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from physbench.errors import PhysbenchError
+from physbench.posterior.domain import TrainingDomain
 
 #: The central intervals a run reports.
 LEVELS = (0.5, 0.9)
@@ -35,7 +36,8 @@ class Posterior:
     ``complete``: ``False`` when the method stopped short of its target (e.g. a sampler whose
     budget ran out), with the reason in ``note``; ``extra``: the method's own diagnostics, for
     people reading a run's JSON (smc: its noise level, final beta, stages, simulations to reach
-    the posterior); physbench computes nothing from them."""
+    the posterior); physbench computes nothing from them. ``domain``: for a learned method, how
+    far the observation lies from its training data (``None``: not measured)."""
 
     keys: tuple[str, ...]
     samples: np.ndarray
@@ -45,6 +47,7 @@ class Posterior:
     complete: bool = True
     note: str = ""
     extra: Mapping[str, float] = field(default_factory=dict)
+    domain: TrainingDomain | None = None
 
     def __post_init__(self) -> None:
         s = np.asarray(self.samples, dtype=float)
@@ -102,8 +105,18 @@ class Posterior:
             for k, lo, hi in zip(self.keys, self.low, self.high, strict=True)
         }
 
+    @property
+    def outside(self) -> bool:
+        """Whether the observation lies outside the method's training data (see ``domain``)."""
+        return self.domain is not None and not self.domain.inside
+
     def undetermined(self) -> tuple[str, ...]:
-        """Unknowns the data did not narrow down (see :data:`UNDETERMINED_RATIO`)."""
+        """Unknowns the data did not narrow down (see :data:`UNDETERMINED_RATIO`). Only a
+        complete posterior from inside its method's training data says that: an incomplete
+        one is too wide by construction, and one from outside its training data is wide (or
+        narrow) for reasons of its own, not the data's."""
+        if not self.complete or self.outside:
+            return ()
         return tuple(k for k, r in self.width_ratio().items() if r >= UNDETERMINED_RATIO)
 
     def to_dict(self, max_samples: int = JSON_SAMPLES) -> dict[str, Any]:
@@ -124,6 +137,7 @@ class Posterior:
             "quantiles": self.quantiles(qs),
             "undetermined": list(self.undetermined()),
             "extra": dict(self.extra),
+            "domain": None if self.domain is None else self.domain.to_dict(),
             "samples": self.samples[idx].tolist(),
         }
 
@@ -138,6 +152,7 @@ class Posterior:
             complete=bool(d.get("complete", True)),
             note=str(d.get("note", "")),
             extra=dict(d.get("extra", {})),
+            domain=None if d.get("domain") is None else TrainingDomain.from_dict(d["domain"]),
         )
 
     def describe(self, truth: Mapping[str, float] | None = None) -> list[str]:
@@ -160,6 +175,8 @@ class Posterior:
                     "do not tell this unknown"
                 )
             lines.append(line)
+        if self.domain is not None and not self.domain.inside:
+            lines.append(self.domain.describe(self.method))
         if not self.complete:
             lines.append(f"incomplete posterior ({self.method}): {self.note}")
         return lines

@@ -414,3 +414,35 @@ def test_the_size_check_refuses_through_the_api_too(monkeypatch: pytest.MonkeyPa
     monkeypatch.delenv("PHYSBENCH_NO_SIZE_CHECK", raising=False)
     with pytest.raises(SizeError, match="1000000003 simulations"):
         run_config(RunConfig(iterations=10**9))
+
+
+def test_smc_with_too_few_iterations_says_why_its_posterior_falls_short(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # 11 iterations for 64 particles: before, no posterior and not a word about why.
+    code, out, err = run(capsys, "--scene", "ball_drop", "--estimator", "smc")
+    assert code == 0
+    assert "posterior (smc, 10 samples):" in out
+    assert "warning: incomplete posterior: too few iterations for 64 particles" in err
+    assert "at least 65 iterations" in err and "--iterations 65" in err
+    assert "do not determine" not in err  # 10 prior draws say nothing about the data
+
+
+def test_npe_says_a_blurred_observation_is_outside_its_training_data(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    pytest.importorskip("torch")
+    argv = ["--estimator", "npe", "--blur", "3", "--seed", "0"]
+    code, out, err = run(capsys, *argv)
+    assert code == 0
+    # Before: "the data do not determine a.mass", while the frames pin it down.
+    assert "outside npe's training data (blur? another engine?): use smc" in err
+    assert "do not determine" not in err and "not determined" not in out
+    code, out, _ = run(capsys, *argv, "--json")
+    domain = json.loads(out)["posterior"]["domain"]
+    assert domain["inside"] is False and domain["distance"] > 100 * domain["threshold"]
+    code, out, err = run(capsys, "--estimator", "npe", "--seed", "0", "--json")
+    h = json.loads(out)
+    assert h["posterior"]["domain"]["inside"] is True
+    assert h["predictive"]["reproduced"] is True and h["predictive"]["draws"] == 59
+    assert "warning" not in err

@@ -63,8 +63,14 @@ class NPEEstimator(CorrectionEstimator):
         import torch
 
         from physbench.estimators.npe import weights
-        from physbench.estimators.npe.features import summarize
+        from physbench.estimators.npe.features import (
+            DEFAULT_THRESHOLD,
+            DISTANCE,
+            distance,
+            summarize,
+        )
         from physbench.estimators.npe.network import sample_unit
+        from physbench.posterior.domain import TrainingDomain
         from physbench.posterior.samples import Posterior
 
         if self.threads:
@@ -89,6 +95,10 @@ class NPEEstimator(CorrectionEstimator):
         rng = np.random.default_rng([seed, 23])
         unit = np.empty((self.samples, len(task.space)))
         index = {k: j for j, k in enumerate(task.space.keys)}
+        # Every member standardizes with the training set's feature mean and spread.
+        mean = members[0].feature_mean.double().numpy()
+        std = members[0].feature_std.double().numpy()
+        far = 0.0
         for body in task.space.bodies:
             keys = [f"{body}.{p}" for p in data["params"]]
             for k, p in zip(keys, data["params"], strict=True):
@@ -107,11 +117,17 @@ class NPEEstimator(CorrectionEstimator):
                     f"focus={body!r}); give marked_<body> arrays in the observation file"
                 )
             feats = summarize(task.marked_observation[body], int(data["frames"]))
+            far = max(far, float(distance(feats, mean, std)))
             draws = sample_unit(members, feats, self.samples, rng)
             for j, k in enumerate(keys):
                 unit[:, index[k]] = draws[:, j]
+        threshold = float(meta.get("domain", {}).get("threshold", DEFAULT_THRESHOLD))
         self._posterior = Posterior.from_unit(
-            task.space, unit, "npe", note="product over bodies of per-body amortized posteriors"
+            task.space,
+            unit,
+            "npe",
+            note="product over bodies of per-body amortized posteriors",
+            domain=TrainingDomain(far, threshold, f"{DISTANCE} (the farthest marked view)"),
         )
         self.space = task.space
         self.proposed = 0

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from physbench.estimators.npe.features import domain_record
 from physbench.estimators.npe.network import MDNConfig, build_mdn, ensemble_log_prob, to_logit
 from physbench.estimators.npe.training_data import (
     TRAIN_SEED0,
@@ -136,6 +137,7 @@ def train(
             )
     with torch.no_grad():
         val_nll = float(-ensemble_log_prob(members, tvx, tvz).mean())
+    domain = domain_record(vx, mean.numpy(), std.numpy())
     space = ParamSpace.from_scene(spec.instance(0), spec.params)
     meta = {
         "kind": "npe",
@@ -154,6 +156,7 @@ def train(
             "members": records,
         },
         "val_nll": val_nll,
+        "domain": domain,
         "physbench_version": physbench.__version__,
         "torch_version": torch.__version__,
     }
