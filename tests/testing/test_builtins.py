@@ -21,6 +21,10 @@ SETTINGS: dict[str, dict[str, Any]] = {
     "cmaes": {"kit": {"bad_options": [{"sigma": 0.0}, {"popsize": 1}, {"elitist": "yes"}]}},
     "nevergrad": {"kit": {"bad_options": [{"optimizer": "NoSuchOptimizer"}]}},
     "optuna": {"kit": {"bad_options": [{"sampler": "grid"}, {"startup": 2.5}]}},
+    "gp": {
+        "kit": {"bad_options": [{"startup": 0}, {"design": "sobol"}]},
+        "requires": ("torch",),
+    },
     "resnet3d": {
         # Shipped weights for mass; the toy task's frames are resampled to the network's input.
         "options": {
@@ -64,7 +68,9 @@ def test_every_kind_has_builtins() -> None:
         "camera",
     }
     assert by_kind["effect"] == {cls.name for cls in BUILTIN_EFFECTS}
-    assert {"random", "tpe", "cmaes", "nevergrad", "optuna", "resnet3d"} <= by_kind["estimator"]
+    assert {"random", "tpe", "cmaes", "nevergrad", "optuna", "gp", "resnet3d"} <= by_kind[
+        "estimator"
+    ]
     assert "scipy" not in by_kind["estimator"]  # the example plugin tests itself
     assert set(SETTINGS) <= by_kind["estimator"]
     registered = build_registry(env=False).names("estimator")
