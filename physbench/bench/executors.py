@@ -13,9 +13,10 @@ it cannot contain that. Local worker processes (a LocalCluster's too) die with t
 started them.
 
 The caller may group items by what their first run in a process costs (``affinity``: a cell's
-estimator and engine, whose libraries take up to a second to import): the ``processes`` executor
-then gives a free worker the items of groups it has already run, so each group's imports are paid
-by as few workers as the load allows instead of by every worker.
+estimator and engine, whose libraries take up to 2 s to import): the ``processes`` and ``dask``
+executors then give a free worker the items of groups it has already run, so each group's imports
+are paid by as few workers as the load allows instead of by every worker
+(:mod:`~physbench.bench.placement`).
 """
 
 from __future__ import annotations
@@ -27,14 +28,16 @@ import threading
 import time
 from collections.abc import Callable, Generator, Hashable, Iterator, Sequence
 from pathlib import Path
-from typing import Any, Generic, Protocol, TypeVar
+from typing import Any, Protocol, TypeVar
 
+from physbench.bench.placement import Pending, timed_call
 from physbench.errors import PhysbenchError, counted
 
 T = TypeVar("T")
 R = TypeVar("R")
 NAMES = ("serial", "processes", "dask")
-#: Items a local pool holds per worker: one running, one queued behind it.
+#: Items a worker holds at most: one running, one queued behind it (while at least as many items
+#: as workers are left; fewer, and each worker holds one, so that none waits behind another's).
 QUEUED = 2
 
 
@@ -154,53 +157,11 @@ class SerialExecutor:
         return "serial"
 
 
-class Pending(Generic[T]):
-    """The items a :class:`ProcessExecutor` has yet to hand out, grouped by ``affinity`` (all in
-    one group without it), each group in the callers' order; asked by the executor each time a
-    worker has room for another item."""
-
-    def __init__(self, items: Sequence[T], affinity: Callable[[T], Hashable] | None) -> None:
-        from collections import deque
-
-        self._groups: dict[Hashable, deque[T]] = {}
-        for item in items:
-            key = affinity(item) if affinity is not None else None
-            self._groups.setdefault(key, deque()).append(item)
-        self._started: set[Hashable] = set()
-        self._affinity = affinity
-
-    def __len__(self) -> int:
-        return sum(len(q) for q in self._groups.values())
-
-    def take(self, ran: set[Hashable]) -> T:
-        """The next item for a worker that has run the groups ``ran`` (updated): one of those
-        groups if any is left; else a group no worker has started, in the callers' order; else
-        one from the group with the most items left, so that stragglers share the longest one."""
-        key = next((k for k, q in self._groups.items() if q and k in ran), None)
-        if key is None:
-            key = next((k for k, q in self._groups.items() if q and k not in self._started), None)
-        if key is None:
-            key = max(self._groups, key=lambda k: len(self._groups[k]))
-        ran.add(key)
-        self._started.add(key)
-        item = self._groups[key].popleft()
-        if not self._groups[key]:
-            del self._groups[key]
-        return item
-
-    def put_back(self, item: T) -> None:
-        """Return ``item`` to the front of its group: the worker it was taken for was gone."""
-        from collections import deque
-
-        key = self._affinity(item) if self._affinity is not None else None
-        self._groups.setdefault(key, deque()).appendleft(item)
-
-
 class ProcessExecutor:
     """``workers`` local processes, started with ``spawn`` (a fork would copy this process's
     threads, e.g. the progress bar's monitor, into a half-initialised child), each its own
     single-process pool so that this process chooses which worker runs which item (see
-    :class:`Pending`).
+    :class:`~physbench.bench.placement.Pending`).
 
     At most :data:`QUEUED` items per worker are handed out at a time (one running, one waiting,
     so that a worker starts its next item without a round trip through this process), so when a
@@ -249,13 +210,17 @@ class ProcessExecutor:
         affinity: Callable[[T], Hashable] | None = None,
     ) -> Iterator[tuple[T, R]]:
         pending = Pending(items, affinity)
+        generation = 0
         while pending:
             if not self._pools:
                 self.__enter__()
-            suspects = yield from self._until_broken(fn, pending)
+            generation += 1
+            suspects = yield from self._until_broken(fn, pending, generation)
             if suspects is not None:
                 for pool in self._pools:
                     pool.shutdown(wait=True)
+                for w in range(len(self._pools)):
+                    pending.forget((generation, w))
                 self._pools = []
                 for i in range(0, len(suspects), self.workers):
                     yield from self._each_alone(fn, suspects[i : i + self.workers], died)
@@ -264,30 +229,41 @@ class ProcessExecutor:
         self,
         fn: Callable[[T], R],
         pending: Pending[T],
+        generation: int,
     ) -> Generator[tuple[T, R], None, list[T] | None]:
-        """Yield results from the pools until ``pending`` is empty (then return ``None``) or a
-        pool breaks (then, once the other pools' items in flight are done, return the broken
-        pools' items, maybe none)."""
+        """Yield results from the pools (worker ``w`` is ``(generation, w)`` to ``pending``)
+        until ``pending`` is empty (then return ``None``) or a pool breaks (then, once the other
+        pools' items in flight are done, return the broken pools' items, maybe none)."""
         from concurrent.futures import ALL_COMPLETED, FIRST_COMPLETED, wait
         from concurrent.futures.process import BrokenProcessPool
 
         window: dict[Any, tuple[int, T]] = {}  # future -> (worker, item)
-        ran: list[set[Hashable]] = [set() for _ in self._pools]
         queued = [0] * len(self._pools)
         suspects: list[T] = []
         broken = False
+
+        def hand_out(w: int, *, force: bool = False) -> None:
+            nonlocal broken
+            limit = QUEUED if len(pending) >= len(self._pools) else 1
+            while pending and queued[w] < limit and not broken:
+                item = pending.take((generation, w), force=force)
+                if item is None:
+                    return
+                try:
+                    window[self._pools[w].submit(timed_call, fn, item)] = (w, item)
+                except BrokenProcessPool:
+                    pending.put_back(item)
+                    broken = True
+                    return
+                queued[w] += 1
+                force = False
+
         try:
             while pending or window:
-                for w, pool in enumerate(self._pools):
-                    while pending and queued[w] < QUEUED and not broken:
-                        item = pending.take(ran[w])
-                        try:
-                            window[pool.submit(fn, item)] = (w, item)
-                        except BrokenProcessPool:
-                            pending.put_back(item)
-                            broken = True
-                            break
-                        queued[w] += 1
+                for w in range(len(self._pools)):
+                    hand_out(w)
+                if pending and not window and not broken:  # every worker chose to wait
+                    hand_out(queued.index(min(queued)), force=True)
                 # once a pool broke, wait for all: a broken pool fails every future it holds
                 done = wait(window, return_when=ALL_COMPLETED if broken else FIRST_COMPLETED).done
                 for fut in done:
@@ -297,7 +273,9 @@ class ProcessExecutor:
                         suspects.append(item)
                         broken = True
                     else:
-                        yield item, fut.result()
+                        seconds, result = fut.result()
+                        pending.done((generation, w), item, seconds)
+                        yield item, result
                 if broken and not window:
                     return suspects
             return None
@@ -355,9 +333,35 @@ class ProcessExecutor:
         return f"processes ({counted(self.workers, 'worker')})"
 
 
+#: Dask settings for the LocalCluster physbench starts (its workers get them from its nannies).
+LOCAL_DASK_CONFIG = {
+    # Dask sets MALLOC_TRIM_THRESHOLD_=65536 in the workers it spawns, so that glibc hands freed
+    # memory back at once; a cell then faults its frames' memory in again and again: 42-43 ms of
+    # CPU per smoke cell against 27-30 ms without it (measured on the development VM).
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    # The statistical profiler samples every thread's stack every 10 ms, for a dashboard that a
+    # physbench LocalCluster does not open; the monitors below poll for it too. Together they
+    # cost an idle 2-worker cluster 0.065 CPU-s per second, 0.016 with these settings.
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.admin.tick.interval": "1s",
+    "distributed.worker.memory.monitor-interval": "1s",
+    # Cells are placed by physbench (see map_unordered), at most QUEUED per worker: nothing to
+    # steal.
+    "distributed.scheduler.work-stealing": False,
+}
+
+
 class DaskExecutor:
     """A Dask ``distributed`` cluster: the scheduler at ``address`` (``tcp://host:8786``), or a
-    LocalCluster of ``workers`` single-threaded worker processes when no address is given.
+    LocalCluster of ``workers`` single-threaded worker processes when no address is given
+    (started with :data:`LOCAL_DASK_CONFIG`).
+
+    Cells are handed out as by :class:`ProcessExecutor`: at most :data:`QUEUED` per worker
+    thread at a time, each to a worker chosen by ``affinity`` (:class:`~.placement.Pending`), as
+    a loose restriction (``workers=[address], allow_other_workers=True``: if that worker leaves, the
+    scheduler runs the cell elsewhere). Workers that join a remote cluster later get cells from
+    then on.
 
     A cell whose worker dies is run again once, alone on the cluster after the other cells, then
     given to ``died``. A LocalCluster's scheduler gives up on a cell at its first dead worker
@@ -374,11 +378,13 @@ class DaskExecutor:
         self.workers = workers or default_workers()
         self._client: Any = None
         self._cluster: Any = None
+        self._seen: set[str] = set()  # the workers cells were last handed to
 
     def __enter__(self) -> DaskExecutor:
         import logging
 
         try:
+            import dask
             from distributed import Client, LocalCluster
         except ImportError:
             raise PhysbenchError(
@@ -387,24 +393,19 @@ class DaskExecutor:
         try:
             if self.address:
                 self._client = Client(self.address, timeout="20s")
-                self.workers = max(
-                    1,
-                    sum(
-                        w.get("nthreads", 1)
-                        for w in self._client.scheduler_info()["workers"].values()
-                    ),
-                )
+                self.workers = max(1, sum(self._threads().values()))
             else:
-                self._cluster = LocalCluster(
-                    n_workers=self.workers,
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address=None,
-                    # The scheduler logs every cell it gives up on as an error; physbench
-                    # reports that cell itself.
-                    silence_logs=logging.CRITICAL,
-                    scheduler_kwargs={"allowed_failures": 0},
-                )
+                with dask.config.set(LOCAL_DASK_CONFIG):
+                    self._cluster = LocalCluster(
+                        n_workers=self.workers,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=None,
+                        # The scheduler logs every cell it gives up on as an error; physbench
+                        # reports that cell itself.
+                        silence_logs=logging.CRITICAL,
+                        scheduler_kwargs={"allowed_failures": 0},
+                    )
                 self._client = Client(self._cluster)
         except OSError as exc:
             raise PhysbenchError(
@@ -420,6 +421,11 @@ class DaskExecutor:
             self._cluster.close()
         self._client = self._cluster = None
 
+    def _threads(self) -> dict[str, int]:
+        """Each worker's address and threads, as the scheduler last told this client."""
+        workers = self._client.scheduler_info()["workers"]
+        return {addr: int(info.get("nthreads", 1)) for addr, info in workers.items()}
+
     def map_unordered(
         self,
         fn: Callable[[T], R],
@@ -427,39 +433,93 @@ class DaskExecutor:
         died: Callable[[T, str], R],
         affinity: Callable[[T], Hashable] | None = None,
     ) -> Iterator[tuple[T, R]]:
-        """``affinity`` is ignored: the Dask scheduler places tasks itself."""
         from distributed import KilledWorker, as_completed
 
-        running: dict[str, tuple[Any, T]] = {}
-        for item in items:
-            fut = self._client.submit(fn, item, pure=False)
-            running[fut.key] = (fut, item)
+        pending = Pending(items, affinity)
+        running: dict[str, tuple[Any, T, str]] = {}  # future key -> (future, item, worker)
+        finished = as_completed()
         suspects: list[T] = []
         try:
-            for fut in as_completed([f for f, _ in running.values()]):
-                _, item = running.pop(fut.key)
+            self._refill(fn, pending, running, finished)
+            for fut in finished:
+                _, item, addr = running.pop(fut.key)
                 try:
-                    result = self._result(fut)
+                    seconds, result = self._result(fut)
                 except KilledWorker:  # maybe only queued on the worker another cell killed
                     suspects.append(item)
+                    self._refill(fn, pending, running, finished)
                     continue
+                pending.done(addr, item, seconds)
+                self._refill(fn, pending, running, finished)
                 yield item, result
-            for item in suspects:
-                # Alone, so that if it kills its worker again it takes no other cell along.
-                fut = self._client.submit(fn, item, pure=False)
-                running[fut.key] = (fut, item)
-                try:
-                    result = self._result(fut)
-                except KilledWorker:
-                    result = died(
-                        item,
-                        "the Dask worker process died running it (KilledWorker), also when run "
-                        "again alone on the cluster",
-                    )
-                del running[fut.key]
-                yield item, result
+            yield from self._alone(fn, suspects, died, running)
         finally:
-            self._client.cancel([f for f, _ in running.values()])
+            self._client.cancel([f for f, _, _ in running.values()])
+
+    def _refill(
+        self,
+        fn: Callable[[T], R],
+        pending: Pending[T],
+        running: dict[str, tuple[Any, T, str]],
+        finished: Any,
+    ) -> None:
+        """Hand each worker items from ``pending`` as :class:`ProcessExecutor` does, :data:`QUEUED`
+        per thread; with none in flight and no worker (a LocalCluster's nanny restarting the
+        only one), wait for one."""
+        if pending and not running and not self._threads():
+            try:
+                self._client.wait_for_workers(1, timeout=60)
+            except TimeoutError:
+                raise PhysbenchError(
+                    "the Dask cluster has no workers left (none joined in 60 s); finished cells "
+                    "are saved: re-run the same command to resume"
+                ) from None
+        threads = self._threads()
+        for addr in self._seen - threads.keys():
+            pending.forget(addr)
+        self._seen = set(threads)
+        held: dict[str, int] = {}
+        for _, _, addr in running.values():
+            held[addr] = held.get(addr, 0) + 1
+        force = not running
+        for addr, n in threads.items():
+            limit = n * (QUEUED if len(pending) >= sum(threads.values()) else 1)
+            while pending and held.get(addr, 0) < limit:
+                item = pending.take(addr, force=force)
+                if item is None:
+                    break
+                fut = self._client.submit(
+                    timed_call, fn, item, pure=False, workers=[addr], allow_other_workers=True
+                )
+                running[fut.key] = (fut, item, addr)
+                held[addr] = held.get(addr, 0) + 1
+                finished.add(fut)
+                force = False
+
+    def _alone(
+        self,
+        fn: Callable[[T], R],
+        suspects: list[T],
+        died: Callable[[T, str], R],
+        running: dict[str, tuple[Any, T, str]],
+    ) -> Iterator[tuple[T, R]]:
+        """Run each suspect again, one at a time, so that if it kills its worker again it takes
+        no other cell along; yield its result or ``died``'s."""
+        from distributed import KilledWorker
+
+        for item in suspects:
+            fut = self._client.submit(timed_call, fn, item, pure=False)
+            running[fut.key] = (fut, item, "")
+            try:
+                _, result = self._result(fut)
+            except KilledWorker:
+                result = died(
+                    item,
+                    "the Dask worker process died running it (KilledWorker), also when run "
+                    "again alone on the cluster",
+                )
+            del running[fut.key]
+            yield item, result
 
     @staticmethod
     def _result(fut: Any) -> Any:

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from physbench.bench.spec import Cell, Spec
-from physbench.bench.store import RESULTS, CellStore, atomic_write
+from physbench.bench.store import RESULTS, CellStore, CellWriter, atomic_write
 from physbench.errors import PhysbenchError, counted
 from physbench.experiment import RunConfig
 
@@ -140,24 +140,32 @@ class SweepFailedError(PhysbenchError):
         )
 
 
-def assemble(cells: list[Cell], store: CellStore) -> pd.DataFrame:
+def identity(c: Cell) -> dict[str, Any]:
+    """What the long table says of ``c`` beyond its stored data (:func:`~.tables.cell_rows`)."""
+    return {
+        "key": c.key,
+        "index": c.index,
+        "scene": c.scene,
+        "label": c.label,
+        "renderer_label": c.renderer_label,
+        "observer_label": c.observer_label,
+    }
+
+
+def assemble(
+    cells: list[Cell], store: CellStore, built: dict[str, list[dict[str, Any]]] | None = None
+) -> pd.DataFrame:
     """The long table from the stored cells, in cell order (cells without a result are left
-    out)."""
+    out). ``built`` holds rows already made from stored cells, by key (a sweep makes them as it
+    stores its cells); the other cells are read from ``store``."""
     from physbench.bench.tables import cell_rows, to_frame
 
     rows: list[dict[str, Any]] = []
     for c in cells:
-        data = store.load(c.key)
-        if data is not None:
-            identity = {
-                "key": c.key,
-                "index": c.index,
-                "scene": c.scene,
-                "label": c.label,
-                "renderer_label": c.renderer_label,
-                "observer_label": c.observer_label,
-            }
-            rows += cell_rows(identity, data)
+        if built is not None and c.key in built:
+            rows += built[c.key]
+        elif (data := store.load(c.key)) is not None:
+            rows += cell_rows(identity(c), data)
     return to_frame(rows)
 
 
@@ -296,6 +304,40 @@ def _log_run(spec: Spec, out: Path, entry: dict[str, Any], *, cells: int, failed
     atomic_write(log_path, (json.dumps(log, indent=1) + "\n").encode())
 
 
+def _run_cells(
+    ex: Executor,
+    todo: list[Cell],
+    store: CellStore,
+    stamps: dict[str, dict[str, Any]],
+    bar: Any,
+    built: dict[str, list[dict[str, Any]]],
+) -> int:
+    """Run ``todo`` on ``ex``, storing each cell as it arrives (in a :class:`CellWriter`, which
+    also fills ``built`` with each stored cell's table rows) and counting it on ``bar``; returns
+    how many failed."""
+    from physbench.bench.tables import cell_rows
+
+    by_config = {id(c.config): c for c in todo}  # executors hand back the objects they were given
+    by_key = {c.key: c for c in todo}
+
+    def saved(key: str, data: dict[str, Any]) -> None:
+        # a cell whose rows cannot be made here is read again by assemble, which says why
+        with contextlib.suppress(Exception):
+            built[key] = cell_rows(identity(by_key[key]), data)
+
+    failed = 0
+    with ex, CellWriter(store, saved) as writer:
+        configs = [c.config for c in todo]
+        for config, data in ex.map_unordered(run_cell, configs, died_cell, libraries):
+            key = by_config[id(config)].key
+            writer.put(key, {**data, "stamp": stamps[key]})
+            if data["status"] != "ok":
+                failed += 1
+                bar.set_postfix(failed=failed, refresh=False)
+            bar.update(1)
+    return failed
+
+
 def _run_locked(
     spec: Spec,
     store: CellStore,
@@ -333,8 +375,6 @@ def _run_locked(
 
     done = {c.key for c in kept}
     todo = [c for c in cells if c.key not in done]
-    # executors hand back the very objects they were given
-    by_config = {id(c.config): c for c in todo}
     # The tables' libraries take ~0.6 s to import: do it while the workers run the cells.
     warm = threading.Thread(target=_import_tables, name="physbench-import-tables", daemon=True)
     warm.start()
@@ -350,23 +390,16 @@ def _run_locked(
         disable=None if progress else True,
         dynamic_ncols=True,
     )
+    built: dict[str, list[dict[str, Any]]] = {}
     try:
         if todo:
-            with ex:
-                configs = [c.config for c in todo]
-                for config, data in ex.map_unordered(run_cell, configs, died_cell, libraries):
-                    key = by_config[id(config)].key
-                    store.save(key, {**data, "stamp": stamps[key]})
-                    if data["status"] != "ok":
-                        n_failed += 1
-                        bar.set_postfix(failed=n_failed, refresh=False)
-                    bar.update(1)
+            n_failed = _run_cells(ex, todo, store, stamps, bar, built)
     finally:
         bar.close()
     wall = time.perf_counter() - t0
 
     warm.join()
-    table = assemble(cells, store)
+    table = assemble(cells, store, built)
     write_table(table, out)
     st = write_summary(table, out, title=spec.name)
     failed = int((table.drop_duplicates("cell")["status"] != "ok").sum())

@@ -5,6 +5,13 @@ the same folder, flushed to disk, then renamed over the target), so a sweep kill
 leaves only whole cells, and a re-run skips them. Tables, summaries and plots are derived from the
 cells and rewritten atomically the same way.
 
+A sweep stores its cells through a :class:`CellWriter`: a thread that writes them in batches, off
+the loop that hands out cells, with one concurrent flush per batch. Flushing one file to disk
+(``fsync``) waits for the file system's journal: 1.4 ms on the quiet development VM, 8-12 ms while
+other jobs write, which capped a sweep that flushed each cell in its main loop at 80-700 cells/s
+whatever its workers could do. Concurrent flushes share journal commits (100 files: 0.5-0.8 s one
+after another, 40-50 ms from 16 threads, measured on that VM under load).
+
 One sweep at a time writes a folder: it holds ``DIR/.lock`` (a :class:`filelock.FileLock`, released
 by the system if the process is killed) and records its pid in ``DIR/.lock.pid``, so a second sweep
 on the same folder is refused with that pid (or waits) instead of repeating cells and deleting the
@@ -17,9 +24,10 @@ import contextlib
 import json
 import os
 import shutil
-from collections.abc import Iterator
+import threading
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from physbench.errors import PhysbenchError
 
@@ -125,3 +133,105 @@ class CellStore:
 
     def save(self, key: str, data: dict[str, Any]) -> None:
         atomic_write(self.path(key), json.dumps(data).encode())
+
+    def save_many(self, cells: list[tuple[str, dict[str, Any]]], flush: Any = map) -> list[str]:
+        """Write each ``(key, data)`` as :meth:`save` does (whole or not at all), flushing the
+        batch's files at once: each to a temporary file, then all flushed to disk through
+        ``flush`` (``map`` or a thread pool's ``map``: concurrent flushes share the file system's
+        journal commits), then each renamed into place. Returns each cell's JSON text."""
+        texts = [json.dumps(data) for _, data in cells]
+        files: list[tuple[IO[bytes], Path, Path]] = []
+        try:
+            for (key, _), text in zip(cells, texts, strict=True):
+                path = self.path(key)
+                tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+                files.append((open(tmp, "wb"), tmp, path))  # noqa: SIM115 (closed below)
+                files[-1][0].write(text.encode())
+            list(flush(_flush, [f for f, _, _ in files]))
+            for _, tmp, path in files:
+                os.replace(tmp, path)
+        finally:
+            for f, _, _ in files:
+                f.close()
+        return texts
+
+
+def _flush(f: IO[bytes]) -> None:
+    f.flush()
+    os.fsync(f.fileno())
+
+
+#: Threads that flush one batch of cell files to disk together (see the module's docstring).
+FLUSHERS = 16
+#: Cells one batch holds at most (each an open file until the batch is flushed).
+BATCH = 128
+
+
+class CellWriter:
+    """Stores finished cells in a background thread, in batches (:meth:`CellStore.save_many`),
+    so that the sweep's loop hands out the next cells while earlier ones are flushed to disk.
+    Used as a context manager around the loop: :meth:`put` queues a cell and returns at once;
+    leaving the block stores every queued cell before it returns, also when the loop raised
+    (Ctrl-C included), so only cells still running are lost. A failure to write (a full disk)
+    is raised by the next :meth:`put` or by leaving the block; the cells queued after it are not
+    stored (a re-run runs them).
+
+    ``saved(key, data)``, if given, is called in the writer thread for each cell once its file
+    is in place, with ``data`` read back from that file's JSON text (what :meth:`CellStore.load`
+    would return), e.g. to build the cell's table rows while the sweep goes on."""
+
+    def __init__(
+        self, store: CellStore, saved: Callable[[str, dict[str, Any]], None] | None = None
+    ) -> None:
+        self._store = store
+        self._saved = saved
+        self._queue: list[tuple[str, dict[str, Any]]] = []
+        self._wake = threading.Condition()
+        self._closed = False
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, name="physbench-cell-writer", daemon=True)
+
+    def __enter__(self) -> CellWriter:
+        self._thread.start()
+        return self
+
+    def put(self, key: str, data: dict[str, Any]) -> None:
+        """Queue ``data`` to be stored as cell ``key``; raises the writer's error, if any."""
+        with self._wake:
+            self._raise()
+            self._queue.append((key, data))
+            self._wake.notify()
+
+    def __exit__(self, *exc: object) -> None:
+        with self._wake:
+            self._closed = True
+            self._wake.notify()
+        self._thread.join()
+        if exc[0] is None:
+            with self._wake:
+                self._raise()
+
+    def _raise(self) -> None:
+        if self._error is not None:
+            raise self._error
+
+    def _run(self) -> None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(FLUSHERS, thread_name_prefix="physbench-flush") as pool:
+            while True:
+                with self._wake:
+                    while not self._queue and not self._closed:
+                        self._wake.wait()
+                    batch, self._queue = self._queue[:BATCH], self._queue[BATCH:]
+                if not batch:
+                    return
+                try:
+                    texts = self._store.save_many(batch, pool.map)
+                    if self._saved is not None:
+                        for (key, _), text in zip(batch, texts, strict=True):
+                            self._saved(key, json.loads(text))
+                except BaseException as exc:  # handed to the sweep's thread by put / __exit__
+                    with self._wake:
+                        self._error, self._queue = exc, []
+                    return

@@ -20,12 +20,12 @@ from physbench.bench.executors import (
     NAMES,
     QUEUED,
     DaskExecutor,
-    Pending,
     ProcessExecutor,
     SerialExecutor,
     default_workers,
     make_executor,
 )
+from physbench.bench.placement import Pending
 from physbench.errors import PhysbenchError
 
 ITEMS = [-3, 1, -4, 1, -5, 9, -2, 6]
@@ -123,36 +123,68 @@ def _group(item: str) -> str:
 
 def test_a_worker_keeps_to_the_groups_it_has_run_then_starts_a_new_one() -> None:
     pending = Pending(["a1", "b1", "a2", "b2", "c1", "a3"], _group)
-    first: set[object] = set()
-    second: set[object] = set()
-    taken = [pending.take(first), pending.take(second), pending.take(second)]
+    taken = [pending.take("first"), pending.take("second"), pending.take("second")]
     assert taken == ["a1", "b1", "b2"]  # the second worker starts b, a group nobody has started
-    assert [pending.take(first), pending.take(first), pending.take(second)] == ["a2", "a3", "c1"]
-    assert first == {"a"} and second == {"b", "c"} and not pending
+    assert [pending.take("first"), pending.take("first"), pending.take("second")] == [
+        "a2",
+        "a3",
+        "c1",
+    ]
+    assert not pending
 
 
-def test_a_worker_with_nothing_of_its_own_helps_with_the_longest_group() -> None:
+def test_without_estimates_a_worker_with_nothing_of_its_own_helps_the_longest_group() -> None:
     pending = Pending(["a1", "b1", "b2", "c1", "c2", "c3"], _group)
-    first: set[object] = set()
-    assert [pending.take(set()), pending.take(set()), pending.take(set())] == ["a1", "b1", "c1"]
-    assert pending.take(first) == "c2" and first == {"c"}  # c has 2 left, b 1
+    assert [pending.take(w) for w in ("x", "y", "z")] == ["a1", "b1", "c1"]
+    assert pending.take("x") == "c2"  # c has 2 left, b 1; no item has finished yet
     pending.put_back("c2")
-    assert pending.take({"c"}) == "c2" and len(pending) == 2
+    assert pending.take("z") == "c2" and len(pending) == 2
+
+
+def _timed_groups(left: int) -> Pending[str]:
+    """Group a: 1 s per item, 5 s more for a worker's first (its imports), ``left`` items left
+    on its one worker; group b: done."""
+    pending = Pending([f"a{i}" for i in range(3 + left)] + ["b0"], _group)
+    assert [pending.take("on a") for _ in range(3)] == ["a0", "a1", "a2"]
+    for item, seconds in (("a0", 6.0), ("a1", 1.0), ("a2", 1.0)):
+        pending.done("on a", item, seconds)
+    assert pending.take("on b") == "b0"
+    assert pending.estimates("a") == (1.0, 5.0)
+    return pending
+
+
+def test_a_worker_joins_a_started_group_only_while_that_pays() -> None:
+    # 5 items left: its worker needs 5 s, a newcomer 6 s for its first: wait
+    pending = _timed_groups(5)
+    assert pending.take("on b") is None
+    assert pending.take("on b", force=True) == "a3"  # nothing else in flight: go anyway
+    # 7 items left: 7 s against 6 s: join
+    assert _timed_groups(7).take("on b") == "a3"
+    # a group whose workers are gone is taken up whatever it costs
+    pending = _timed_groups(1)
+    pending.forget("on a")
+    assert pending.take("on b") == "a3"
 
 
 def test_without_affinity_items_go_in_the_callers_order() -> None:
     pending = Pending(ITEMS, None)
-    assert [pending.take(set()) for _ in ITEMS] == ITEMS
+    assert [pending.take(i % 3) for i in range(len(ITEMS))] == ITEMS
 
 
-def test_processes_run_each_group_in_the_worker_that_started_it(
-    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+@pytest.mark.parametrize("executor", ["processes", "dask"])
+def test_each_group_runs_in_the_worker_that_started_it(
+    executor: str,
+    tmp_path: Path,
+    plugin: Callable[..., ModuleType],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    if executor == "dask":
+        pytest.importorskip("distributed")
     monkeypatch.setenv("PB_GO_FILE", str(tmp_path / "go"))
     stamping = plugin("pb_stamping", STAMPING)
     # QUEUED items of each group: all are handed out at once, so none is left to share.
     items = [f"{g}{i}" for i in range(QUEUED) for g in "ab"]
-    with make_executor("processes", workers=2) as ex:
+    with make_executor(executor, workers=2) as ex:
         pids = dict(ex.map_unordered(stamping.pid_of, items, _never, _group))
     assert sorted(pids) == sorted(items)
     assert {pids[f"a{i}"] for i in range(QUEUED)} == {pids["a0"]}

@@ -198,6 +198,29 @@ def test_a_cell_that_kills_its_worker_is_recorded_failed_and_the_sweep_goes_on(
     assert "WorkerDied" in (tmp_path / "summary.md").read_text()
 
 
+def test_the_table_is_made_as_cells_are_stored_and_equals_the_one_read_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from physbench.bench.runner import assemble
+    from physbench.bench.store import CellStore
+
+    loads: list[str] = []
+    load = CellStore.load
+
+    def counted_load(self: CellStore, key: str) -> dict[str, Any] | None:
+        loads.append(key)
+        return load(self, key)
+
+    monkeypatch.setattr(CellStore, "load", counted_load)
+    spec = parse_spec({**TINY, "seeds": 2})
+    res = run_sweep(spec, tmp_path, executor="serial", progress=False)
+    cells = spec.cells()
+    # once each, to find what is done before the sweep; the table came from the rows made while
+    # storing, not from reading every cell again
+    assert sorted(loads) == sorted(c.key for c in cells)
+    pd.testing.assert_frame_equal(res.table, assemble(cells, CellStore(tmp_path)), check_exact=True)
+
+
 @pytest.mark.slow
 def test_executors_give_identical_tables(tmp_path: Path) -> None:
     pytest.importorskip("distributed")

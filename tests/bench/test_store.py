@@ -124,3 +124,85 @@ def test_killed_sweep_resumes_to_the_uninterrupted_table(tmp_path: Path) -> None
     assert got["cell"].nunique() == CELLS and (got["status"] == "ok").all()
     pd.testing.assert_frame_equal(without_timings(got), without_timings(want), check_exact=True)
     assert not list(out.rglob("*.tmp"))
+
+
+# ---------------------------------------------------------------- the sweep's cell writer
+
+
+def _cells(n: int) -> list[tuple[str, dict[str, Any]]]:
+    return [(f"c{i:04d}", {"i": i, "values": [0.1 * i, None], "status": "ok"}) for i in range(n)]
+
+
+def test_the_writer_stores_every_cell_whole_and_hands_back_what_load_reads(
+    tmp_path: Path,
+) -> None:
+    from physbench.bench.store import BATCH, CellStore, CellWriter
+
+    store = CellStore(tmp_path)
+    store.dir.mkdir(parents=True)
+    seen: dict[str, dict[str, Any]] = {}
+    cells = _cells(2 * BATCH + 5)  # more than one batch
+    with CellWriter(store, lambda key, data: seen.__setitem__(key, data)) as writer:
+        for key, data in cells:
+            writer.put(key, data)
+    assert seen == {key: store.load(key) for key, _ in cells}
+    assert seen["c0003"] == {"i": 3, "values": [0.30000000000000004, None], "status": "ok"}
+    assert sorted(p.name for p in store.dir.iterdir()) == [f"{key}.json" for key, _ in cells]
+
+
+def test_the_loop_hands_cells_over_without_waiting_for_the_disk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from physbench.bench import store as store_module
+
+    flushed: list[float] = []
+
+    def slow_flush(f: Any) -> None:  # a disk whose fsync takes 0.2 s
+        time.sleep(0.2)
+        flushed.append(time.monotonic())
+
+    monkeypatch.setattr(store_module, "_flush", slow_flush)
+    store = store_module.CellStore(tmp_path)
+    store.dir.mkdir(parents=True)
+    t0 = time.monotonic()
+    with store_module.CellWriter(store) as writer:
+        slowest_put = 0.0
+        for key, data in _cells(48):
+            t = time.monotonic()
+            writer.put(key, data)
+            slowest_put = max(slowest_put, time.monotonic() - t)
+            time.sleep(0.005)  # cells arriving one after another
+    took = time.monotonic() - t0
+    assert len(flushed) == 48 and len(list(store.dir.glob("*.json"))) == 48
+    assert slowest_put < 0.1  # never a flush's 0.2 s
+    assert took < 3.0  # flushed one after another, 48 cells take 9.6 s
+
+
+def test_a_failed_write_is_raised_in_the_loop(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from physbench.bench import store as store_module
+
+    def full(f: Any) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(store_module, "_flush", full)
+    store = store_module.CellStore(tmp_path)
+    store.dir.mkdir(parents=True)
+    with pytest.raises(OSError, match="No space left"), store_module.CellWriter(store) as writer:
+        for key, data in _cells(20):
+            writer.put(key, data)
+            time.sleep(0.01)
+    assert not list(store.dir.glob("*.json"))  # no cell renamed into place half-flushed
+
+
+def test_cells_handed_over_before_an_interrupt_are_stored(tmp_path: Path) -> None:
+    from physbench.bench.store import CellStore, CellWriter
+
+    store = CellStore(tmp_path)
+    store.dir.mkdir(parents=True)
+    with pytest.raises(KeyboardInterrupt), CellWriter(store) as writer:
+        for key, data in _cells(5):
+            writer.put(key, data)
+        raise KeyboardInterrupt
+    assert [store.load(key) for key, _ in _cells(5)] == [data for _, data in _cells(5)]
