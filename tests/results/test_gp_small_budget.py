@@ -1,6 +1,6 @@
-"""The committed held-out study of ``gp`` at the paper's budget (``results/gp_small_budget``, made by
-``physbench bench benchmarks/gp_small_budget.toml``, about a minute on one core): the figures
-docs/results.md states, read back from the table."""
+"""The committed held-out study of ``gp`` at the paper's budget (``results/gp_small_budget``,
+made by ``physbench bench benchmarks/gp_small_budget.toml``, about a minute on one core): the
+figures docs/results.md states, read back from the table."""
 
 from __future__ import annotations
 
