@@ -230,7 +230,7 @@ def test_estimator_options(capsys: pytest.CaptureFixture[str]) -> None:
     [
         (
             ["--estimator", "nope"],
-            "unknown estimator 'nope'; known estimators: cmaes, nevergrad, npe, optuna, random, "
+            "unknown estimator 'nope'; known estimators: cmaes, gp, nevergrad, npe, optuna, random, "
             "resnet3d",
         ),
         (["--scene", "no_such_scene"], "unknown scene 'no_such_scene'"),
