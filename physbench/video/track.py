@@ -62,6 +62,7 @@ from physbench.video.detect import (
     plane_pose,
     split_pixels,
 )
+from physbench.video.faint import SHUTTER, find_faint
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import Light, LightMeter, plate_index
@@ -392,6 +393,11 @@ class Tracker:
             self._first_contrast(image, visible)
         self._thresholds()
         found = self._measure(image, gates, reach, t, visible)
+        for i in range(len(self.states)):
+            if visible[i] and i not in found:
+                faint = self._faint(i, image, gates[i], found)
+                if faint is not None:
+                    found[i] = faint
         for i, s in enumerate(self.states):
             if i in found:
                 s.in_view += 1
@@ -411,6 +417,27 @@ class Tracker:
                 s.unseen.close()
         self.frames += 1
         self.t_last = t
+
+    def _faint(
+        self, i: int, image: np.ndarray, gate: float, found: dict[int, _Found]
+    ) -> _Found | None:
+        """A disc of a few pixels that no blob showed, found by a matched filter
+        (:mod:`~physbench.video.faint`): its disc smeared along its predicted motion over the
+        exposure, searched within its gate, away from the bodies found in this frame. Measured
+        by its centroid; its looks are not learnt from it (too few, too faint pixels)."""
+        s = self.states[i]
+        if not s.disc or s.radius >= SMALL_DISC:
+            return None
+        pred = self.pred_uv[i]
+        ahead = self.pred_xy[i] + s.v * (SHUTTER / self.scene.fps)
+        smear = self.cal.to_image(ahead[None])[0] - pred
+        taken = [f.uv for f in found.values()]
+        got = find_faint(image, self.bg, self.light, pred, gate, s.radius, smear, taken, s.last_uv)
+        if got is None:
+            return None
+        xy = self.cal.to_scene(got.uv[None])[0]
+        look = Look(math.nan, np.zeros(3), 0.0)
+        return _Found(xy, got.uv, PlanePose(xy, 0.0, 1.0, 0.0), look, centroid=True)
 
     def _not_found(self, i: int, image: np.ndarray) -> str:
         from physbench.video.diagnosis import Missing, not_found

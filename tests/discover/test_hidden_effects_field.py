@@ -36,16 +36,7 @@ CASES = [
         marks=pytest.mark.xfail(strict=True, reason=ARM_BLUR),
     ),
     pytest.param(
-        "quadratic_drag",
-        "projectile",
-        "pymunk",
-        1,
-        id="quadratic_drag/projectile/pymunk/1",
-        marks=pytest.mark.xfail(
-            strict=True,
-            reason="refused at frame 0: the light is 7 % above the plate's and the ball 1.9 px "
-            "in radius",
-        ),
+        "quadratic_drag", "projectile", "pymunk", 1, id="quadratic_drag/projectile/pymunk/1"
     ),
 ]
 

@@ -1,0 +1,91 @@
+"""A ball of a few pixels, fainter than a per-pixel threshold, found by the matched filter."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+from physbench.calibration import Calibration
+from physbench.scene import Body, Circle, Scene
+from physbench.video.faint import find_faint, footprint
+from physbench.video.photometry import Light
+from physbench.video.reader import Frame
+from physbench.video.track import track_frames
+
+H, W = 480, 640
+#: 1 cm per pixel, y up, the plane's origin 400 px down the image.
+CAL = Calibration.from_scale(0.01, (0.0, 400.0))
+
+
+def _wall(rng: np.random.Generator) -> np.ndarray:
+    """A textured plate: smooth blotches and planks' stripes, 60-200 grey levels."""
+    blotch = ndimage.gaussian_filter(rng.normal(0, 1, (H, W)), 6)
+    blotch *= 25 / blotch.std()
+    stripes = 20 * np.sin(np.arange(H) / 7.0)[:, None] + 8 * np.sin(np.arange(W) / 3.1)[None]
+    grey = 128 + blotch + stripes
+    wall = np.stack([grey, 0.9 * grey, 0.8 * grey], axis=2)
+    return np.clip(np.rint(wall), 0, 255).astype(np.uint8)
+
+
+def _toss() -> Scene:
+    ball = Body("ball", Circle(0.012), (1.0, 3.0), velocity=(1.5, 3.0))  # 1.2 px
+    return Scene(
+        "toss", (ball,), bounds=(0.0, -0.8, 6.4, 4.0), gravity=(0.0, -9.81), fps=30.0, frames=30
+    ).validate()
+
+
+def _film(scene: Scene, plate: np.ndarray, rng: np.random.Generator, contrast: float):
+    """Frames of the ball ``contrast`` grey levels brighter than the wall, smeared along its
+    parabola over 0.3 of the frame interval, with Gaussian noise of sigma 4; and its true pixels."""
+    body = scene.bodies[0]
+    p0, v0, g = (np.asarray(a, dtype=float) for a in (body.position, body.velocity, scene.gravity))
+    r = body.shape.extent() / 0.01
+    vv, uu = np.mgrid[0:H, 0:W].astype(float)
+    frames, truth = [], []
+    for k in range(scene.frames):
+        t = k / scene.fps
+        cover = np.zeros((H, W))
+        for s in np.linspace(-0.15, 0.15, 9) / scene.fps:
+            u, v = CAL.to_image(p0 + v0 * (t + s) + 0.5 * g * (t + s) ** 2)
+            cover += np.clip(r + 0.5 - np.hypot(uu - u, vv - v), 0.0, 1.0) / 9
+        truth.append(CAL.to_image(p0 + v0 * t + 0.5 * g * t * t))
+        image = plate + contrast * cover[:, :, None] + rng.normal(0, 4.0, (H, W, 3))
+        frames.append(Frame(k, t, np.clip(np.rint(image), 0, 255).astype(np.uint8)))
+    return frames, np.array(truth)
+
+
+def test_a_faint_ball_of_a_pixel_is_tracked_by_its_footprint() -> None:
+    # A 1.2 px ball 30 grey levels off a textured wall under noise of sigma 4, smeared over up
+    # to 4 px: no pixel of it stands out of the noise (the threshold is ~40), only its
+    # footprint's sum does. Before the matched filter it was refused at frame 0.
+    rng = np.random.default_rng(3)
+    scene = _toss()
+    plate = _wall(rng)
+    frames, truth = _film(scene, plate, rng, 30.0)
+    result = track_frames(frames, scene, CAL, plate, allow_gaps=True)
+    summary = result.summary
+    assert summary.detections["ball"] >= 0.95 * summary.in_view["ball"]
+    tuv = result.pixels["ball"]
+    k = np.round(tuv[:, 0] * scene.fps).astype(int)
+    errors = np.hypot(*(tuv[:, 1:] - truth[k]).T)
+    assert np.median(errors) <= 0.3 and errors.max() <= 0.6, errors
+
+
+def test_the_filter_finds_nothing_in_noise_alone() -> None:
+    rng = np.random.default_rng(5)
+    plate = _wall(rng)
+    light = Light(np.ones(3), np.zeros(3), 5.0, 500)
+    misses = 0
+    for _ in range(20):
+        image = np.clip(np.rint(plate + rng.normal(0, 5.0, plate.shape)), 0, 255).astype(np.uint8)
+        got = find_faint(image, plate, light, np.array([320.0, 240.0]), 20.0, 1.2, np.zeros(2))
+        misses += got is None
+    assert misses == 20
+
+
+def test_a_footprint_is_the_disc_smeared_along_its_motion() -> None:
+    still = footprint(1.5, np.zeros(2))
+    moving = footprint(1.5, np.array([6.0, 0.0]))
+    assert still.shape[0] == still.shape[1] and moving.shape[0] > still.shape[0]
+    assert abs(still.sum() - np.pi * 1.5**2) < 1.0
+    assert moving.sum() > still.sum() + 6 * 2  # the swept band adds about 6 x 3 px
