@@ -230,8 +230,8 @@ def test_estimator_options(capsys: pytest.CaptureFixture[str]) -> None:
     [
         (
             ["--estimator", "nope"],
-            "unknown estimator 'nope'; known estimators: cmaes, gp, nevergrad, npe, optuna, random, "
-            "resnet3d",
+            "unknown estimator 'nope'; known estimators: cmaes, gp, nevergrad, npe, optuna, "
+            "random, resnet3d",
         ),
         (["--scene", "no_such_scene"], "unknown scene 'no_such_scene'"),
         (["--params", "friction"], "unknown parameter 'friction' of scene 'three_circles'"),

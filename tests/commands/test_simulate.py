@@ -136,7 +136,10 @@ def test_effects_change_the_simulated_motion(tmp_path: Path, capsys) -> None:  #
     for bad, message in (
         ("linear_drag:c", "expected NAME[:KEY=NUMBER,...]"),
         ("linear_drag:q=1", "does not take option 'q'; its options: bodies, label, c"),
-        ("nope", "unknown effect 'nope'; known effects: axis_rotation, calibration_scale, clock_scale"),
+        (
+            "nope",
+            "unknown effect 'nope'; known effects: axis_rotation, calibration_scale, clock_scale",
+        ),
     ):
         assert main(["simulate", "--scene", "ball_drop", "--effect", bad]) == 2
         assert message in capsys.readouterr().err
