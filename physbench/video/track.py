@@ -81,6 +81,9 @@ ELONGATED = 1.3
 UNMODELLED = 0.5
 #: How far a body's first move may depart from the scene's initial velocity, as a share of it.
 VELOCITY_PRIOR = 0.5
+#: How far from where the scene says it starts (px) a body not found there is looked for in the
+#: first frame (:meth:`Tracker._look_wider`); a blob farther off is named in the error instead.
+FIRST_GATE_PX = 24.0
 #: A body's appearance is learnt from detections within this factor of the size the scene gives
 #: it (until the first, no detection of it is judged by its looks).
 PLAUSIBLE = 1.8
@@ -393,6 +396,8 @@ class Tracker:
             self._first_contrast(image, visible)
         self._thresholds()
         found = self._measure(image, gates, reach, t, visible)
+        if first:
+            self._look_wider(image, gates, reach, t, visible, found)
         for i in range(len(self.states)):
             if visible[i] and i not in found:
                 faint = self._faint(i, image, gates[i], found)
@@ -417,6 +422,28 @@ class Tracker:
                 s.unseen.close()
         self.frames += 1
         self.t_last = t
+
+    def _look_wider(
+        self,
+        image: np.ndarray,
+        gates: np.ndarray,
+        reach: np.ndarray,
+        t: float,
+        visible: list[bool],
+        found: dict[int, _Found],
+    ) -> None:
+        """In the first frame, a body not found near where the scene says it starts is looked
+        for again out to :data:`FIRST_GATE_PX`, away
+        from the bodies already found: a scene's initial position is a measurement or an
+        estimate, and an uncalibrated lens moved a puck near the image's edge by 18-20 px."""
+        missing = [v and i not in found for i, v in enumerate(visible)]
+        if not any(missing):
+            return
+        wide = np.maximum(gates, FIRST_GATE_PX)
+        more = self._measure(image, wide, reach + (wide - gates), t, missing)
+        for i, got in more.items():
+            if all(np.hypot(*(got.uv - f.uv)) > self.states[i].radius for f in found.values()):
+                found[i] = got
 
     def _faint(
         self, i: int, image: np.ndarray, gate: float, found: dict[int, _Found]
