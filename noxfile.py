@@ -22,8 +22,8 @@ def tests(session: nox.Session) -> None:
 @nox.session
 def extended(session: nox.Session) -> None:
     """The tests marked ``extended`` that CI's pytest leaves out to stay within 10 minutes on 2
-    cores: the other engine's half of the hidden-effect suites (CI runs each effect and scene on
-    one engine, in turn)."""
+    cores: the other engine's half of the hidden-effect and bound suites (CI runs each effect and
+    scene on one engine, in turn)."""
     session.install(TORCH)
     session.install("-e", ".[all]")
     session.run("pytest", "tests", "-m", "extended", *session.posargs)
