@@ -420,7 +420,7 @@ def test_smc_with_too_few_iterations_says_why_its_posterior_falls_short(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     # 11 iterations for 64 particles: before, no posterior and not a word about why.
-    code, out, err = run(capsys, "--scene", "ball_drop", "--estimator", "smc")
+    code, out, err = run(capsys, "--scene", "ball_drop", "--estimator", "smc", "--resolution", "32")
     assert code == 0
     assert "posterior (smc, 10 samples):" in out
     assert "warning: incomplete posterior: too few iterations for 64 particles" in err

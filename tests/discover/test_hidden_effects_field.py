@@ -33,7 +33,7 @@ CASES = [
         "pymunk",
         1,
         id="joint_quadratic_damping/pendulum_xy/pymunk/1",
-        marks=pytest.mark.xfail(strict=True, reason=ARM_BLUR),
+        marks=(pytest.mark.xfail(strict=True, reason=ARM_BLUR), pytest.mark.extended),  # 15 s
     ),
     pytest.param(
         "quadratic_drag", "projectile", "pymunk", 1, id="quadratic_drag/projectile/pymunk/1"

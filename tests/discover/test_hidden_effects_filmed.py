@@ -18,8 +18,9 @@ CASES = [
     ("linear_drag", "projectile", "pymunk"),
     ("joint_viscous_damping", "pendulum", "box2d"),
     ("constant_force", "two_pucks", "pymunk"),
-    ("velocity_dependent_restitution", "bouncer", "box2d"),
 ]
+#: 19 s a run: ``nox -s extended`` runs it
+EXTENDED = [("velocity_dependent_restitution", "bouncer", "box2d")]
 # The last three raised a false alarm before the fixes in docs/video.md (an arm's lopsided blur,
 # two arms in one blob, a bounce's blurred V).
 CONTROLS = [
@@ -31,7 +32,11 @@ CONTROLS = [
 ]
 
 
-@pytest.mark.parametrize(("effect", "scene", "engine"), CASES, ids=["/".join(c) for c in CASES])
+@pytest.mark.parametrize(
+    ("effect", "scene", "engine"),
+    [pytest.param(*c, id="/".join(c)) for c in CASES]
+    + [pytest.param(*c, id="/".join(c), marks=pytest.mark.extended) for c in EXTENDED],
+)
 def test_a_filmed_hidden_effect_is_named_with_its_magnitude(effect, scene, engine) -> None:
     sim = ENGINES[engine]()
     case = make_case(effect, scene, 0, sim)
