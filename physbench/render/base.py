@@ -13,6 +13,7 @@ made them.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, ClassVar
 
@@ -53,6 +54,25 @@ def check_resolution(resolution: object) -> int | tuple[int, int]:
         f"resolution = {resolution!r}: expected a whole number >= 1 (image width, square pixels) "
         "or a pair (height, width) of whole numbers >= 1"
     )
+
+
+def check_view(view: object) -> tuple[float, float, float, float]:
+    """A camera's ``view`` option as ``(xmin, ymin, xmax, ymax)`` in metres with ``xmin < xmax``
+    and ``ymin < ymax``, else :class:`RenderError`."""
+    try:
+        vals = tuple(float(v) for v in view)  # type: ignore[attr-defined]
+    except (TypeError, ValueError):
+        vals = ()
+    if (
+        len(vals) != 4
+        or not all(map(math.isfinite, vals))
+        or not (vals[0] < vals[2] and vals[1] < vals[3])
+    ):
+        raise RenderError(
+            f"view = {view!r}: expected [xmin, ymin, xmax, ymax] in metres with xmin < xmax and "
+            "ymin < ymax"
+        )
+    return vals  # type: ignore[return-value]
 
 
 class Renderer(Requirements):

@@ -40,7 +40,7 @@ import numpy as np
 from physbench.calibration import Calibration, Lens
 from physbench.codec import h264_round_trip
 from physbench.hookspecs import hookimpl
-from physbench.render.base import Camera, RenderError
+from physbench.render.base import Camera, RenderError, check_view
 from physbench.scene import Circle, Segment
 
 if TYPE_CHECKING:
@@ -418,24 +418,6 @@ def _light(cam: CameraRenderer, view: _View) -> np.ndarray:
     return ((1 - cam.light) + cam.light * s).astype(np.float32)
 
 
-def _region(view: object) -> tuple[float, float, float, float]:
-    """``view`` as ``(xmin, ymin, xmax, ymax)`` with ``xmin < xmax`` and ``ymin < ymax``."""
-    try:
-        vals = tuple(float(v) for v in view)  # type: ignore[attr-defined]
-    except (TypeError, ValueError):
-        vals = ()
-    if (
-        len(vals) != 4
-        or not all(map(math.isfinite, vals))
-        or not (vals[0] < vals[2] and vals[1] < vals[3])
-    ):
-        raise RenderError(
-            f"view = {view!r}: expected [xmin, ymin, xmax, ymax] in metres with xmin < xmax and "
-            "ymin < ymax"
-        )
-    return vals  # type: ignore[return-value]
-
-
 class CameraRenderer(Camera):
     """A camera filming the scene: ``rgb`` frames with perspective, lens distortion, motion blur,
     a textured background, shaded bodies, uneven and flickering light, sensor noise and
@@ -501,7 +483,7 @@ class CameraRenderer(Camera):
         view: Sequence[float] | None = None,
     ) -> None:
         super().__init__(resolution, mode)
-        self.view = None if view is None else _region(view)
+        self.view = None if view is None else check_view(view)
         self.tilt = _number("tilt", tilt, -90, 90, open_=True)
         self.yaw = _number("yaw", yaw, -90, 90, open_=True)
         self.roll = _number("roll", roll, -360, 360)

@@ -48,7 +48,7 @@ import numpy as np
 
 from physbench.calibration import Calibration, Lens
 from physbench.codec import h264_round_trip
-from physbench.render.base import Camera, RenderError
+from physbench.render.base import Camera, RenderError, check_view
 from physbench.scene import Circle, Segment
 
 if TYPE_CHECKING:
@@ -448,23 +448,6 @@ def _downsample(a: np.ndarray) -> np.ndarray:
 # --------------------------------------------------------------------------- the camera
 
 
-def _region(view: object) -> tuple[float, float, float, float]:
-    try:
-        vals = tuple(float(v) for v in view)  # type: ignore[attr-defined]
-    except (TypeError, ValueError):
-        vals = ()
-    if (
-        len(vals) != 4
-        or not all(map(math.isfinite, vals))
-        or not (vals[0] < vals[2] and vals[1] < vals[3])
-    ):
-        raise RenderError(
-            f"view = {view!r}: expected [xmin, ymin, xmax, ymax] in metres with xmin < xmax and "
-            "ymin < ymax"
-        )
-    return vals  # type: ignore[return-value]
-
-
 class FieldCamera(Camera):
     """The second, independent camera (see the module docstring). ``resolution``: image width
     with a 4:3 sensor, or ``(H, W)``; ``seed`` draws the :class:`Domain`, and keyword ``pins``
@@ -491,7 +474,7 @@ class FieldCamera(Camera):
         if unknown:
             raise RenderError(f"{unknown[0]}: unknown option; known: {', '.join(sorted(known))}")
         self.seed = int(seed)
-        self.view = None if view is None else _region(view)
+        self.view = None if view is None else check_view(view)
         self.domain = replace(Domain.draw(self.seed), **pins)
         self.domain.check()
         self.crf = int(self.domain.crf)
