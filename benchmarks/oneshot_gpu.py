@@ -4,7 +4,7 @@ the shipped weights for a fixed wall time, then every model evaluated after 2 it
 same held-out seeds as the shipped one.
 
     bash benchmarks/gpu_oneshot.sh        # on the GPU machine (installs .whl/, writes into $OUT)
-    python benchmarks/oneshot_gpu.py --out /tmp/oneshot --device cpu --train-seconds 20 \\
+    python benchmarks/oneshot_gpu.py --out out/oneshot --device cpu --train-seconds 20 \\
         --seeds 3 --deadline 400           # a dry run on a CPU
 
 Arms, per row, each its own ``physbench train`` process with as many data workers as the others:
@@ -436,7 +436,7 @@ def main() -> int:
     ap.add_argument("--workers", type=int, default=0, help="data workers per arm (0: share cores)")
     ap.add_argument("--val-groups", type=int, default=48)
     ap.add_argument("--eval-every", type=int, default=40_000)
-    ap.add_argument("--site", default="/tmp/oneshot_site", help="where a dist-info may be written")
+    ap.add_argument("--site", default="out/oneshot_site", help="where a dist-info may be written")
     args = ap.parse_args()
 
     t0 = float(os.environ.get("ONESHOT_T0") or time.time())
