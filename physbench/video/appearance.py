@@ -79,10 +79,8 @@ class Appearance:
     def first(cls, look: Look) -> Appearance:
         return cls(look.size, np.asarray(look.colour, dtype=float))
 
-    def mismatch(self, look: Look, *, size: bool = True, hidden: bool = False) -> str | None:
+    def mismatch(self, look: Look, *, hidden: bool = False) -> str | None:
         """Why ``look`` is not this body (a few words with the measured values), or ``None``.
-        ``size=False`` judges the colour only: the tracker passes it for a body's share of a blob
-        it shares with touching bodies, whose area is where the split put the border.
         ``hidden``: the look is of the pixels of the body's colour in a blob that holds other
         colours too, so part of the body may be hidden (by a neighbour, or where a median
         background holds the body itself): down to :data:`HIDDEN` of its size. The colour of a
@@ -91,7 +89,7 @@ class Appearance:
         # A body of a few pixels has a size of a few pixels, give or take most of them.
         allowed = SIZE_RATIO * max(1.0, math.sqrt(SMALL / max(look.pixels, 1e-9)))
         least = min(1 / allowed, HIDDEN) if hidden else 1 / allowed
-        if size and not least <= ratio <= allowed:
+        if not least <= ratio <= allowed:
             return f"{ratio:.2f} times its size"
         if look.pixels < COLOUR_PIXELS:
             return None

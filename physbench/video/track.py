@@ -805,7 +805,6 @@ class Tracker:
                 centres, split, inside = split_pixels(u, v, w, self.pred_uv[members], outlines)
         for j, i in enumerate(members):
             s = self.states[i]
-            share = False
             if i in discs and (discs[i] is not None or not shared):
                 got = discs[i]
             elif not shared:
@@ -830,11 +829,10 @@ class Tracker:
                 axes = plane_pose(u[mine], v[mine], wi[mine], self.cal)
                 look = self._look(i, part.area, img[mine], w[mine], at=part.centre)
                 got = _Found(centre.xy, centres[j], replace(axes, xy=centre.xy), look)
-                share = True
             if got is None:
                 continue
             hidden = i in plans and plans[i].pixels is not None
-            if s.look and s.look.mismatch(got.look, size=not share, hidden=hidden) is not None:
+            if s.look and s.look.mismatch(got.look, hidden=hidden) is not None:
                 s.rejected += 1
                 continue
             out[i] = got
