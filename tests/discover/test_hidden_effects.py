@@ -36,9 +36,13 @@ HIDDEN = [
 CONTROLS = [(sc, eng, seed) for sc in sorted(SCENES) for eng in ENGINES for seed in SEEDS]
 
 
-#: (effect, scene) pairs that take 25-30 s a case: ``nox -s extended`` runs them on both engines,
+#: (effect, scene) pairs that take 10-30 s a case: ``nox -s extended`` runs them on both engines,
 #: and CI the effect's other scene on both.
-SLOW = {("velocity_dependent_restitution", "drops")}
+SLOW = {
+    ("velocity_dependent_restitution", "drops"),
+    ("joint_viscous_damping", "double_pendulum"),
+    ("joint_coulomb_friction", "double_pendulum"),
+}
 
 
 def _alternate(cases: list[tuple], scene_at: int) -> list:
