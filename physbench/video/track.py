@@ -81,6 +81,9 @@ ELONGATED = 1.3
 UNMODELLED = 0.5
 #: How far a body's first move may depart from the scene's initial velocity, as a share of it.
 VELOCITY_PRIOR = 0.5
+#: The restitution a body is predicted to bounce off static geometry with until it is seen again;
+#: the gate covers any restitution from 0 (it stays on the surface) to 1 (elastic).
+RESTITUTION = 0.5
 #: How far from where the scene says it starts (px) a body not found there is looked for in the
 #: first frame (:meth:`Tracker._look_wider`); a blob farther off is named in the error instead.
 FIRST_GATE_PX = 24.0
@@ -178,6 +181,7 @@ class _State:
     seen: int = 0
     last_uv: np.ndarray | None = None
     contact: np.ndarray | None = None  # normal of the static its prediction touches
+    bounce: float = 0.0  # m/s: the speed off a surface it hit, unknown until it is seen again
     look: Appearance | None = None
     radius_m: float | None = None  # a disc's radius on the plane, from its outlines so far
     rejected: int = 0  # detections whose appearance was not the body's
@@ -326,6 +330,7 @@ class Tracker:
                 unknown = UNMODELLED * g * dt * dt / 2  # metres
                 if s.seen < 2:  # its velocity is the scene's guess until measured
                     unknown += VELOCITY_PRIOR * float(np.hypot(*s.v)) * dt
+                unknown += s.bounce * dt
                 gates[i] = (
                     0.75 * s.radius
                     + 3.0
@@ -489,9 +494,11 @@ class Tracker:
         dt = t - s.t
         if s.seen and dt > 0:
             kick = self.motion.kick(s.body.name, s.t, dt)
+            hit = float(s.v @ s.contact) if s.contact is not None else 0.0
             s.v = (xy - s.xy) / dt + kick.dv - kick.dx / dt
-            if s.contact is not None and float(s.v @ s.contact) < 0:
-                s.v = s.v - float(s.v @ s.contact) * s.contact  # it stays on the surface
+            s.bounce = 0.0
+            if s.contact is not None:
+                s.v, s.bounce = _off_surface(s.v, s.contact, hit)
             assert s.last_uv is not None
             s.step = float(np.hypot(*(found.uv - s.last_uv))) / (s.missed + 1)
         angle = self._angle(s, found.pose, t) if s.k else None
@@ -1232,6 +1239,21 @@ def track_video(
         )
     except VideoError as exc:
         raise TrackError(str(exc)) from None
+
+
+def _off_surface(v: np.ndarray, normal: np.ndarray, hit: float) -> tuple[np.ndarray, float]:
+    """The velocity ``v`` (m/s, measured over the last frame interval) of a body whose prediction
+    touched a surface of ``normal``, and the speed off it that is unknown (m/s). ``hit``: its
+    velocity along ``normal`` before, negative where it was moving into the surface. A body
+    resting or rolling on it stays on it; one that hit it may have bounced off with any
+    restitution, which is predicted as :data:`RESTITUTION` of the speed it came in with: a ball
+    that bounced between two frames moved little between them, and predicted to stay on the floor
+    it was lost for 6 frames of its rise."""
+    into = float(v @ normal)
+    if hit >= 0:
+        return (v - into * normal if into < 0 else v), 0.0
+    out = max(into, -RESTITUTION * hit)
+    return v + (out - into) * normal, -max(RESTITUTION, 1 - RESTITUTION) * hit
 
 
 def _alpha(colour: np.ndarray, behind: np.ndarray, diff: np.ndarray) -> np.ndarray:
