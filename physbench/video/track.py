@@ -98,6 +98,10 @@ SMEAR = 0.2
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
 SMALL_DISC = 5.0
+#: A body lost with a smaller radius (px) is said to be too small for the video's coding: on the
+#: field camera at CRF 18-30, balls of 0.8-1.9 px were absent from the coded pixels themselves
+#: (benchmarks/field_visibility.py) in more than a tenth of the frames in 46 of 51 refused clips.
+TINY = 2.5
 
 
 class TrackError(PhysbenchError, ValueError):
@@ -1176,7 +1180,8 @@ def track_frames(
         raise TrackLostError(
             "; ".join(failures) + ". A track with such gaps is not the motion; find why in a "
             "--preview (an occluder, too little contrast, a body leaving the view), or pass "
-            f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{held}",
+            f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{held}"
+            f"{_tiny(tracker, failures)}",
             result,
         )
     return result
@@ -1239,6 +1244,21 @@ def track_video(
         )
     except VideoError as exc:
         raise TrackError(str(exc)) from None
+
+
+def _tiny(tracker: Tracker, failures: list[str]) -> str:
+    """What a lost body's size says, where it is under :data:`TINY` px in radius."""
+    small = [
+        f"{s.body.name!r} is {s.radius:.1f} px in radius"
+        for s in tracker.states
+        if s.radius < TINY and any(f"body {s.body.name!r} " in f for f in failures)
+    ]
+    if not small:
+        return ""
+    return (
+        f"; {', '.join(small)}: a lossy video coder leaves a body that small out of many frames "
+        "altogether, so film it closer, at a higher resolution or at a higher bitrate"
+    )
 
 
 def _off_surface(v: np.ndarray, normal: np.ndarray, hit: float) -> tuple[np.ndarray, float]:
