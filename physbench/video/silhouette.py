@@ -147,7 +147,7 @@ def edge_points(
     :data:`INNER` out to its reach;
     ``low`` is the foreground threshold. Rays that leave the crop, or find no edge, are left
     out."""
-    counts = [int(np.clip(round(2 * math.pi * r.radius / SPACING), 16, 64)) for r in rays]
+    counts = [min(max(round(2 * math.pi * r.radius / SPACING), 16), 64) for r in rays]
     owner = np.repeat(np.arange(len(rays)), counts)
     theta = np.concatenate([np.arange(n) * (2 * math.pi / n) for n in counts])
     radius = np.array([r.radius for r in rays])[owner]

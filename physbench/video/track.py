@@ -63,6 +63,7 @@ from physbench.video.detect import (
     split_pixels,
 )
 from physbench.video.faint import SHUTTER, find_faint
+from physbench.video.medians import median
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import Light, LightMeter, plate_index
@@ -1033,7 +1034,7 @@ class Tracker:
             colours = colours[weights >= np.percentile(weights, 75)]
         if len(colours) > 64:
             colours = colours[::4]
-        raw = np.median(colours, axis=0).astype(float) if len(colours) else np.zeros(3)
+        raw = median(colours, axis=0) if len(colours) else np.zeros(3)
         colour = (raw - self.light.offset) / np.maximum(self.light.gain, 1e-3)
         return Look(area / max(expected, 1e-9), colour, expected)
 
