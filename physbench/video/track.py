@@ -67,7 +67,14 @@ from physbench.video.medians import median
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import Light, LightMeter, plate_index
-from physbench.video.silhouette import DiscFit, Edges, Rays, edge_points, fit_disc, fit_discs
+from physbench.video.silhouette import (
+    DiscFit,
+    Rays,
+    edge_points,
+    fit_disc,
+    fit_discs,
+    window_edges,
+)
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -897,14 +904,13 @@ class Tracker:
             by_window.setdefault(id(plans[i][1][0]), []).append(i)
         for members in by_window.values():
             diff, origin = plans[members[0]][1]
-            rays = [plans[i][0].rays for i in members]
-            found.append(edge_points(diff, origin, rays, self.edge_low))
+            found.append((diff, origin, [plans[i][0].rays for i in members]))
         order = [i for members in by_window.values() for i in members]
         fits: dict[int, DiscFit | None] = {}
         if order:
             mine = [plans[i][0] for i in order]
             got = fit_discs(
-                Edges.join(found, [len(members) for members in by_window.values()]),
+                window_edges(found, self.edge_low),
                 [p.rays.radius for p in mine],
                 self.cal,
                 [p.mpp for p in mine],
