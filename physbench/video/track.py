@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -627,10 +627,12 @@ class Tracker:
             )
             if not blobs:
                 continue
-            own = [self._own_colours(image, blob, group) for blob in blobs]
+            own = [_Split(self._own_colours, image, blob, group) for blob in blobs]
             owner, dist = self._assign(group, blobs, gates, own)
             for c, members in owner.items():
-                mixed = len(members) > 1 or _colours_of(blobs[c], own[c], self.states) > 1
+                mixed = len(members) > 1 or (
+                    len(group) > 1 and _colours_of(blobs[c], own[c], self.states) > 1
+                )
                 for i in members:
                     if self.states[i].disc:
                         mask = own[c].get(i) if mixed else None
@@ -661,7 +663,7 @@ class Tracker:
         group: list[int],
         blobs: list,
         c: int,
-        own: list[dict[int, np.ndarray]],
+        own: list[Mapping[int, np.ndarray]],
         dist: np.ndarray,
         gates: np.ndarray,
     ) -> list[int]:
@@ -681,7 +683,7 @@ class Tracker:
         window: tuple[np.ndarray, tuple[int, int]],
         blobs: list,
         c: int,
-        own: list[dict[int, np.ndarray]],
+        own: list[Mapping[int, np.ndarray]],
         tries: list[int],
     ) -> tuple[_Found, int] | None:
         """Body ``i`` measured on the first blob of ``tries`` where it looks like itself (on
@@ -698,7 +700,7 @@ class Tracker:
         return None
 
     def _assign(
-        self, ids: list[int], blobs: list, gates: np.ndarray, own: list[dict[int, np.ndarray]]
+        self, ids: list[int], blobs: list, gates: np.ndarray, own: list[Mapping[int, np.ndarray]]
     ) -> tuple[dict[int, list[int]], np.ndarray]:
         """Blobs to bodies ``ids``: each blob's owners, and the distance of each body's prediction
         to each blob's centre (px). ``own``: per blob, the pixels of each body's colour."""
@@ -735,7 +737,7 @@ class Tracker:
         ids: list[int],
         blobs: list,
         gates: np.ndarray,
-        own: list[dict[int, np.ndarray]],
+        own: list[Mapping[int, np.ndarray]],
         owner: dict[int, list[int]],
         dist: np.ndarray,
     ) -> None:
@@ -752,9 +754,8 @@ class Tracker:
 
         for c, members in list(owner.items()):
             others = [k for k in ids if k not in members and held(c, k) >= HIDDEN]
-            for i in [i for i in members if i in own[c] and held(c, i) < 0.1]:
-                if others:
-                    members.remove(i)
+            for i in [i for i in members if i in own[c] and held(c, i) < 0.1] if others else []:
+                members.remove(i)
             if not members:
                 del owner[c]
         for j, i in enumerate(ids):
@@ -785,7 +786,7 @@ class Tracker:
         window: tuple[np.ndarray, tuple[int, int]],
         plans: dict[int, _Plan],
         fits: dict[int, DiscFit | None],
-        own: dict[int, np.ndarray],
+        own: Mapping[int, np.ndarray],
     ) -> dict[int, _Found]:
         """Measure ``members`` on one blob (pixels ``u``, ``v``, coverage ``w``): a disc by its
         outline (``fits``), a body alone by its centroid, bodies sharing the blob by its pixels
@@ -1275,7 +1276,30 @@ def _project(colour: np.ndarray, behind: np.ndarray, body: np.ndarray) -> np.nda
     return np.einsum("ij,ij->i", colour - behind, span) / np.maximum(norm, 1.0)
 
 
-def _colours_of(found_blob: tuple, own: dict[int, np.ndarray], states: list[_State]) -> int:
+def _colours_of(found_blob: tuple, own: Mapping[int, np.ndarray], states: list[_State]) -> int:
     """How many bodies' colours a blob holds much of (a fifth of a body's area or more)."""
     w = found_blob[3]
     return sum(float(w[mask].sum()) >= 0.2 * states[i].area for i, mask in own.items())
+
+
+class _Split(Mapping[int, np.ndarray]):
+    """A blob's pixels of each body's colour, ``split(*args)`` (:meth:`Tracker._own_colours`),
+    split when first asked for: most blobs are one body's alone, which never asks."""
+
+    def __init__(self, split: Callable[..., dict[int, np.ndarray]], *args: object) -> None:
+        self._split, self._args = split, args
+        self._masks: dict[int, np.ndarray] | None = None
+
+    def _get(self) -> dict[int, np.ndarray]:
+        if self._masks is None:
+            self._masks = self._split(*self._args)
+        return self._masks
+
+    def __getitem__(self, i: int) -> np.ndarray:
+        return self._get()[i]
+
+    def __iter__(self) -> Iterator[int]:
+        return iter(self._get())
+
+    def __len__(self) -> int:
+        return len(self._get())
