@@ -52,7 +52,13 @@ import numpy as np
 from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
 from physbench.video.accuracy import stated_accuracy
-from physbench.video.appearance import HIDDEN, Appearance, Look, colour_directions
+from physbench.video.appearance import (
+    HIDDEN,
+    Appearance,
+    Look,
+    colour_directions,
+    matching,
+)
 from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
     Outline,
@@ -775,8 +781,8 @@ class Tracker:
         known = {i: look for i, look in looks.items() if look is not None}
         if not known:
             return {}
-        colours = self._colours(image, found_blob)
-        return {i: look.matches(*colours) for i, look in known.items()}
+        masks = matching(list(known.values()), *self._colours(image, found_blob))
+        return {i: masks[:, k] for k, i in enumerate(known)}
 
     def _members(
         self,
