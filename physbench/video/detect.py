@@ -116,17 +116,21 @@ def find_blobs(
     labels, n = ndimage.label(mask, CROSS)
     if n == 0:
         return []
-    cov = coverage(diff, low, high)
+    # Every blob's pixels in one pass, each blob's in the frame's row-major order.
+    rows, cols = np.nonzero(labels)
+    label = labels[rows, cols]
+    order = np.argsort(label, kind="stable")
+    rows, cols = rows[order], cols[order]
+    cov = coverage(diff[rows, cols], low, high).astype(np.float64)
+    us = (cols + offset[1]).astype(np.float64)
+    vs = (rows + offset[0]).astype(np.float64)
+    ends = np.cumsum(np.bincount(label, minlength=n + 1)[1:]).tolist()
     out = []
-    for k, sl in enumerate(ndimage.find_objects(labels), start=1):
-        if sl is None:
-            continue
-        rows, cols = np.nonzero(labels[sl] == k)
-        w = cov[sl][rows, cols].astype(np.float64)
+    for a, b in zip([0, *ends[:-1]], ends, strict=True):
+        w = cov[a:b]
         if w.sum() < min_area:
             continue
-        u = (cols + sl[1].start + offset[1]).astype(np.float64)
-        v = (rows + sl[0].start + offset[0]).astype(np.float64)
+        u, v = us[a:b], vs[a:b]
         blob = blob_from_pixels(u, v, w)
         if blob is not None:
             out.append((blob, u, v, w))

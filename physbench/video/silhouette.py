@@ -270,6 +270,9 @@ class _Groups:
         return np.bincount(self.owner, values, self.count)
 
 
+_ROW, _COLUMN = np.repeat(np.arange(3), 4), np.tile(np.arange(4), 3)
+
+
 def _circles(xy: np.ndarray, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray, np.ndarray]:
     """Each group's weighted least-squares circle through its points ``xy`` (algebraic: Kasa, by
     its normal equations), as centres ``(count, 2)`` and radii ``(count,)``; NaN for a group
@@ -280,9 +283,11 @@ def _circles(xy: np.ndarray, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray
     a = np.ones((len(xy), 4))
     a[:, :2] = xy - mean[g.owner]
     a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
-    outer = (a[:, :3] * weight[:, None])[:, :, None] * a[:, None, :]  # (n, 3, 4)
+    # The products a_i a_j (weighted, i < 3, j < 4) as 12 columns: an (n, 3, 4) broadcast costs
+    # several times as much for the same values.
+    outer = (a[:, :3] * weight[:, None])[:, _ROW] * a[:, _COLUMN]  # (n, 12)
     m = np.zeros((g.count, 3, 4))
-    m[some] = np.add.reduceat(outer, g.starts[some], axis=0)
+    m[some] = np.add.reduceat(outer, g.starts[some], axis=0).reshape(-1, 3, 4)
     sol = np.full((g.count, 3), np.nan)
     ok = g.total(weight > 0) >= 3
     if ok.any():
