@@ -12,6 +12,7 @@ unseen in that frame rather than recorded where something else is.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,7 +56,12 @@ class Look:
 
 def _direction(c: np.ndarray) -> np.ndarray:
     d = np.asarray(c, dtype=float) + DARK
-    return d / np.linalg.norm(d)
+    return d / _length(d)
+
+
+def _length(d: np.ndarray) -> float:
+    """``np.linalg.norm`` of a vector, without its generic handling (the same value)."""
+    return math.sqrt(float(d @ d))
 
 
 def colour_directions(colours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -93,7 +99,7 @@ class Appearance:
             return f"{ratio:.2f} times its size"
         if look.pixels < COLOUR_PIXELS:
             return None
-        hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
+        hue = _length(_direction(look.colour) - _direction(self.colour))
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread):
             return f"another colour (hue {hue:.2f} off)"
         bright = (float(np.sum(look.colour)) + 3 * DARK) / (float(np.sum(self.colour)) + 3 * DARK)
@@ -104,19 +110,25 @@ class Appearance:
     def matches(self, units: np.ndarray, norms: np.ndarray) -> np.ndarray:
         """Which pixels of a blob have this body's hue and brightness (its own pixels, in a blob
         shared with bodies or things of other colours), from their :func:`colour_directions`."""
-        tolerance = max(HUE_TOLERANCE, 4 * self.hue_spread)
-        ref = self.colour + DARK
-        size = float(np.linalg.norm(ref))
-        bright = norms / size
-        # |a - b| <= tol for unit vectors: a . b >= 1 - tol^2 / 2.
-        return (units @ (ref / size) >= 1 - 0.5 * tolerance**2) & (
-            (bright >= 1 / BRIGHTNESS_RATIO) & (bright <= BRIGHTNESS_RATIO)
-        )
+        return matching([self], units, norms)[:, 0]
 
     def update(self, look: Look) -> None:
         """Called by the tracker with each accepted detection's appearance."""
-        hue = float(np.linalg.norm(_direction(look.colour) - _direction(self.colour)))
+        hue = _length(_direction(look.colour) - _direction(self.colour))
         self.hue_spread += RATE * (hue - self.hue_spread)
         self.size += RATE * (look.size - self.size)
         self.colour = self.colour + RATE * (np.asarray(look.colour, dtype=float) - self.colour)
         self.seen += 1
+
+
+def matching(looks: Sequence[Appearance], units: np.ndarray, norms: np.ndarray) -> np.ndarray:
+    """:meth:`Appearance.matches` of several bodies at once (one product for all): ``(n, k)``,
+    a column per body of ``looks``."""
+    refs = np.array([look.colour for look in looks], dtype=float) + DARK  # (k, 3)
+    size = np.array([_length(ref) for ref in refs])
+    tolerance = np.array([max(HUE_TOLERANCE, 4 * look.hue_spread) for look in looks])
+    bright = norms[:, None] / size
+    # |a - b| <= tol for unit vectors: a . b >= 1 - tol^2 / 2.
+    return (units @ (refs / size[:, None]).T >= 1 - 0.5 * tolerance**2) & (
+        (bright >= 1 / BRIGHTNESS_RATIO) & (bright <= BRIGHTNESS_RATIO)
+    )

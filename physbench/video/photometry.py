@@ -21,6 +21,7 @@ from functools import cached_property
 
 import numpy as np
 
+from physbench.video.medians import median
 from physbench.video.segment import difference
 
 #: Pixels the meter samples per frame (a regular grid over the image): the gain's standard
@@ -133,9 +134,9 @@ def _fit(x: np.ndarray, y: np.ndarray) -> Light:
     """``y ≈ gain * x + offset`` per channel (rows of ``(3, n)``), by iteratively reweighted
     least squares with Tukey's biweight from the median ratio (the scale from its residuals):
     foreground the meter did not know of (a hand, a shadow) gets weight 0."""
-    gain = np.median(y / np.maximum(x, 1.0), axis=1)[:, None]
+    gain = median(y / np.maximum(x, 1.0), axis=1)[:, None]
     r = y - gain * x
-    scale = TUKEY * np.maximum(1.4826 * np.median(np.abs(r), axis=1), 0.5)[:, None]
+    scale = TUKEY * np.maximum(1.4826 * median(np.abs(r), axis=1), 0.5)[:, None]
     spread = x.std(axis=1) >= MIN_SPREAD
     offset = np.zeros((3, 1))
     w = np.ones_like(x)
@@ -153,5 +154,5 @@ def _fit(x: np.ndarray, y: np.ndarray) -> Light:
         gain, offset = g[:, None], o[:, None]
         r = y - gain * x - offset
     r = np.abs(r)
-    sigma = 1.4826 * float(np.median(np.maximum(np.maximum(r[0], r[1]), r[2])))
+    sigma = 1.4826 * float(median(np.maximum(np.maximum(r[0], r[1]), r[2])))
     return Light(gain[:, 0], offset[:, 0], sigma, int((w > 0).all(axis=0).sum()))

@@ -66,16 +66,18 @@ class DiscFit:
     fixed: bool = False
 
 
-def _sample(image: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """Bilinear samples (float32) of ``image`` ``(h, w)`` at fractional ``rows``, ``cols``
-    (clamped to the image)."""
-    h, w = image.shape
-    r = np.minimum(np.maximum(rows, 0), h - 1.001)
-    c = np.minimum(np.maximum(cols, 0), w - 1.001)
+def _sample(
+    flat: np.ndarray, base: np.ndarray, shape: np.ndarray, rows: np.ndarray, cols: np.ndarray
+) -> np.ndarray:
+    """Bilinear samples (float32) at fractional ``rows``, ``cols`` ``(n, m)`` (clamped to the
+    image) of images stored row-major in ``flat``: row ``j``'s image is ``shape[j] = (h, w)``
+    and starts at ``flat[base[j]]``."""
+    h, w = shape[:, :1], shape[:, 1:]
+    r = np.minimum(np.maximum(rows, 0), (h - 1.001).astype(np.float32))
+    c = np.minimum(np.maximum(cols, 0), (w - 1.001).astype(np.float32))
     r0, c0 = r.astype(np.intp), c.astype(np.intp)
     fr, fc = r - r0, c - c0
-    flat = image.ravel()
-    i = r0 * w + c0
+    i = r0 * w + c0 + base[:, None]
     a, b = flat[i].astype(np.float32), flat[i + 1].astype(np.float32)
     top = a + (b - a) * fc
     a, b = flat[i + w].astype(np.float32), flat[i + w + 1].astype(np.float32)
@@ -119,20 +121,6 @@ class Edges:
             self.owner[keep],
         )
 
-    @staticmethod
-    def join(parts: Sequence[Edges], discs: Sequence[int]) -> Edges:
-        """The edges of several calls of :func:`edge_points` (for ``discs[k]`` discs each) as
-        one, their discs numbered on in order."""
-        shift = np.concatenate([[0], np.cumsum(discs)[:-1]]).astype(np.intp)
-        return Edges(
-            np.concatenate([p.uv for p in parts]).reshape(-1, 2),
-            np.concatenate([p.theta for p in parts]),
-            np.concatenate([p.contrast for p in parts]),
-            np.concatenate([p.width for p in parts]),
-            np.concatenate([p.reach for p in parts]),
-            np.concatenate([p.owner + k for p, k in zip(parts, shift, strict=True)]),
-        )
-
     def of(self, disc: int) -> Edges:
         """The edges of disc ``disc``."""
         return self.select(self.owner == disc)
@@ -147,7 +135,17 @@ def edge_points(
     :data:`INNER` out to its reach;
     ``low`` is the foreground threshold. Rays that leave the crop, or find no edge, are left
     out."""
-    counts = [int(np.clip(round(2 * math.pi * r.radius / SPACING), 16, 64)) for r in rays]
+    return window_edges([(diff, offset, rays)], low)
+
+
+def window_edges(
+    windows: Sequence[tuple[np.ndarray, tuple[int, int], Sequence[Rays]]], low: float
+) -> Edges:
+    """:func:`edge_points` in several crops ``(diff, offset, rays)`` at once (one pass over all
+    their rays: a frame's discs cost one call, not one per window), their discs numbered on in
+    order."""
+    rays = [r for _, _, some in windows for r in some]
+    counts = [min(max(round(2 * math.pi * r.radius / SPACING), 16), 64) for r in rays]
     owner = np.repeat(np.arange(len(rays)), counts)
     theta = np.concatenate([np.arange(n) * (2 * math.pi / n) for n in counts])
     radius = np.array([r.radius for r in rays])[owner]
@@ -158,8 +156,17 @@ def edge_points(
     s = (start[:, None] + STEP * np.arange(m)[None]).astype(np.float32)  # (n, m)
     du, dv = np.cos(theta), np.sin(theta)
     centres = np.array([r.centre for r in rays], dtype=float)[owner]
-    cu, cv = centres[:, 0] - offset[1], centres[:, 1] - offset[0]
-    h, w = diff.shape
+    # Each ray's window: its offset, its shape and where its pixels start with the windows'
+    # laid end to end, and how far inside an edge its inner level is looked for (from the
+    # window's smallest disc).
+    window = np.repeat(np.arange(len(windows)), [len(some) for _, _, some in windows])[owner]
+    shape = np.array([diff.shape for diff, _, _ in windows], dtype=np.intp)
+    base = np.concatenate([[0], np.cumsum(shape[:-1, 0] * shape[:-1, 1])])[window]
+    shape, offset = shape[window], np.array([o for _, o, _ in windows], dtype=np.intp)[window]
+    inner = [min(INNER, 0.5 * min(r.radius for r in some)) for _, _, some in windows]
+    ks = np.array([max(2, round(x / STEP)) for x in inner])[window]
+    cu, cv = centres[:, 0] - offset[:, 1], centres[:, 1] - offset[:, 0]
+    h, w = shape[:, 0], shape[:, 1]
     # Rays are straight: inside the crop where both their ends are.
     ok = np.ones(len(theta), dtype=bool)
     for far in (start, start + STEP * (steps - 1)):
@@ -170,20 +177,43 @@ def edge_points(
         cv.astype(f32)[:, None] + dv.astype(f32)[:, None] * s,
         cu.astype(f32)[:, None] + du.astype(f32)[:, None] * s,
     )
-    p = _sample(diff, rows_, cols_)  # (n, m)
+    flat = np.concatenate([diff.ravel() for diff, _, _ in windows])
+    p = _sample(flat, base, shape, rows_, cols_)  # (n, m)
+    groups = np.unique(ks)
+    if len(groups) == 1:
+        found = _edges_on(p, s, steps, int(groups[0]), low)
+    else:  # windows whose smallest discs look for the inner level at different depths
+        parts = [(ks == k, _edges_on(p[ks == k], s[ks == k], steps[ks == k], int(k), low))
+                 for k in groups]  # fmt: skip
+        found = tuple(np.empty(len(theta), dtype=a.dtype) for a in parts[0][1])
+        for mine, got in parts:
+            for out, part in zip(found, got, strict=True):
+                out[mine] = part
+    good, dist, contrast, width = found
+    ok &= good
+    uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
+    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok])
+
+
+def _edges_on(
+    p: np.ndarray, s: np.ndarray, steps: np.ndarray, k: int, low: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each ray's edge on its profile ``p`` ``(n, m)`` sampled at distances ``s`` (``steps`` of
+    them its own), its inner level searched ``k`` samples inside: whether it has one, its
+    distance, contrast and width (see :class:`Edges`)."""
+    m = p.shape[1]
     above = (p >= low) & (np.arange(m)[None] < steps[:, None])
     # The outermost run of foreground at least RUN samples long ends at the edge: a speck of the
     # wall's texture the light does not quite match, a pixel or so past the rim, is not it.
     run = above[:, RUN - 1 :].copy()
-    for k in range(1, RUN):
-        run &= above[:, RUN - 1 - k : m - k]
+    for j in range(1, RUN):
+        run &= above[:, RUN - 1 - j : m - j]
     last = m - 1 - np.argmax(run[:, ::-1], axis=1)
-    ok &= run.any(axis=1) & (last < steps - 1)
+    ok = run.any(axis=1) & (last < steps - 1)
     # The edge's inner level is where the profile stops falling steeply, walking in from its
     # steepest point near the threshold crossing: the rim's own brightness, not the shading
     # further in (a lit sphere brightens inwards from a limb as dark as the wall).
-    k = max(2, round(min(INNER, 0.5 * float(radius.min())) / STEP))
-    rows = np.arange(len(theta))
+    rows = np.arange(len(p))
     idx = np.clip(last[:, None] + np.arange(-k, 2), 0, m - 1)  # (n, k + 2): inside out
     near = p[rows[:, None], idx]
     slope = near[:, :-1] - near[:, 1:]  # (n, k + 1): the fall over each step outwards
@@ -204,9 +234,8 @@ def edge_points(
     pj, pn = near[rows, j], near[rows, j + 1]
     frac = np.clip((pj - level) / np.maximum(pj - pn, 1e-6), 0.0, 1.0)
     dist = s[rows, idx[rows, j]] + STEP * frac
-    uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
     width = s[rows, last] + 0.5 * STEP - dist
-    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok])
+    return ok, dist, contrast, width
 
 
 @dataclass(frozen=True)
@@ -241,6 +270,9 @@ class _Groups:
         return np.bincount(self.owner, values, self.count)
 
 
+_ROW, _COLUMN = np.repeat(np.arange(3), 4), np.tile(np.arange(4), 3)
+
+
 def _circles(xy: np.ndarray, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray, np.ndarray]:
     """Each group's weighted least-squares circle through its points ``xy`` (algebraic: Kasa, by
     its normal equations), as centres ``(count, 2)`` and radii ``(count,)``; NaN for a group
@@ -251,9 +283,11 @@ def _circles(xy: np.ndarray, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray
     a = np.ones((len(xy), 4))
     a[:, :2] = xy - mean[g.owner]
     a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
-    outer = (a[:, :3] * weight[:, None])[:, :, None] * a[:, None, :]  # (n, 3, 4)
+    # The products a_i a_j (weighted, i < 3, j < 4) as 12 columns: an (n, 3, 4) broadcast costs
+    # several times as much for the same values.
+    outer = (a[:, :3] * weight[:, None])[:, _ROW] * a[:, _COLUMN]  # (n, 12)
     m = np.zeros((g.count, 3, 4))
-    m[some] = np.add.reduceat(outer, g.starts[some], axis=0)
+    m[some] = np.add.reduceat(outer, g.starts[some], axis=0).reshape(-1, 3, 4)
     sol = np.full((g.count, 3), np.nan)
     ok = g.total(weight > 0) >= 3
     if ok.any():

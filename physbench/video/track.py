@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -52,7 +52,13 @@ import numpy as np
 from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
 from physbench.video.accuracy import stated_accuracy
-from physbench.video.appearance import HIDDEN, Appearance, Look, colour_directions
+from physbench.video.appearance import (
+    HIDDEN,
+    Appearance,
+    Look,
+    colour_directions,
+    matching,
+)
 from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
     Outline,
@@ -63,10 +69,18 @@ from physbench.video.detect import (
     split_pixels,
 )
 from physbench.video.faint import SHUTTER, find_faint
+from physbench.video.medians import median
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import Light, LightMeter, plate_index
-from physbench.video.silhouette import DiscFit, Edges, Rays, edge_points, fit_disc, fit_discs
+from physbench.video.silhouette import (
+    DiscFit,
+    Rays,
+    edge_points,
+    fit_disc,
+    fit_discs,
+    window_edges,
+)
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -630,10 +644,12 @@ class Tracker:
             )
             if not blobs:
                 continue
-            own = [self._own_colours(image, blob, group) for blob in blobs]
+            own = [_Split(self._own_colours, image, blob, group) for blob in blobs]
             owner, dist = self._assign(group, blobs, gates, own)
             for c, members in owner.items():
-                mixed = len(members) > 1 or _colours_of(blobs[c], own[c], self.states) > 1
+                mixed = len(members) > 1 or (
+                    len(group) > 1 and _colours_of(blobs[c], own[c], self.states) > 1
+                )
                 for i in members:
                     if self.states[i].disc:
                         mask = own[c].get(i) if mixed else None
@@ -664,7 +680,7 @@ class Tracker:
         group: list[int],
         blobs: list,
         c: int,
-        own: list[dict[int, np.ndarray]],
+        own: list[Mapping[int, np.ndarray]],
         dist: np.ndarray,
         gates: np.ndarray,
     ) -> list[int]:
@@ -684,7 +700,7 @@ class Tracker:
         window: tuple[np.ndarray, tuple[int, int]],
         blobs: list,
         c: int,
-        own: list[dict[int, np.ndarray]],
+        own: list[Mapping[int, np.ndarray]],
         tries: list[int],
     ) -> tuple[_Found, int] | None:
         """Body ``i`` measured on the first blob of ``tries`` where it looks like itself (on
@@ -701,7 +717,7 @@ class Tracker:
         return None
 
     def _assign(
-        self, ids: list[int], blobs: list, gates: np.ndarray, own: list[dict[int, np.ndarray]]
+        self, ids: list[int], blobs: list, gates: np.ndarray, own: list[Mapping[int, np.ndarray]]
     ) -> tuple[dict[int, list[int]], np.ndarray]:
         """Blobs to bodies ``ids``: each blob's owners, and the distance of each body's prediction
         to each blob's centre (px). ``own``: per blob, the pixels of each body's colour."""
@@ -738,7 +754,7 @@ class Tracker:
         ids: list[int],
         blobs: list,
         gates: np.ndarray,
-        own: list[dict[int, np.ndarray]],
+        own: list[Mapping[int, np.ndarray]],
         owner: dict[int, list[int]],
         dist: np.ndarray,
     ) -> None:
@@ -755,9 +771,8 @@ class Tracker:
 
         for c, members in list(owner.items()):
             others = [k for k in ids if k not in members and held(c, k) >= HIDDEN]
-            for i in [i for i in members if i in own[c] and held(c, i) < 0.1]:
-                if others:
-                    members.remove(i)
+            for i in [i for i in members if i in own[c] and held(c, i) < 0.1] if others else []:
+                members.remove(i)
             if not members:
                 del owner[c]
         for j, i in enumerate(ids):
@@ -777,8 +792,8 @@ class Tracker:
         known = {i: look for i, look in looks.items() if look is not None}
         if not known:
             return {}
-        colours = self._colours(image, found_blob)
-        return {i: look.matches(*colours) for i, look in known.items()}
+        masks = matching(list(known.values()), *self._colours(image, found_blob))
+        return {i: masks[:, k] for k, i in enumerate(known)}
 
     def _members(
         self,
@@ -788,7 +803,7 @@ class Tracker:
         window: tuple[np.ndarray, tuple[int, int]],
         plans: dict[int, _Plan],
         fits: dict[int, DiscFit | None],
-        own: dict[int, np.ndarray],
+        own: Mapping[int, np.ndarray],
     ) -> dict[int, _Found]:
         """Measure ``members`` on one blob (pixels ``u``, ``v``, coverage ``w``): a disc by its
         outline (``fits``), a body alone by its centroid, bodies sharing the blob by its pixels
@@ -907,14 +922,13 @@ class Tracker:
             by_window.setdefault(id(plans[i][1][0]), []).append(i)
         for members in by_window.values():
             diff, origin = plans[members[0]][1]
-            rays = [plans[i][0].rays for i in members]
-            found.append(edge_points(diff, origin, rays, self.edge_low))
+            found.append((diff, origin, [plans[i][0].rays for i in members]))
         order = [i for members in by_window.values() for i in members]
         fits: dict[int, DiscFit | None] = {}
         if order:
             mine = [plans[i][0] for i in order]
             got = fit_discs(
-                Edges.join(found, [len(members) for members in by_window.values()]),
+                window_edges(found, self.edge_low),
                 [p.rays.radius for p in mine],
                 self.cal,
                 [p.mpp for p in mine],
@@ -1044,7 +1058,7 @@ class Tracker:
             colours = colours[weights >= np.percentile(weights, 75)]
         if len(colours) > 64:
             colours = colours[::4]
-        raw = np.median(colours, axis=0).astype(float) if len(colours) else np.zeros(3)
+        raw = median(colours, axis=0) if len(colours) else np.zeros(3)
         colour = (raw - self.light.offset) / np.maximum(self.light.gain, 1e-3)
         return Look(area / max(expected, 1e-9), colour, expected)
 
@@ -1310,7 +1324,30 @@ def _project(colour: np.ndarray, behind: np.ndarray, body: np.ndarray) -> np.nda
     return np.einsum("ij,ij->i", colour - behind, span) / np.maximum(norm, 1.0)
 
 
-def _colours_of(found_blob: tuple, own: dict[int, np.ndarray], states: list[_State]) -> int:
+def _colours_of(found_blob: tuple, own: Mapping[int, np.ndarray], states: list[_State]) -> int:
     """How many bodies' colours a blob holds much of (a fifth of a body's area or more)."""
     w = found_blob[3]
     return sum(float(w[mask].sum()) >= 0.2 * states[i].area for i, mask in own.items())
+
+
+class _Split(Mapping[int, np.ndarray]):
+    """A blob's pixels of each body's colour, ``split(*args)`` (:meth:`Tracker._own_colours`),
+    split when first asked for: most blobs are one body's alone, which never asks."""
+
+    def __init__(self, split: Callable[..., dict[int, np.ndarray]], *args: object) -> None:
+        self._split, self._args = split, args
+        self._masks: dict[int, np.ndarray] | None = None
+
+    def _get(self) -> dict[int, np.ndarray]:
+        if self._masks is None:
+            self._masks = self._split(*self._args)
+        return self._masks
+
+    def __getitem__(self, i: int) -> np.ndarray:
+        return self._get()[i]
+
+    def __iter__(self) -> Iterator[int]:
+        return iter(self._get())
+
+    def __len__(self) -> int:
+        return len(self._get())
