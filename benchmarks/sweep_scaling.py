@@ -3,7 +3,8 @@ LocalCluster, against raw engine episodes with as many processes, in the same ru
 sweep's time goes; and how its cells spread over the workers.
 
     python benchmarks/sweep_scaling.py [--repeats 3] [--workers 1 2 4 8 16]
-        [--executors processes dask] [--specs benchmarks/smoke48.toml] [--out results/sweep_scaling]
+        [--executors processes dask] [--dask-workers 16] [--raw-workers 1 16] [--seeds 4]
+        [--specs benchmarks/smoke48.toml] [--out results/sweep_scaling] [--add]
 
 Sweep: ``physbench bench SPEC --fresh -q --executor E --workers N`` in a fresh interpreter (end
 to end: start-up, imports, cells, tables), instrumented from the outside (wrappers installed
@@ -29,8 +30,15 @@ worker's overhead + work; N workers need at least serial + the largest overhead 
 workers (measured in the N-worker run: each pays it at once) + work / N. And the schedule: serial
 + the busiest worker's CPU (overhead and cells) in the N-worker run as it was measured.
 
-Writes ``OUT/sweep_scaling.json`` (every run, the load averages before each) and
-``OUT/sweep_scaling.md``.
+Placement replayed: the executor's own placement (:class:`physbench.bench.placement.Pending`,
+at most ``QUEUED`` cells per worker) run on a simulated clock for 1..16 workers, each cell taking
+its estimator's median CPU time measured here and a worker's first cell of an estimator that
+estimator's measured extra (its imports): how the cells would spread over 16 workers on this
+machine's measured costs, and the time workers would stand idle while cells waited.
+
+Writes ``OUT/results.json`` (every run, the load averages before each; rewritten after each run,
+so a benchmark cut short keeps what it measured; ``--add`` adds runs to it) and
+``OUT/summary.md``.
 """
 
 from __future__ import annotations
@@ -127,7 +135,7 @@ def child(spec: str, executor: str, workers: int, out: str, events: str) -> None
     def put_timed(self: Any, key: str, data: dict[str, Any]) -> None:
         timing = data.pop("_timing")
         _EVENTS["cells"].append(
-            {**timing, "received": time.time(), "est": data["config"]["estimator"]}
+            {**timing, "received": time.time(), "est": data["config"]["estimator"], "key": key}
         )
         put(self, key, data)
 
@@ -140,6 +148,11 @@ def child(spec: str, executor: str, workers: int, out: str, events: str) -> None
         finally:
             _EVENTS["batches"].append((t0, time.time(), len(cells)))
 
+    from physbench.bench.spec import load_spec
+
+    for c in load_spec(spec).cells():
+        n = _EVENTS.setdefault("estimators_cells", {})
+        n[c.config.estimator] = n.get(c.config.estimator, 0) + 1
     store.CellWriter.put = put_timed  # type: ignore[method-assign]
     store.CellStore.save_many = save_many_timed  # type: ignore[method-assign]
     argv = ["bench", spec, "--out", out, "--fresh", "-q", "--executor", executor]
@@ -169,7 +182,19 @@ def spread(cells: list[dict[str, Any]]) -> dict[str, Any]:
         idle[pid] = sum(gaps) + max(0.0, last_start - own[-1]["t1"])
     counts = sorted(len(own) for own in by_worker.values())
     span = sum(last_start - min(c["t0"] for c in own) for own in by_worker.values())
+    per_worker = [
+        {
+            "cells": len(own),
+            "estimators": sorted({c["est"] for c in own}),
+            "busy_s": round(sum(c["t1"] - c["t0"] for c in own), 3),
+            "cpu_s": round(sum(c["cpu"] for c in own), 3),
+            "first_cell_s": round(own[0]["t0"] - first_start, 3),
+            "idle_while_waiting_s": round(idle[pid], 3),
+        }
+        for pid, own in sorted(by_worker.items(), key=lambda kv: kv[1][0]["t0"])
+    ]
     return {
+        "per_worker": per_worker,
         "workers_used": len(by_worker),
         "cells_per_worker": counts,
         "estimators_per_worker": sorted(len({c["est"] for c in own}) for own in by_worker.values()),
@@ -197,6 +222,24 @@ def overheads(cells: list[dict[str, Any]]) -> dict[int, dict[str, float]]:
         if (c["pid"], c["est"]) not in seen:
             seen.add((c["pid"], c["est"]))
             w["first_cells"] += max(0.0, c["cpu"] - median[c["est"]])
+    return out
+
+
+def estimator_costs(cells: list[dict[str, Any]]) -> dict[str, dict[str, float]]:
+    """Per estimator, in CPU seconds: its median cell (a worker's first cell of it left out) and
+    the median extra of a worker's first cell of it over that (its imports and first-call work)."""
+    seen: set[tuple[int, str]] = set()
+    firsts: dict[str, list[float]] = {}
+    others: dict[str, list[float]] = {}
+    for c in sorted(cells, key=lambda c: c["t0"]):
+        first = (c["pid"], c["est"]) not in seen
+        seen.add((c["pid"], c["est"]))
+        (firsts if first else others).setdefault(c["est"], []).append(c["cpu"])
+    out = {}
+    for est, v in others.items():
+        typical = statistics.median(v)
+        extra = statistics.median(firsts.get(est, [typical])) - typical
+        out[est] = {"typical": round(typical, 4), "extra": round(max(0.0, extra), 4)}
     return out
 
 
@@ -243,12 +286,28 @@ def breakdown(ev: dict[str, Any], launched: float, ended: float, workers: int) -
         "busiest_worker_cpu": max(w["startup"] + w["cells"] for w in over.values()),
     }
     res.update(spread(cells))
+    res["estimator_costs"] = estimator_costs(cells)
+    res["cells"] = len(cells)
+    res["estimators_cells"] = ev["estimators_cells"]  # in the spec's order
+    res["parent_loop_cpu_per_cell_ms"] = 1000 * loop_cpu / len(cells)
     return res
 
 
 def _cpu_of_children() -> float:
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r.ru_utime + r.ru_stime
+
+
+def table_hash(out: Path) -> str:
+    """A hash of the sweep's long table without its timings and versions: the same cells with
+    the same results give the same hash, whatever executor and workers ran them."""
+    import hashlib
+
+    import pandas as pd
+
+    df = pd.read_parquet(out / "results.parquet")
+    df = df.drop(columns=[c for c in df.columns if c.startswith("t_") or c == "versions"])
+    return hashlib.sha256(df.to_csv(index=False).encode()).hexdigest()[:16]
 
 
 def run_sweep_once(spec: str, executor: str, workers: int, tmp: Path) -> dict[str, Any]:
@@ -258,13 +317,90 @@ def run_sweep_once(spec: str, executor: str, workers: int, tmp: Path) -> dict[st
     cmd = [sys.executable, __file__, "--child", spec, executor, str(workers), str(out), str(events)]
     load = os.getloadavg()
     cpu, launched = _cpu_of_children(), time.time()
-    subprocess.run(cmd, check=True, env={**os.environ, "PYTHONPATH": os.getcwd()})
+    path = os.pathsep.join(p for p in (os.getcwd(), os.environ.get("PYTHONPATH")) if p)
+    subprocess.run(cmd, check=True, env={**os.environ, "PYTHONPATH": path})
     ended = time.time()
     res = breakdown(json.loads(events.read_text()), launched, ended, workers)
     # the sweep's workers ended before it, so their CPU time is counted with it
     res["cpu"] = _cpu_of_children() - cpu
+    res["table_hash"] = table_hash(out)
     res["load_before"] = [round(x, 2) for x in load]
     return res
+
+
+# ---------------------------------------------------------------- placement replayed
+
+
+def replay(
+    counts: dict[str, int], costs: dict[str, dict[str, float]], workers: int, startup: float
+) -> dict[str, Any]:
+    """The executor's placement on a simulated clock (see the module's docstring): ``counts``
+    cells per estimator (in spec order, grouped as the executor groups them), each taking its
+    estimator's ``typical`` seconds, plus ``extra`` in a worker's first cell of it; every worker
+    ready after ``startup`` seconds; the parent hands out cells instantly."""
+    import heapq
+
+    from physbench.bench.executors import QUEUED
+    from physbench.bench.placement import Pending
+
+    items = [(est, i) for est, n in counts.items() for i in range(n)]
+    pending = Pending(items, lambda it: it[0])
+    queue: dict[int, list[tuple[str, int]]] = {w: [] for w in range(workers)}
+    ran: dict[int, set[str]] = {w: set() for w in range(workers)}
+    free = dict.fromkeys(range(workers), startup)  # when each worker's running cell ends
+    running: set[int] = set()
+    events: list[tuple[float, int, tuple[str, int], float]] = []
+    n_cells = dict.fromkeys(range(workers), 0)
+    idle = dict.fromkeys(range(workers), 0.0)
+    now = 0.0
+
+    def start(w: int) -> None:
+        if w in running or not queue[w]:
+            return
+        est = queue[w][0][0]
+        sec = costs[est]["typical"] + (0.0 if est in ran[w] else costs[est]["extra"])
+        ran[w].add(est)
+        running.add(w)
+        heapq.heappush(events, (max(now, free[w]) + sec, w, queue[w][0], sec))
+
+    def hand_out(force: bool = False) -> None:
+        for w in range(workers):
+            limit = QUEUED if len(pending) >= workers else 1
+            while pending and len(queue[w]) < limit:
+                item = pending.take(w, force=force)
+                if item is None:
+                    break
+                queue[w].append(item)
+                force = False
+            start(w)
+
+    hand_out()
+    while events:
+        nxt = events[0][0]
+        # workers without a cell (once started) while a cell has not started: idle while waiting
+        unstarted = len(pending) + sum(len(q) for q in queue.values()) - len(running)
+        if unstarted:
+            for v in range(workers):
+                if v not in running:
+                    idle[v] += max(0.0, nxt - max(now, free[v]))
+        now, w, item, sec = heapq.heappop(events)
+        queue[w].pop(0)
+        running.discard(w)
+        free[w] = now
+        n_cells[w] += 1
+        pending.done(w, item, sec)
+        hand_out()
+        if pending and not events:
+            hand_out(force=True)
+    end = now
+    return {
+        "workers": workers,
+        "span_s": round(end, 3),
+        "cells_per_worker": sorted(n_cells.values()),
+        "estimators_per_worker": sorted(len(r) for r in ran.values()),
+        "idle_while_waiting_s": round(sum(idle.values()), 3),
+        "idle_while_waiting_max_s": round(max(idle.values()), 3),
+    }
 
 
 # ---------------------------------------------------------------- raw engine episodes
@@ -356,27 +492,34 @@ def median_run(runs: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def predict(one: dict[str, Any], many: dict[str, Any], n: int) -> dict[str, float]:
-    """What ``n`` cores would give (see the module's docstring), from the medians of the
-    1-worker processes run ``one`` and of the ``n``-worker run ``many``, in CPU seconds."""
+def predict(one: dict[str, Any], many: dict[str, Any], n: int) -> dict[str, Any]:
+    """What ``n`` cores would give (see the module's docstring), in CPU seconds, from the medians
+    of the 1-worker processes run ``one`` and of the processes run with the most workers
+    ``many`` (its workers' overheads: each of them ran fewer estimators than the single worker).
+    The sweep process is one: its CPU in the cell loop, per cell, bounds the cells per second."""
     serial = one["parent_serial_cpu"]
     overhead_1 = one["worker_overhead_cpu_max"]
     work = one["cells_cpu"] - one["worker_first_cells_cpu_mean"]
     t1 = serial + overhead_1 + work
-    amdahl = serial + many["worker_overhead_cpu_max"] + work / n
-    schedule = serial + many["busiest_worker_cpu"]
+    overhead_n = many["worker_overhead_cpu_max"]
+    amdahl = serial + overhead_n + work / n
+    parent_loop = one["cells"] * many["parent_loop_cpu_per_cell_ms"] / 1000
+    rep = replay(one["estimators_cells"], one["estimator_costs"], n, many["worker_startup_cpu_max"])
     return {
         "workers": n,
         "serial_cpu": round(serial, 3),
         "overhead_1_cpu": round(overhead_1, 3),
-        "overhead_n_cpu": round(many["worker_overhead_cpu_max"], 3),
+        "overhead_n_cpu": round(overhead_n, 3),
         "work_cpu": round(work, 3),
         "t1_cpu": round(t1, 3),
         "amdahl_s": round(amdahl, 3),
         "amdahl_ratio": round(t1 / amdahl, 3),
         "serial_only_ratio": round(t1 / (serial + work / n), 3),
-        "schedule_s": round(schedule, 3),
-        "schedule_ratio": round(t1 / schedule, 3),
+        "parent_loop_cpu": round(parent_loop, 3),
+        "parent_bound_ratio": round(t1 / (serial + parent_loop), 3),
+        "replay": rep,
+        "replay_s": round(serial + rep["span_s"], 3),
+        "replay_ratio": round(t1 / (serial + rep["span_s"]), 3),
     }
 
 
@@ -385,67 +528,105 @@ def summarise(result: dict[str, Any]) -> None:
     for res in result["specs"].values():
         res["median"] = {}
         for key, runs in res["runs"].items():
-            res["median"][key] = median_run(runs)
+            if runs:
+                res["median"][key] = median_run(runs)
         for key, runs in res["raw"].items():
-            res["median"][f"raw_{key}"] = {
-                "wall": round(statistics.median(r["wall"] for r in runs), 4)
-            }
+            if runs:
+                res["median"][f"raw_{key}"] = {
+                    "wall": round(statistics.median(r["wall"] for r in runs), 4)
+                }
+        if "processes_1" not in res["median"]:
+            continue
         one = res["median"]["processes_1"]["wall"]
-        raw1 = res["median"]["raw_1"]["wall"]
         res["ratios"] = {
             key: round(one / m["wall"], 3)
             for key, m in res["median"].items()
             if not key.startswith("raw")
         }
+        raw1 = res["median"].get("raw_1", {}).get("wall")
         res["raw_ratios"] = {
-            key: round(raw1 / m["wall"], 3)
+            key: round(raw1 / m["wall"], 3) if raw1 else None
             for key, m in res["median"].items()
             if key.startswith("raw")
         }
-        n = max(result["workers"])
-        res["prediction"] = predict(
-            res["median"]["processes_1"], res["median"][f"processes_{n}"], n
-        )
-        dask = [w for w in result["workers"] if f"dask_{w}" in res["median"]]
+        procs = [int(k.split("_")[1]) for k in res["median"] if k.startswith("processes_")]
+        many = res["median"][f"processes_{max(procs)}"]
+        one_run = res["median"]["processes_1"]
+        res["prediction"] = {
+            str(n): predict(one_run, many, n) for n in sorted({max(procs), *TARGETS})
+        }
+        res["replays"] = {
+            str(n): replay(
+                one_run["estimators_cells"],
+                one_run["estimator_costs"],
+                n,
+                many["worker_startup_cpu_max"],
+            )
+            for n in REPLAY_WORKERS
+        }
+        dask = sorted(int(k.split("_")[1]) for k in res["median"] if k.startswith("dask_"))
         res["dask_vs_processes"] = {
             str(w): round(
                 res["median"][f"dask_{w}"]["wall"] / res["median"][f"processes_{w}"]["wall"], 3
             )
             for w in dask
+            if f"processes_{w}" in res["median"]
         }
         res["dask_vs_processes_cpu"] = {
             str(w): round(
                 res["median"][f"dask_{w}"]["cpu"] / res["median"][f"processes_{w}"]["cpu"], 3
             )
             for w in dask
+            if f"processes_{w}" in res["median"]
         }
+        # per-cell overhead: the sweep's time less the cells' own work, per cell
+        res["overhead_per_cell_ms"] = {
+            key: round(1000 * (m["wall"] * int(key.split("_")[1]) - m["cells_cpu"]) / m["cells"], 2)
+            for key, m in res["median"].items()
+            if not key.startswith("raw")
+        }
+        res["identical_tables"] = {
+            key: m.get("table_hash") == one_run.get("table_hash")
+            for key, m in res["median"].items()
+            if not key.startswith("raw")
+        }
+
+
+#: Worker counts the projections are made for, and the placement replayed for.
+TARGETS = (16,)
+REPLAY_WORKERS = (1, 2, 4, 8, 16)
 
 
 def markdown(result: dict[str, Any]) -> str:
     lines = [
         "# Sweep scaling",
         "",
-        f"Machine: {result['machine']}. {result['repeats']} repeats, each configuration once per "
-        "repeat in alternating order; medians. `python benchmarks/sweep_scaling.py "
+        f"Machine: {result['machine']}, Python {result['python']}. {result['repeats']} repeat(s), "
+        "each configuration once per repeat in alternating order; medians. "
+        "`python benchmarks/sweep_scaling.py "
         + " ".join(result["argv"])
-        + "`. Load average (1, 5, 15 min) before every run is in sweep_scaling.json; over the "
+        + "`. Load average (1, 5, 15 min) before every run is in results.json; over the "
         f"sweeps it ranged {result['load_range'][0]:.1f}-{result['load_range'][1]:.1f} (1 min).",
     ]
     for name, res in result["specs"].items():
-        lines += _spec_markdown(name, res, result)
+        if "prediction" in res:
+            lines += _spec_markdown(name, res, result)
     return "\n".join(lines) + "\n"
 
 
 def _spec_markdown(name: str, res: dict[str, Any], result: dict[str, Any]) -> list[str]:
     med = res["median"]
-    keys = [k for k in med if not k.startswith("raw")]
+    keys = sorted(
+        (k for k in med if not k.startswith("raw")),
+        key=lambda k: (int(k.rsplit("_", 1)[1]), k),
+    )
     lines = [
         "",
-        f"## {name}",
+        f"## {name} ({med['processes_1']['cells']} cells)",
         "",
-        "| executor | workers | wall s | speed-up | CPU s | cells per worker (min-max) "
-        "| idle while cells waited s | load (1 min) | runs, wall s |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| executor | workers | wall s | speed-up | CPU s | overhead per cell ms | cells per worker"
+        " (min-max) | idle while cells waited s | same table | load (1 min) | runs, wall s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for key in keys:
         m, runs = med[key], res["runs"][key]
@@ -455,31 +636,23 @@ def _spec_markdown(name: str, res: dict[str, Any], result: dict[str, Any]) -> li
         walls = " ".join(f"{r['wall']:.2f}" for r in runs)
         lines.append(
             f"| {ex} | {w} | {m['wall']:.2f} | {res['ratios'][key]:.2f} | {m['cpu']:.2f} | "
-            f"{cpw[0]}-{cpw[-1]} | {m['idle_while_waiting_s']:.2f} | {loads} | {walls} |"
+            f"{res['overhead_per_cell_ms'][key]:.1f} | {cpw[0]}-{cpw[-1]} | "
+            f"{m['idle_while_waiting_s']:.2f} | {'yes' if res['identical_tables'][key] else 'NO'} "
+            f"| {loads} | {walls} |"
         )
     for key in sorted((k for k in med if k.startswith("raw")), key=lambda k: int(k.split("_")[1])):
         runs = res["raw"][key.split("_", 1)[1]]
         loads = " ".join(f"{r['load_before'][0]:.1f}" for r in runs)
         walls = " ".join(f"{r['wall']:.2f}" for r in runs)
+        ratio = res["raw_ratios"][key]
         lines.append(
             f"| raw engine | {key.split('_')[1]} | {med[key]['wall']:.2f} | "
-            f"{res['raw_ratios'][key]:.2f} | | | | {loads} | {walls} |"
+            f"{'' if ratio is None else f'{ratio:.2f}'} | | | | | | {loads} | {walls} |"
         )
-    p = res["prediction"]
     lines += [
         "",
-        f"What {p['workers']} cores would give, in CPU seconds (see the script's docstring): "
-        f"serial phases {p['serial_cpu']:.2f}, one worker's overhead {p['overhead_1_cpu']:.2f} "
-        f"(the largest of {p['workers']} workers': {p['overhead_n_cpu']:.2f}), cells' work "
-        f"{p['work_cpu']:.2f}; 1 worker {p['t1_cpu']:.2f}.",
-        "",
-        f"| model | {p['workers']} workers s | speed-up |",
-        "|---|---|---|",
-        f"| Amdahl: serial + largest worker overhead + work / {p['workers']} | "
-        f"{p['amdahl_s']:.2f} | {p['amdahl_ratio']:.2f} |",
-        f"| Amdahl, serial phases only | | {p['serial_only_ratio']:.2f} |",
-        f"| measured schedule: serial + busiest worker | {p['schedule_s']:.2f} | "
-        f"{p['schedule_ratio']:.2f} |",
+        "Overhead per cell: (wall × workers − the cells' CPU) / cells: what a cell costs beyond "
+        "its own work (start-up, imports, hand-out, storing, tables, idle workers).",
     ]
     if res["dask_vs_processes"]:
         lines += [
@@ -491,6 +664,45 @@ def _spec_markdown(name: str, res: dict[str, Any], result: dict[str, Any]) -> li
             )
             + ".",
         ]
+    for n, p in res["prediction"].items():
+        lines += [
+            "",
+            f"What {n} cores would give, in CPU seconds (see the script's docstring): serial "
+            f"phases of the sweep process {p['serial_cpu']:.2f}, one worker's overhead "
+            f"{p['overhead_1_cpu']:.2f} (the largest in the run with the most workers: "
+            f"{p['overhead_n_cpu']:.2f}), the cells' work {p['work_cpu']:.2f}; 1 worker "
+            f"{p['t1_cpu']:.2f}. The sweep process's CPU in the cell loop: "
+            f"{p['parent_loop_cpu']:.2f} for all cells.",
+            "",
+            f"| model | {n} workers s | speed-up |",
+            "|---|---|---|",
+            f"| Amdahl: serial + largest worker overhead + work / {n} | "
+            f"{p['amdahl_s']:.2f} | {p['amdahl_ratio']:.2f} |",
+            f"| Amdahl, serial phases only | | {p['serial_only_ratio']:.2f} |",
+            f"| bound of one sweep process: serial + its cell-loop CPU | "
+            f"{p['serial_cpu'] + p['parent_loop_cpu']:.2f} | {p['parent_bound_ratio']:.2f} |",
+            f"| placement replayed: serial + replayed span | {p['replay_s']:.2f} | "
+            f"{p['replay_ratio']:.2f} |",
+        ]
+    lines += [
+        "",
+        "Placement replayed with the 1-worker run's per-estimator costs (CPU s: "
+        + ", ".join(
+            f"{e} {c['typical'] * 1000:.0f} ms + {c['extra']:.2f} first"
+            for e, c in med["processes_1"]["estimator_costs"].items()
+        )
+        + "):",
+        "",
+        "| workers | span s | cells per worker | estimators per worker | idle while cells "
+        "waited s (largest) |",
+        "|---|---|---|---|---|",
+    ]
+    for n, r in res["replays"].items():
+        cpw, epw = r["cells_per_worker"], r["estimators_per_worker"]
+        lines.append(
+            f"| {n} | {r['span_s']:.2f} | {cpw[0]}-{cpw[-1]} | {epw[0]}-{epw[-1]} | "
+            f"{r['idle_while_waiting_s']:.2f} ({r['idle_while_waiting_max_s']:.2f}) |"
+        )
     lines += ["", f"Where the {name} sweep's time goes (medians, seconds unless noted):", ""]
     lines += ["| phase | " + " | ".join(k.replace("_", " ") for k in keys) + " |"]
     lines += ["|---|" + "---|" * len(keys)]
@@ -504,10 +716,39 @@ def _spec_markdown(name: str, res: dict[str, Any], result: dict[str, Any]) -> li
         )
         + " |"
     )
+    for key in [k for k in keys if k.endswith(f"_{max(int(x.rsplit('_', 1)[1]) for x in keys)}")]:
+        lines += [
+            "",
+            f"How the cells spread over the workers, {key.replace('_', ' ')} workers (the median "
+            "run; workers in the order of their first cell):",
+            "",
+            "| worker | cells | estimators | first cell at s | busy s | CPU s | idle while cells "
+            "waited s |",
+            "|---|---|---|---|---|---|---|",
+        ]
+        for i, w in enumerate(med[key]["per_worker"]):
+            lines.append(
+                f"| {i} | {w['cells']} | {' '.join(w['estimators'])} | {w['first_cell_s']:.2f} | "
+                f"{w['busy_s']:.2f} | {w['cpu_s']:.2f} | {w['idle_while_waiting_s']:.2f} |"
+            )
     return lines
 
 
 # ---------------------------------------------------------------- main
+
+
+def _with_seeds(spec: str, seeds: int | None, tmp: Path) -> str:
+    """``spec``, or a copy of it with ``seeds`` seeds (fewer cells, for a quick run)."""
+    if seeds is None:
+        return spec
+    import re
+
+    text = Path(spec).read_text()
+    text = re.sub(r"(?m)^seeds = .*$", f"seeds = {seeds}", text)
+    text = re.sub(r'(?m)^name = "(.*)"$', rf'name = "\1-{seeds}seeds"', text, count=1)
+    path = tmp / f"{Path(spec).stem}_{seeds}seeds.toml"
+    path.write_text(text)
+    return str(path)
 
 
 def main() -> None:
@@ -515,60 +756,83 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--workers", type=int, nargs="+", default=list(WORKERS))
     ap.add_argument("--executors", nargs="+", default=list(EXECUTORS), choices=EXECUTORS)
+    ap.add_argument(
+        "--dask-workers", type=int, nargs="*", help="worker counts Dask runs (default: all)"
+    )
+    ap.add_argument(
+        "--raw-workers", type=int, nargs="*", help="worker counts of raw episodes (default: all)"
+    )
+    ap.add_argument("--seeds", type=int, help="run the specs with this many seeds instead")
     ap.add_argument("--specs", nargs="+", default=list(SPECS))
     ap.add_argument("--out", default="results/sweep_scaling")
+    ap.add_argument("--add", action="store_true", help="add these runs to OUT/results.json")
     ap.add_argument("--child", nargs=5, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         spec, executor, workers, out, events = args.child
         child(spec, executor, int(workers), out, events)
         return
-    if 1 not in args.workers or "processes" not in args.executors:
-        ap.error("the speed-ups are relative to processes with 1 worker: include both")
-    configs = [(e, w) for w in sorted(args.workers) for e in args.executors]
+    out = Path(args.out)
+    workers = sorted(args.workers)
+    dask_w = set(workers if args.dask_workers is None else args.dask_workers)
+    raw_w = set(workers if args.raw_workers is None else args.raw_workers)
+    configs = [(e, w) for w in workers for e in args.executors if e == "processes" or w in dask_w]
     result: dict[str, Any] = {
         "machine": f"{os.cpu_count()} cores",
         "python": platform.python_version(),
         "argv": sys.argv[1:],
         "repeats": args.repeats,
-        "workers": sorted(args.workers),
+        "workers": workers,
         "specs": {},
     }
-    items = {s: episodes(s) for s in args.specs}
-    for s in args.specs:
-        result["specs"][Path(s).stem] = {
-            "runs": {f"{e}_{w}": [] for e, w in configs},
-            "raw": {str(w): [] for w in sorted(args.workers)},
-        }
+    if args.add and (out / "results.json").exists():
+        result = json.loads((out / "results.json").read_text())
+        result["argv"] = [*result["argv"], "+", *sys.argv[1:]]
+    out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
+        specs = {s: _with_seeds(s, args.seeds, Path(tmp)) for s in args.specs}
+        items = {s: episodes(specs[s]) for s in args.specs if raw_w}
+        for s in args.specs:
+            res = result["specs"].setdefault(Path(specs[s]).stem, {"runs": {}, "raw": {}})
+            for e, w in configs:
+                res["runs"].setdefault(f"{e}_{w}", [])
+            for w in raw_w:
+                res["raw"].setdefault(str(w), [])
         for r in range(args.repeats):
             for spec in args.specs:
-                res = result["specs"][Path(spec).stem]
+                res = result["specs"][Path(specs[spec]).stem]
                 for e, w in configs if r % 2 == 0 else configs[::-1]:
-                    run = run_sweep_once(spec, e, w, Path(tmp))
+                    run = run_sweep_once(specs[spec], e, w, Path(tmp))
                     res["runs"][f"{e}_{w}"].append(run)
                     print(
                         f"repeat {r + 1}/{args.repeats}, {Path(spec).stem}, {e}, {w} worker(s): "
-                        f"{run['wall']:.2f} s, CPU {run['cpu']:.2f} s, load {run['load_before']}",
+                        f"{run['wall']:.2f} s, CPU {run['cpu']:.2f} s, cells per worker "
+                        f"{run['cells_per_worker'][0]}-{run['cells_per_worker'][-1]}, idle while "
+                        f"cells waited {run['idle_while_waiting_s']:.2f} s, load "
+                        f"{run['load_before']}",
                         file=sys.stderr,
                     )
-                    if e == args.executors[0]:
+                    if e == "processes" and w in raw_w:
                         raw = run_raw_once(w, items[spec])
                         res["raw"][str(w)].append(raw)
                         print(f"  raw engine: {raw['wall']:.2f} s", file=sys.stderr)
+                    _write(result, out)
+    _write(result, out)
+    print((out / "summary.md").read_text())
+
+
+def _write(result: dict[str, Any], out: Path) -> None:
+    """Summarise ``result`` and write OUT/results.json and OUT/summary.md."""
     loads = [
         r["load_before"][0]
         for res in result["specs"].values()
         for runs in res["runs"].values()
         for r in runs
     ]
-    result["load_range"] = [min(loads), max(loads)]
+    result["load_range"] = [min(loads), max(loads)] if loads else [0.0, 0.0]
     summarise(result)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "sweep_scaling.json").write_text(json.dumps(result, indent=1) + "\n")
-    (out / "sweep_scaling.md").write_text(markdown(result))
-    print(markdown(result))
+    (out / "results.json").write_text(json.dumps(result, indent=1) + "\n")
+    (out / "summary.md").write_text(markdown(result))
 
 
 if __name__ == "__main__":
