@@ -27,8 +27,9 @@ time): the sweep's own serial phases (its process's CPU outside the cell loop), 
 overhead (start-up and the extra time of its first cell of each estimator) and the cells' work
 (their CPU, less those extras). Amdahl: the 1-worker run splits into serial phases + one
 worker's overhead + work; N workers need at least serial + the largest overhead among the N
-workers (measured in the N-worker run: each pays it at once) + work / N. And the schedule: serial
-+ the busiest worker's CPU (overhead and cells) in the N-worker run as it was measured.
+workers (each pays its own at once; measured in the N-worker run, or, where there was none, that
+of the estimators each worker runs in the placement replayed below) + work / N. The sweep
+process's own CPU in the cell loop, per cell, bounds how many cells per second it can take.
 
 Placement replayed: the executor's own placement (:class:`physbench.bench.placement.Pending`,
 at most ``QUEUED`` cells per worker) run on a simulated clock for 1..16 workers, each cell taking
@@ -129,6 +130,15 @@ def child(spec: str, executor: str, workers: int, out: str, events: str) -> None
     _timed(runner, "write_table", "write_table")
     _timed(summary, "write_summary", "write_summary")
     runner.run_cell = timed_run_cell  # type: ignore[assignment]
+    warm = runner._import_tables
+
+    def warm_timed() -> None:
+        try:
+            warm()
+        finally:
+            _EVENTS["import_tables_cpu"] = time.thread_time()
+
+    runner._import_tables = warm_timed
 
     put = store.CellWriter.put
 
@@ -289,7 +299,9 @@ def breakdown(ev: dict[str, Any], launched: float, ended: float, workers: int) -
     res["estimator_costs"] = estimator_costs(cells)
     res["cells"] = len(cells)
     res["estimators_cells"] = ev["estimators_cells"]  # in the spec's order
-    res["parent_loop_cpu_per_cell_ms"] = 1000 * loop_cpu / len(cells)
+    # the tables' imports run in a thread beside the loop, once: not a cost per cell
+    res["import_tables_cpu"] = ev.get("import_tables_cpu", 0.0)
+    res["parent_loop_cpu_per_cell_ms"] = 1000 * (loop_cpu - res["import_tables_cpu"]) / len(cells)
     return res
 
 
@@ -400,6 +412,10 @@ def replay(
         "estimators_per_worker": sorted(len(r) for r in ran.values()),
         "idle_while_waiting_s": round(sum(idle.values()), 3),
         "idle_while_waiting_max_s": round(max(idle.values()), 3),
+        # the largest start-up + imports of one worker, for the estimators it ran here
+        "overhead_max_s": round(
+            startup + max(sum(costs[e]["extra"] for e in r) for r in ran.values()), 3
+        ),
     }
 
 
@@ -471,6 +487,8 @@ PHASES = (
     ("cpu", "CPU, sweep process + workers", "{:.2f}"),
     ("parent_cpu", "CPU, sweep process", "{:.2f}"),
     ("parent_serial_cpu", "  of it outside the cell loop", "{:.2f}"),
+    ("import_tables_cpu", "  importing the tables' libraries (a thread beside the loop)", "{:.2f}"),
+    ("parent_loop_cpu_per_cell_ms", "  in the loop, the rest per cell, ms", "{:.2f}"),
     ("worker_startup_cpu_mean", "CPU of a worker's start-up, mean", "{:.2f}"),
     ("worker_startup_cpu_max", "  largest", "{:.2f}"),
     ("worker_first_cells_cpu_mean", "CPU of a worker's first cells' extra, mean", "{:.2f}"),
@@ -501,10 +519,15 @@ def predict(one: dict[str, Any], many: dict[str, Any], n: int) -> dict[str, Any]
     overhead_1 = one["worker_overhead_cpu_max"]
     work = one["cells_cpu"] - one["worker_first_cells_cpu_mean"]
     t1 = serial + overhead_1 + work
-    overhead_n = many["worker_overhead_cpu_max"]
-    amdahl = serial + overhead_n + work / n
     parent_loop = one["cells"] * many["parent_loop_cpu_per_cell_ms"] / 1000
     rep = replay(one["estimators_cells"], one["estimator_costs"], n, many["worker_startup_cpu_max"])
+    # measured with n workers if a run had as many; else the replay's: the estimators each of n
+    # workers would run, with their measured imports
+    if many["workers_used"] >= n:
+        overhead_n = many["worker_overhead_cpu_max"]
+    else:
+        overhead_n = rep["overhead_max_s"]
+    amdahl = serial + overhead_n + work / n
     return {
         "workers": n,
         "serial_cpu": round(serial, 3),
@@ -669,14 +692,15 @@ def _spec_markdown(name: str, res: dict[str, Any], result: dict[str, Any]) -> li
             "",
             f"What {n} cores would give, in CPU seconds (see the script's docstring): serial "
             f"phases of the sweep process {p['serial_cpu']:.2f}, one worker's overhead "
-            f"{p['overhead_1_cpu']:.2f} (the largest in the run with the most workers: "
-            f"{p['overhead_n_cpu']:.2f}), the cells' work {p['work_cpu']:.2f}; 1 worker "
+            f"{p['overhead_1_cpu']:.2f} (the largest of {n} workers': {p['overhead_n_cpu']:.2f}, "
+            "measured, or replayed where no run had as many), the cells' work "
+            f"{p['work_cpu']:.2f}; 1 worker "
             f"{p['t1_cpu']:.2f}. The sweep process's CPU in the cell loop: "
             f"{p['parent_loop_cpu']:.2f} for all cells.",
             "",
             f"| model | {n} workers s | speed-up |",
             "|---|---|---|",
-            f"| Amdahl: serial + largest worker overhead + work / {n} | "
+            f"| Amdahl: serial + the largest worker overhead + work / {n} | "
             f"{p['amdahl_s']:.2f} | {p['amdahl_ratio']:.2f} |",
             f"| Amdahl, serial phases only | | {p['serial_only_ratio']:.2f} |",
             f"| bound of one sweep process: serial + its cell-loop CPU | "

@@ -12,19 +12,20 @@
 # so a run cut short keeps what it measured.
 set -euo pipefail
 OUT=${OUT:-out/sweep_scaling}
+export SITE=${SITE:-/tmp/site}  # where the wheels are installed
 mkdir -p "$OUT"
 LOG="$OUT/log.txt"
 exec > >(tee -a "$LOG") 2>&1
 export PYTHONUNBUFFERED=1
 echo "nproc: $(nproc); $(python3 --version); $(date -u +%FT%TZ)"
 python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade \
-    --target /tmp/site .whl/*.whl
+    --target "$SITE" .whl/*.whl
 # physbench's own components register through entry points: give the source tree a dist-info.
 python3 - <<'EOF'
-import pathlib, re, tomllib
+import os, pathlib, re, tomllib
 meta = tomllib.loads(pathlib.Path("pyproject.toml").read_text())["project"]
 version = re.search(r'__version__ = "(.+)"', pathlib.Path("physbench/__init__.py").read_text())[1]
-d = pathlib.Path(f"/tmp/site/physbench-{version}.dist-info")
+d = pathlib.Path(os.environ["SITE"]) / f"physbench-{version}.dist-info"
 d.mkdir(exist_ok=True)
 (d / "METADATA").write_text(f"Metadata-Version: 2.1\nName: physbench\nVersion: {version}\n")
 eps = meta["entry-points"]["physbench"]
@@ -33,7 +34,7 @@ eps = meta["entry-points"]["physbench"]
     + "\n[console_scripts]\nphysbench = physbench.__main__:main\n"
 )
 EOF
-export PYTHONPATH="$PWD:/tmp/site"
+export PYTHONPATH="$PWD:$SITE"
 python3 -c "import physbench, pymunk, pyarrow, nevergrad, hyperopt, optuna, distributed; print('imports ok')"
 W=${WORKERS:-1 2 4 8 16}
 D=${DASK_WORKERS:-16}
