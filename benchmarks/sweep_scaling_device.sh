@@ -49,3 +49,4 @@ if (( SECONDS - S < 200 )) && [[ -z "${DASK_WORKERS:-}" ]]; then
         --executors dask --raw-workers --add --out "$OUT" || echo "stopped: $?"
 fi
 echo "done in $((SECONDS - S)) s"
+sleep 1  # let tee write the log out
