@@ -8,8 +8,9 @@ instead, so what those handlers do (logging's flush, multiprocessing joining its
 temporary folders' finalizers) still happens; only the freeing is skipped, which the operating
 system does at once.
 
-Only processes physbench owns from start to end use it: the ``physbench`` script and the
-``processes`` executor's workers, never an interpreter that imported physbench as a library.
+Only processes physbench owns from start to end use it: the ``physbench`` script, the
+``processes`` executor's workers and the workers of the Dask LocalCluster it starts, never an
+interpreter that imported physbench as a library, nor the workers of a cluster at ``--address``.
 """
 
 from __future__ import annotations

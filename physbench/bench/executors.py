@@ -352,16 +352,57 @@ LOCAL_DASK_CONFIG = {
 }
 
 
+#: Cells one Dask task runs at most. Each task costs this process ~4 ms of CPU (the client's
+#: messages and the LocalCluster's scheduler, beside physbench's own ~2 ms per cell): alone, a
+#: 2-worker LocalCluster of trivial cells ran 5x slower than local processes. A task of several
+#: cells shares that cost; tasks shrink to one cell towards the end of a sweep
+#: (:func:`chunk_size`), so that no worker waits behind another's chunk.
+CHUNK = 4
+#: A chunk is at most this fraction of what is left per worker thread.
+CHUNK_SHARE = 8
+
+
+def chunk_size(left: int, threads: int) -> int:
+    """Cells per Dask task while ``left`` cells wait for ``threads`` worker threads."""
+    return max(1, min(CHUNK, left // (CHUNK_SHARE * max(threads, 1))))
+
+
+def timed_calls(fn: Callable[[T], R], items: list[T], own: bool) -> list[tuple[float, R]]:
+    """:func:`timed_call` for each of ``items`` (one Dask task); ``own``: the worker is one of
+    physbench's own LocalCluster, whose process then ends without the interpreter's teardown
+    (as the ``processes`` executor's do, :func:`start_worker`): closing a 2-worker LocalCluster
+    took 1.2-1.7 s, 0.1 s this way."""
+    if own and not _ENDS_EARLY:
+        from physbench.teardown import skip_at_exit
+
+        skip_at_exit(lambda: 0)
+        _ENDS_EARLY.append(True)
+    return [timed_call(fn, item) for item in items]
+
+
+#: Set in a worker process once :func:`timed_calls` made it end without teardown.
+_ENDS_EARLY: list[bool] = []
+
+
+#: Seconds between two looks at a Dask cluster's workers. Each look is a round trip to the
+#: scheduler; made for every finished cell (with every worker's details, as before), it cost this
+#: process ~8 ms of CPU per cell and capped a 2-worker LocalCluster at 27 cells/s. Workers that
+#: join are given cells within this time; a cell handed to one that left is run elsewhere by
+#: the scheduler (a loose restriction).
+LOOK_EVERY = 1.0
+
+
 class DaskExecutor:
     """A Dask ``distributed`` cluster: the scheduler at ``address`` (``tcp://host:8786``), or a
     LocalCluster of ``workers`` single-threaded worker processes when no address is given
     (started with :data:`LOCAL_DASK_CONFIG`).
 
-    Cells are handed out as by :class:`ProcessExecutor`: at most :data:`QUEUED` per worker
-    thread at a time, each to a worker chosen by ``affinity`` (:class:`~.placement.Pending`), as
-    a loose restriction (``workers=[address], allow_other_workers=True``: if that worker leaves, the
-    scheduler runs the cell elsewhere). Workers that join a remote cluster later get cells from
-    then on.
+    Cells are handed out as by :class:`ProcessExecutor`: at most :data:`QUEUED` tasks per worker
+    thread at a time, each of up to :data:`CHUNK` cells (:func:`chunk_size`), to a worker chosen
+    by ``affinity`` (:class:`~.placement.Pending`), as a loose restriction
+    (``workers=[address], allow_other_workers=True``: if that worker leaves, the scheduler runs
+    the task elsewhere). Workers that join a remote cluster get cells within
+    :data:`LOOK_EVERY` seconds.
 
     A cell whose worker dies is run again once, alone on the cluster after the other cells, then
     given to ``died``. A LocalCluster's scheduler gives up on a cell at its first dead worker
@@ -379,6 +420,8 @@ class DaskExecutor:
         self._client: Any = None
         self._cluster: Any = None
         self._seen: set[str] = set()  # the workers cells were last handed to
+        self._nthreads: dict[str, int] = {}  # the scheduler's answer at self._asked
+        self._asked = -float("inf")
 
     def __enter__(self) -> DaskExecutor:
         import logging
@@ -393,7 +436,7 @@ class DaskExecutor:
         try:
             if self.address:
                 self._client = Client(self.address, timeout="20s")
-                self.workers = max(1, sum(self._threads().values()))
+                self.workers = max(1, sum(self._threads(fresh=True).values()))
             else:
                 with dask.config.set(LOCAL_DASK_CONFIG):
                     self._cluster = LocalCluster(
@@ -421,10 +464,14 @@ class DaskExecutor:
             self._cluster.close()
         self._client = self._cluster = None
 
-    def _threads(self) -> dict[str, int]:
-        """Each worker's address and threads, as the scheduler last told this client."""
-        workers = self._client.scheduler_info()["workers"]
-        return {addr: int(info.get("nthreads", 1)) for addr, info in workers.items()}
+    def _threads(self, *, fresh: bool = False) -> dict[str, int]:
+        """Each worker's address and threads: asked of the scheduler at most every
+        :data:`LOOK_EVERY` seconds, or now with ``fresh``."""
+        now = time.monotonic()
+        if fresh or now - self._asked >= LOOK_EVERY:
+            self._nthreads = {a: int(n) for a, n in self._client.nthreads().items()}
+            self._asked = now
+        return self._nthreads
 
     def map_unordered(
         self,
@@ -436,22 +483,24 @@ class DaskExecutor:
         from distributed import KilledWorker, as_completed
 
         pending = Pending(items, affinity)
-        running: dict[str, tuple[Any, T, str]] = {}  # future key -> (future, item, worker)
+        running: dict[str, tuple[Any, list[T], str]] = {}  # future key -> (future, items, worker)
         finished = as_completed()
         suspects: list[T] = []
         try:
             self._refill(fn, pending, running, finished)
             for fut in finished:
-                _, item, addr = running.pop(fut.key)
+                _, chunk, addr = running.pop(fut.key)
                 try:
-                    seconds, result = self._result(fut)
+                    results = self._result(fut)
                 except KilledWorker:  # maybe only queued on the worker another cell killed
-                    suspects.append(item)
+                    suspects += chunk
                     self._refill(fn, pending, running, finished)
                     continue
-                pending.done(addr, item, seconds)
+                for item, (seconds, _) in zip(chunk, results, strict=True):
+                    pending.done(addr, item, seconds)
                 self._refill(fn, pending, running, finished)
-                yield item, result
+                for item, (_, result) in zip(chunk, results, strict=True):
+                    yield item, result
             yield from self._alone(fn, suspects, died, running)
         finally:
             self._client.cancel([f for f, _, _ in running.values()])
@@ -460,13 +509,13 @@ class DaskExecutor:
         self,
         fn: Callable[[T], R],
         pending: Pending[T],
-        running: dict[str, tuple[Any, T, str]],
+        running: dict[str, tuple[Any, list[T], str]],
         finished: Any,
     ) -> None:
         """Hand each worker items from ``pending`` as :class:`ProcessExecutor` does, :data:`QUEUED`
-        per thread; with none in flight and no worker (a LocalCluster's nanny restarting the
-        only one), wait for one."""
-        if pending and not running and not self._threads():
+        tasks per thread, each of up to :func:`chunk_size` items; with none in flight and no
+        worker (a LocalCluster's nanny restarting the only one), wait for one."""
+        if pending and not running and not self._threads(fresh=True):
             try:
                 self._client.wait_for_workers(1, timeout=60)
             except TimeoutError:
@@ -482,36 +531,51 @@ class DaskExecutor:
         for _, _, addr in running.values():
             held[addr] = held.get(addr, 0) + 1
         force = not running
+        total = sum(threads.values())
+        own = self._cluster is not None
         for addr, n in threads.items():
-            limit = n * (QUEUED if len(pending) >= sum(threads.values()) else 1)
+            limit = n * (QUEUED if len(pending) >= total else 1)
             while pending and held.get(addr, 0) < limit:
-                item = pending.take(addr, force=force)
-                if item is None:
+                chunk: list[T] = []
+                size = chunk_size(len(pending), total)
+                while pending and len(chunk) < size:
+                    item = pending.take(addr, force=force)
+                    if item is None:
+                        break
+                    chunk.append(item)
+                    force = False
+                if not chunk:
                     break
                 fut = self._client.submit(
-                    timed_call, fn, item, pure=False, workers=[addr], allow_other_workers=True
+                    timed_calls,
+                    fn,
+                    chunk,
+                    own,
+                    pure=False,
+                    workers=[addr],
+                    allow_other_workers=True,
                 )
-                running[fut.key] = (fut, item, addr)
+                running[fut.key] = (fut, chunk, addr)
                 held[addr] = held.get(addr, 0) + 1
                 finished.add(fut)
-                force = False
 
     def _alone(
         self,
         fn: Callable[[T], R],
         suspects: list[T],
         died: Callable[[T, str], R],
-        running: dict[str, tuple[Any, T, str]],
+        running: dict[str, tuple[Any, list[T], str]],
     ) -> Iterator[tuple[T, R]]:
         """Run each suspect again, one at a time, so that if it kills its worker again it takes
         no other cell along; yield its result or ``died``'s."""
         from distributed import KilledWorker
 
         for item in suspects:
-            fut = self._client.submit(timed_call, fn, item, pure=False)
-            running[fut.key] = (fut, item, "")
+            own = self._cluster is not None
+            fut = self._client.submit(timed_calls, fn, [item], own, pure=False)
+            running[fut.key] = (fut, [item], "")
             try:
-                _, result = self._result(fut)
+                [(_, result)] = self._result(fut)
             except KilledWorker:
                 result = died(
                     item,

@@ -17,11 +17,13 @@ from types import ModuleType
 import pytest
 
 from physbench.bench.executors import (
+    CHUNK,
     NAMES,
     QUEUED,
     DaskExecutor,
     ProcessExecutor,
     SerialExecutor,
+    chunk_size,
     default_workers,
     make_executor,
 )
@@ -169,6 +171,45 @@ def test_a_worker_joins_a_started_group_only_while_that_pays() -> None:
 def test_without_affinity_items_go_in_the_callers_order() -> None:
     pending = Pending(ITEMS, None)
     assert [pending.take(i % 3) for i in range(len(ITEMS))] == ITEMS
+
+
+def test_dask_tasks_hold_several_cells_until_the_end_of_a_sweep_nears() -> None:
+    # 960 cells on 16 worker threads: CHUNK cells a task, so that the client's and the
+    # scheduler's cost per task is shared
+    assert chunk_size(960, 16) == CHUNK
+    # fewer left: smaller tasks, then one cell each, so that no worker waits behind a chunk
+    assert chunk_size(200, 16) == 1
+    assert [chunk_size(n, 2) for n in (64, 48, 32, 16, 15, 1, 0)] == [4, 3, 2, 1, 1, 1, 1]
+
+
+def test_dask_looks_at_its_workers_once_a_second_not_for_every_cell() -> None:
+    class Client:
+        asked = 0
+
+        def nthreads(self) -> dict[str, int]:
+            Client.asked += 1
+            return {"tcp://w1": 1, "tcp://w2": 1}
+
+    ex = DaskExecutor(workers=2)
+    ex._client = Client()
+    for _ in range(50):
+        assert ex._threads() == {"tcp://w1": 1, "tcp://w2": 1}
+    assert Client.asked == 1
+    ex._threads(fresh=True)  # e.g. when no cell is in flight
+    assert Client.asked == 2
+
+
+def test_dask_chunks_give_every_item_once(
+    tmp_path: Path, plugin: Callable[..., ModuleType], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pytest.importorskip("distributed")
+    monkeypatch.setenv("PB_GO_FILE", str(tmp_path / "go"))
+    stamping = plugin("pb_stamping", STAMPING)
+    items = [f"{g}{i}" for i in range(40) for g in "ab"]  # chunks of 4, then fewer
+    with make_executor("dask", workers=2) as ex:
+        got = list(ex.map_unordered(stamping.pid_of, items, _never, _group))
+    assert sorted(item for item, _ in got) == sorted(items)
+    assert len({pid for _, pid in got}) == 2
 
 
 @pytest.mark.parametrize("executor", ["processes", "dask"])
