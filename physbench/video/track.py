@@ -1142,16 +1142,22 @@ def track_frames(
     median: bool = False,
     allow_gaps: bool = False,
     progress: bool = False,
+    transfer: str = "linear",
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
-    the clip's median). A body lost in more than :data:`~physbench.video.outcome.LOST_SHARE` of
-    the frames where it was in view raises :class:`TrackLostError` unless ``allow_gaps``."""
+    the clip's median), both decoded to linear light from ``transfer``
+    (:mod:`~physbench.video.transfer`). A body lost in more than
+    :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view raises
+    :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
-    tracker = Tracker(scene, calibration, background, median=median)
+    from physbench.video.transfer import Decoder
+
+    linear = Decoder(transfer)
+    tracker = Tracker(scene, calibration, linear(background), median=median)
     tic = _time.perf_counter()
     for fr in frames:
-        tracker.update(fr.image, fr.time)
+        tracker.update(linear(fr.image), fr.time)
         if progress and tracker.frames % 100 == 0:
             print(f"\r  {tracker.frames} frames", end="", file=sys.stderr, flush=True)
     if progress:
@@ -1185,6 +1191,7 @@ def track_video(
     background: np.ndarray | str | Path | None = None,
     allow_gaps: bool = False,
     progress: bool = False,
+    transfer: str | None = None,
 ) -> TrackResult:
     """Track ``scene``'s bodies through the video at ``path`` (see the module docstring).
 
@@ -1194,14 +1201,18 @@ def track_video(
     ``background``: an image of the empty scene (array or file; default: the median of the
     clip, which costs a second pass over the video); ``allow_gaps``: keep a body lost for more
     than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view (else
-    :class:`TrackLostError`)."""
+    :class:`TrackLostError`); ``transfer``: the video's transfer function, a name or ``"auto"``
+    (default: the video's tag, else :data:`~physbench.video.transfer.DEFAULT`; see
+    :func:`~physbench.video.transfer.resolve`)."""
     from physbench.video.background import load_plate, median_background
     from physbench.video.reader import VideoError, VideoReader
+    from physbench.video.transfer import resolve
 
     try:
         # A folder of images has no timestamps: its frames come at the scene's rate.
         reader = VideoReader(path, start=start, end=end, fps=scene.fps)
         info = reader.info()
+        curve, _ = resolve(transfer, info.transfer)
         if calibration is None:
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
@@ -1229,6 +1240,7 @@ def track_video(
             median=median,
             allow_gaps=allow_gaps,
             progress=progress,
+            transfer=curve,
         )
     except VideoError as exc:
         raise TrackError(str(exc)) from None
