@@ -38,9 +38,10 @@ TAGS = {
 }
 #: The code each transfer is tagged with when written.
 CODES = {"bt709": 1, "gamma2.2": 4, "gamma2.8": 5, "linear": 8, "srgb": 13}
-#: The transfer of a video with no tag: physbench's clips before they were tagged were linear
-#: and a wrong guess there moves a ball's centre little, while footage from phones and cameras
-#: comes tagged (see docs/video.md, "Transfer functions").
+#: The transfer of a video with no tag. A wrong guess costs alike both ways (an arm's centre: a
+#: linear clip read as sRGB 3.0 px off instead of 0.3; a gamma clip read as linear 5.1 px instead
+#: of 2.6), physbench's clips from before the tags are untagged and linear, and phones tag
+#: their video; untagged footage from a real camera needs ``--transfer srgb`` (docs/video.md).
 DEFAULT = "linear"
 
 
