@@ -67,6 +67,7 @@ from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import Light, LightMeter, plate_index
 from physbench.video.silhouette import DiscFit, Edges, Rays, edge_points, fit_disc, fit_discs
+from physbench.video.transfer import Decoder
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -236,7 +237,8 @@ class TrackResult:
 class Tracker:
     """Frame-by-frame tracking of ``scene``'s bodies against ``background`` (see the module
     docstring). Call :meth:`update` with each frame in order, then :meth:`result`. ``median``:
-    the background is the median of the clip (a first-frame failure says what that implies)."""
+    the background is the median of the clip (a first-frame failure says what that implies);
+    ``transfer``: how the pixel values encode light (:mod:`~physbench.video.transfer`)."""
 
     def __init__(
         self,
@@ -245,8 +247,10 @@ class Tracker:
         background: np.ndarray,
         *,
         median: bool = False,
+        transfer: str = "linear",
     ) -> None:
         self.scene, self.cal, self.bg = scene, calibration, background
+        self.linear = Decoder(transfer)  # pixel values to linear light, for the unmixing
         self.bg_index = plate_index(background)  # once: each window's difference reads it
         self.h, self.w = background.shape[:2]
         self.g = np.asarray(scene.gravity, dtype=float)
@@ -574,10 +578,11 @@ class Tracker:
         A body that turns is weighed by the share of the exposure each pixel saw it
         (:func:`_alpha`): a turning body's motion blur is lopsided (its far end sweeps more), and
         only that weight keeps its centre at the exposure's middle (a swinging arm: 1 cm off with
-        the coverage)."""
+        the coverage). The unmixing is in linear light (:attr:`linear`)."""
         if not self.states[i].k:
             return coverage
-        return _alpha(colour, behind * self.light.gain + self.light.offset, diff)
+        behind = behind * self.light.gain + self.light.offset
+        return _alpha(self.linear(colour), self.linear(behind), diff)
 
     def _outline(self, i: int) -> Outline:
         """Body ``i``'s outline in the image at its prediction (px, about the predicted pixel):
@@ -1145,19 +1150,16 @@ def track_frames(
     transfer: str = "linear",
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
-    the clip's median), both decoded to linear light from ``transfer``
+    the clip's median), whose pixel values encode light by ``transfer``
     (:mod:`~physbench.video.transfer`). A body lost in more than
     :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view raises
     :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
-    from physbench.video.transfer import Decoder
-
-    linear = Decoder(transfer)
-    tracker = Tracker(scene, calibration, linear(background), median=median)
+    tracker = Tracker(scene, calibration, background, median=median, transfer=transfer)
     tic = _time.perf_counter()
     for fr in frames:
-        tracker.update(linear(fr.image), fr.time)
+        tracker.update(fr.image, fr.time)
         if progress and tracker.frames % 100 == 0:
             print(f"\r  {tracker.frames} frames", end="", file=sys.stderr, flush=True)
     if progress:
