@@ -63,7 +63,8 @@ class RunConfig:
     ``params`` may name by key (``linear_drag.c``) besides gravity and the camera's
     (:func:`~physbench.unknowns.scene_parameters`); ``allow_gaps``: keep a video's
     tracks where a body was lost for more than the tracker's share of the clip (else that is an
-    error)."""
+    error); ``transfer``: how the video's pixels encode light (``None``: its tag, else the
+    default; :mod:`physbench.video.transfer`)."""
 
     scene: str | None = DEFAULT_SCENE
     params: tuple[str, ...] = ("mass",)
@@ -90,6 +91,7 @@ class RunConfig:
     video_end: float | None = None
     effects: tuple[str, ...] = ()
     allow_gaps: bool = False
+    transfer: str | None = None
     #: Posterior draws the posterior predictive check simulates after the loop, for an
     #: estimator that returns a posterior (:mod:`physbench.posterior.predictive`; 0: no check).
     predictive_draws: int = PREDICTIVE_DRAWS
@@ -169,6 +171,7 @@ _LATER = (
     "video_end",
     "effects",
     "allow_gaps",
+    "transfer",
     "restart",
 )
 #: Settings added later with a default that is not empty: omitted while at that default.
@@ -200,6 +203,7 @@ def _check_observation(config: RunConfig) -> None:
         "--start": config.video_start,
         "--end": config.video_end,
         "--allow-gaps": config.allow_gaps or None,
+        "--transfer": config.transfer,
     }
     if config.observer_options and not config.observer:
         raise PhysbenchError(
@@ -209,6 +213,10 @@ def _check_observation(config: RunConfig) -> None:
     stray = [k for k, v in video_only.items() if v is not None]
     if stray and not config.video:
         raise PhysbenchError(f"{', '.join(stray)} apply to a --video only; no --video was given")
+    if config.transfer is not None:
+        from physbench.video.transfer import check_transfer
+
+        check_transfer(config.transfer)
     if (config.video or config.observer) and config.render_mode not in ("mark", "instance", "mask"):
         raise PhysbenchError(
             f"render mode {config.render_mode!r}: frames segmented from a video come as masks "
@@ -387,6 +395,7 @@ def make_observation(
             end=config.video_end,
             marked=marked,
             allow_gaps=config.allow_gaps,
+            transfer=config.transfer,
         )
     simulator = create("simulator", config.observer_engine)
     if config.observer:

@@ -339,8 +339,10 @@ def make_renderer_from(args: argparse.Namespace) -> Any:
 
 def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
     """The flags that say how to read a camera's video: ``--calibration``, ``--background``,
-    ``--start``, ``--end``, ``--allow-gaps`` (the same in ``track``, ``run --video`` and
-    ``discover VIDEO``)."""
+    ``--start``, ``--end``, ``--allow-gaps``, ``--transfer`` (the same in ``track``, ``run --video``
+    and ``discover VIDEO``)."""
+    from physbench.video.transfer import AUTO, DEFAULT, TRANSFERS
+
     group.add_argument(
         "--calibration",
         default=None,
@@ -372,4 +374,11 @@ def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
         action="store_true",
         help="keep the tracks of a body lost in more than a tenth of the frames where it was in "
         "view (default: that is an error, which says from when to when it was lost)",
+    )
+    group.add_argument(
+        "--transfer",
+        choices=(AUTO, *TRANSFERS),
+        default=None,
+        help="how the video's pixel values encode light, decoded to linear light before "
+        f"tracking (default {AUTO}: the video's tag, else {DEFAULT}; phones tag bt709)",
     )

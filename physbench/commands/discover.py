@@ -240,6 +240,7 @@ def _runs(args: argparse.Namespace) -> list[Any]:
         track_out=args.track_out,
         allow_gaps=args.allow_gaps,
         progress=show_progress(args),
+        transfer=args.transfer,
     )
     if args.track_out:
         wrote(args.track_out, args)

@@ -315,6 +315,7 @@ def _build_config(args: argparse.Namespace) -> Any:
         video_end=args.end,
         effects=tuple(args.effect),
         allow_gaps=args.allow_gaps,
+        transfer=args.transfer,
     )
     check_config(config)  # a bad name or option: fail before the progress bar appears
     return config

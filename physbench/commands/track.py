@@ -76,6 +76,7 @@ def main(args: argparse.Namespace) -> int:
             background=args.background,
             allow_gaps=args.allow_gaps,
             progress=show_progress(args),
+            transfer=args.transfer,
         )
     except TrackLostError as exc:
         # A failure: no recording; the summary and a preview, if asked, show what was lost.

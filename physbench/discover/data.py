@@ -97,14 +97,16 @@ def load_runs(
     track_out: str | Path | None = None,
     allow_gaps: bool = False,
     progress: bool = False,
+    transfer: str | None = None,
 ) -> list[Run]:
     """Runs from a recording file (``.csv``: tracked trajectories, one run per ``run`` label;
     ``.npz``: observed frames under key ``frames``; ``.trz``/``.trk``: the hand-marked points of a
     Tracker project, :mod:`physbench.tracker_files`; a video file or a folder of images: tracked
     first, see :func:`~physbench.video.track.track_video`) and a scene (object or ``.toml`` file)
     that every run shares. ``run`` keeps one run of a multi-run CSV. ``calibration``,
-    ``background``, ``start``, ``end`` and ``allow_gaps`` apply to a video only (a body lost in
-    more than the tracker's share of its frames is an error unless ``allow_gaps``);
+    ``background``, ``start``, ``end``, ``allow_gaps`` and ``transfer`` apply to a video only (a
+    body lost in more than the tracker's share of its frames is an error unless ``allow_gaps``;
+    ``transfer``: how its pixels encode light, :func:`~physbench.video.track.track_video`);
     ``track_out`` writes its tracks as a recording CSV."""
     from physbench.scene_toml import load_scene
     from physbench.video.reader import VIDEO_SUFFIXES, is_video
@@ -125,6 +127,7 @@ def load_runs(
         "end": end,
         "track_out": track_out,
         "allow_gaps": allow_gaps or None,
+        "transfer": transfer,
     }
     stray_given = [k for k, v in stray.items() if v is not None]
     if stray_given and not video:
@@ -144,6 +147,7 @@ def load_runs(
                 track_out,
                 allow_gaps=allow_gaps,
                 progress=progress,
+                transfer=transfer,
             )
         ]
     suffix = path.suffix.lower()
@@ -201,6 +205,7 @@ def _video_run(
     *,
     allow_gaps: bool,
     progress: bool,
+    transfer: str | None = None,
 ) -> Run:
     """Track the scene's bodies through a video into one run; the summary goes to stderr."""
     import sys
@@ -219,6 +224,7 @@ def _video_run(
         background=background,
         allow_gaps=allow_gaps,
         progress=progress,
+        transfer=transfer,
     )
     if progress:
         print(tracked.summary.format(), file=sys.stderr)

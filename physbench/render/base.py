@@ -140,6 +140,10 @@ class Camera(Renderer):
     #: ``None``: none). Set by the subclass from its options; the writer reads them.
     bitrate: float = 0.0
     crf: int | None = None
+    #: The transfer function of the footage's pixel values (a name of
+    #: :data:`physbench.video.transfer.TRANSFERS`), which the writer tags the video with so that
+    #: the tracker decodes it to linear light. Default: linear (pixels proportional to light).
+    transfer: str = "linear"
 
     def exposure(self, scene: Scene, traj: Trajectory) -> np.ndarray:
         """Called to film ``traj``: the frames the sensor records, before any encoding, ``(T, H,

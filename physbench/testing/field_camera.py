@@ -478,6 +478,7 @@ class FieldCamera(Camera):
         self.domain = replace(Domain.draw(self.seed), **pins)
         self.domain.check()
         self.crf = int(self.domain.crf)
+        self.transfer = "linear" if GAMMA == 1 else f"gamma{GAMMA:g}"  # the writer's tag
         self._cache: dict[Any, tuple[_Geometry, np.ndarray, np.ndarray]] = {}
 
     def __getstate__(self) -> dict[str, Any]:

@@ -92,12 +92,15 @@ def video_observation(
     end: float | None = None,
     marked: Iterable[str] = (),
     allow_gaps: bool = False,
+    transfer: str | None = None,
 ) -> Observation:
     """The observation of a video file in ``renderer``'s frames (see the module docstring).
     ``calibration``: a :class:`~physbench.calibration.Calibration` or a TOML file (default:
     ``scene.bounds`` fill the frame); ``background``: an image of the empty scene (array or file;
     default: the video's median); ``allow_gaps``: keep tracks where a body was lost for more
-    than the tracker's share of the clip (else :class:`~physbench.video.track.TrackLostError`)."""
+    than the tracker's share of the clip (else :class:`~physbench.video.track.TrackLostError`);
+    ``transfer``: how the video's pixels encode light
+    (:func:`~physbench.video.track.track_video`)."""
     from physbench.calibration import load_calibration
     from physbench.observation import Observation
     from physbench.video.background import load_plate, median_background
@@ -122,6 +125,7 @@ def video_observation(
         end=end,
         background=background,
         allow_gaps=allow_gaps,
+        transfer=transfer,
     )
     recording = tracked.recording
     if background is None:

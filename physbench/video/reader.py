@@ -22,6 +22,7 @@ import numpy as np
 
 from physbench.codec import load_av
 from physbench.errors import PhysbenchError
+from physbench.video.transfer import from_tag
 
 #: Image files a folder may hold, as frames.
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
@@ -53,7 +54,8 @@ class Frame:
 @dataclass(frozen=True)
 class VideoInfo:
     """What the container says: size, the average frame rate, the frame count and duration when
-    it knows them (``None`` otherwise), and the codec."""
+    it knows them (``None`` otherwise), the codec, and the transfer function the stream is tagged
+    with (:mod:`~physbench.video.transfer`; ``None``: untagged, or a folder of images)."""
 
     width: int
     height: int
@@ -61,6 +63,7 @@ class VideoInfo:
     frames: int | None
     duration: float | None
     codec: str
+    transfer: str | None = None
 
 
 def _number(name: str, value: float | None, *, low: float = 0.0) -> float | None:
@@ -139,6 +142,7 @@ class VideoReader:
                 frames,
                 duration,
                 stream.codec_context.name,
+                from_tag(getattr(stream.codec_context, "color_trc", None)),
             )
 
     # ----------------------------------------------------------------- frames

@@ -81,6 +81,7 @@ from physbench.video.silhouette import (
     fit_discs,
     window_edges,
 )
+from physbench.video.transfer import Decoder
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -258,7 +259,8 @@ class TrackResult:
 class Tracker:
     """Frame-by-frame tracking of ``scene``'s bodies against ``background`` (see the module
     docstring). Call :meth:`update` with each frame in order, then :meth:`result`. ``median``:
-    the background is the median of the clip (a first-frame failure says what that implies)."""
+    the background is the median of the clip (a first-frame failure says what that implies);
+    ``transfer``: how the pixel values encode light (:mod:`~physbench.video.transfer`)."""
 
     def __init__(
         self,
@@ -267,8 +269,10 @@ class Tracker:
         background: np.ndarray,
         *,
         median: bool = False,
+        transfer: str = "linear",
     ) -> None:
         self.scene, self.cal, self.bg = scene, calibration, background
+        self.linear = Decoder(transfer)  # pixel values to linear light, for the unmixing
         self.bg_index = plate_index(background)  # once: each window's difference reads it
         self.h, self.w = background.shape[:2]
         self.g = np.asarray(scene.gravity, dtype=float)
@@ -599,10 +603,11 @@ class Tracker:
         A body that turns is weighed by the share of the exposure each pixel saw it
         (:func:`_alpha`): a turning body's motion blur is lopsided (its far end sweeps more), and
         only that weight keeps its centre at the exposure's middle (a swinging arm: 1 cm off with
-        the coverage)."""
+        the coverage). The unmixing is in linear light (:attr:`linear`)."""
         if not self.states[i].k:
             return coverage
-        return _alpha(colour, behind * self.light.gain + self.light.offset, diff)
+        behind = behind * self.light.gain + self.light.offset
+        return _alpha(self.linear(colour), self.linear(behind), diff)
 
     def _outline(self, i: int) -> Outline:
         """Body ``i``'s outline in the image at its prediction (px, about the predicted pixel):
@@ -1167,13 +1172,16 @@ def track_frames(
     median: bool = False,
     allow_gaps: bool = False,
     progress: bool = False,
+    transfer: str = "linear",
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
-    the clip's median). A body lost in more than :data:`~physbench.video.outcome.LOST_SHARE` of
-    the frames where it was in view raises :class:`TrackLostError` unless ``allow_gaps``."""
+    the clip's median), whose pixel values encode light by ``transfer``
+    (:mod:`~physbench.video.transfer`). A body lost in more than
+    :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view raises
+    :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
-    tracker = Tracker(scene, calibration, background, median=median)
+    tracker = Tracker(scene, calibration, background, median=median, transfer=transfer)
     tic = _time.perf_counter()
     for fr in frames:
         tracker.update(fr.image, fr.time)
@@ -1211,6 +1219,7 @@ def track_video(
     background: np.ndarray | str | Path | None = None,
     allow_gaps: bool = False,
     progress: bool = False,
+    transfer: str | None = None,
 ) -> TrackResult:
     """Track ``scene``'s bodies through the video at ``path`` (see the module docstring).
 
@@ -1220,14 +1229,18 @@ def track_video(
     ``background``: an image of the empty scene (array or file; default: the median of the
     clip, which costs a second pass over the video); ``allow_gaps``: keep a body lost for more
     than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view (else
-    :class:`TrackLostError`)."""
+    :class:`TrackLostError`); ``transfer``: the video's transfer function, a name or ``"auto"``
+    (default: the video's tag, else :data:`~physbench.video.transfer.DEFAULT`; see
+    :func:`~physbench.video.transfer.resolve`)."""
     from physbench.video.background import load_plate, median_background
     from physbench.video.reader import VideoError, VideoReader
+    from physbench.video.transfer import resolve
 
     try:
         # A folder of images has no timestamps: its frames come at the scene's rate.
         reader = VideoReader(path, start=start, end=end, fps=scene.fps)
         info = reader.info()
+        curve, _ = resolve(transfer, info.transfer)
         if calibration is None:
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
@@ -1255,6 +1268,7 @@ def track_video(
             median=median,
             allow_gaps=allow_gaps,
             progress=progress,
+            transfer=curve,
         )
     except VideoError as exc:
         raise TrackError(str(exc)) from None

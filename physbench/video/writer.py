@@ -14,6 +14,7 @@ import numpy as np
 
 from physbench.codec import even, load_av
 from physbench.video.reader import VideoError
+from physbench.video.transfer import CODES, check_transfer
 
 if TYPE_CHECKING:
     from physbench.render.base import Camera
@@ -33,14 +34,18 @@ def write_video(
     codec: str = "libx264",
     bitrate: int | None = None,
     crf: int | None = None,
+    transfer: str | None = None,
 ) -> Path:
     """Encode ``frames`` (each ``(H, W, 3)`` uint8 RGB, H and W even for H.264) into ``path``.
 
     ``fps`` is the nominal rate; ``times`` (s, increasing), when given, become the frames'
     timestamps, so a variable frame rate or dropped frames are recorded as such. ``bitrate``
-    (bits/s) or ``crf`` (H.264 quality, 0-51) sets the compression. Returns the path.
+    (bits/s) or ``crf`` (H.264 quality, 0-51) sets the compression. ``transfer``: the transfer
+    function the frames are in (:mod:`~physbench.video.transfer`), tagged in the stream (``None``:
+    untagged). Returns the path.
     """
     av = load_av()
+    code = None if transfer is None else CODES[check_transfer(transfer, auto=False)]
     if not (isinstance(fps, int | float) and math.isfinite(fps) and fps > 0):
         raise VideoError(f"fps = {fps!r}: expected a number > 0")
     if times is not None and (np.diff(np.asarray(times, dtype=float)) <= 0).any():
@@ -56,6 +61,8 @@ def write_video(
             stream.bit_rate = int(bitrate)
         if crf is not None:
             stream.options = {"crf": str(int(crf))}
+        if code is not None:
+            stream.codec_context.color_trc = code
         n = 0
         for i, image in enumerate(frames):
             img = np.ascontiguousarray(image, dtype=np.uint8)
@@ -88,8 +95,8 @@ VIDEO_CODECS = {".webm": "libvpx-vp9"}
 def write_clip(camera: Camera, path: str | Path, scene: Scene, traj: Trajectory) -> Path:
     """Film ``traj`` with ``camera`` and encode the clip to ``path``, each frame at its trajectory
     time: H.264 (VP9 for ``.webm``) at the camera's ``bitrate`` or ``crf``, else CRF
-    :data:`WRITE_CRF`; ``.gif`` is an animated GIF (256 colours, times rounded to 10 ms). Returns
-    the path."""
+    :data:`WRITE_CRF`, tagged with the camera's transfer function; ``.gif`` is an animated GIF
+    (256 colours, times rounded to 10 ms, untagged). Returns the path."""
     frames = camera.exposure(scene, traj)
     times = np.asarray(traj.times, dtype=float)
     path = Path(path)
@@ -105,6 +112,7 @@ def write_clip(camera: Camera, path: str | Path, scene: Scene, traj: Trajectory)
         codec=VIDEO_CODECS.get(path.suffix.lower(), "libx264"),
         bitrate=int(camera.bitrate) if camera.bitrate > 0 else None,
         crf=crf,
+        transfer=getattr(camera, "transfer", None),
     )
 
 

@@ -90,6 +90,10 @@ def test_bad_input_gets_a_clear_error(clip, capsys) -> None:
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert err.startswith("physbench track: error:") and message in err, err
+    with pytest.raises(SystemExit):
+        main(["track", str(tmp / "clip.mp4"), *base, "--transfer", "gamma2.4"])
+    err = capsys.readouterr().err
+    assert "'gamma2.4'" in err and "'srgb', 'bt709'" in err, err
     assert digest(tmp / "clip.mp4") == before
 
 
