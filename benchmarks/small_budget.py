@@ -4,10 +4,14 @@ benchmarks/small_budget.toml` run: per Table 1 row, each estimator's mean normal
 with 95 % BCa intervals; over all rows, the geometric mean of the per-row ratios with a bootstrap
 that resamples seeds within each row.
 
-    python benchmarks/small_budget.py [results/small_budget]
+    python benchmarks/small_budget.py [results/small_budget] [--add results/small_budget_gp]
 
 Writes ``final.csv`` (each cell's final value: the compact record the test reads; the 23 MB
-results.parquet is not committed) and ``small_budget.md`` into the folder.
+results.parquet is not committed) and ``small_budget.md`` into the folder. ``--add FOLDER`` adds
+the final values of another sweep of the same rows (benchmarks/small_budget_gp.toml: ``gp`` on
+the first seeds of the same range) to ``final.csv``; ``final.csv`` already holding them is read
+as it is (the long table may be gone). An estimator that ran on fewer seeds than the others is
+compared with them on its own seeds only, in a section of its own.
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ import pandas as pd
 
 from physbench.bench.tables import ratio_ci
 
-#: (estimator, against): the comparisons the docs draw.
+#: (estimator, against): the comparisons the docs draw, on every seed.
 PAIRS = [
     ("cmaes", "cmaes at the guess"),
     ("cmaes lhs 5", "cmaes at the guess"),
@@ -31,6 +35,9 @@ PAIRS = [
     ("cmaes", "random"),
     ("cmaes at the guess", "random"),
 ]
+
+#: The comparisons for an estimator that ran on a subset of the seeds (``gp``), on that subset.
+SUBSET_AGAINST = ["random", "tpe", "cmaes"]
 
 
 def final_values(folder: Path) -> pd.DataFrame:
@@ -56,10 +63,54 @@ def geo_ratio(wide: dict[str, pd.DataFrame], a: str, b: str, n: int = 2000) -> t
     return float(point), *np.percentile(boots, [2.5, 97.5]).tolist()
 
 
+def _ratio_lines(wide: dict[str, pd.DataFrame], pairs: list[tuple[str, str]]) -> list[str]:
+    lines = [
+        "| estimator / against | " + " | ".join(wide) + " | all rows |",
+        "|---|" + "---|" * (len(wide) + 1),
+    ]
+    for a, b in pairs:
+        cells = []
+        for w in wide.values():
+            p, lo, hi = ratio_ci(w[a].to_numpy(), w[b].to_numpy(), level=0.95)
+            cells.append(f"{p:.2f} [{lo:.2f}, {hi:.2f}]")
+        g, glo, ghi = geo_ratio(wide, a, b)
+        lines.append(f"| {a} / {b} | " + " | ".join(cells) + f" | {g:.2f} [{glo:.2f}, {ghi:.2f}] |")
+    return lines
+
+
+def subset_report(final: pd.DataFrame, name: str) -> list[str]:
+    """The section for ``name``, an estimator that ran on fewer seeds than the rest: every
+    estimator's mean on those seeds, and paired ratios against :data:`SUBSET_AGAINST`."""
+    own = final[final.estimator == name]
+    wide = {}
+    for r, g in final.groupby("row"):
+        seeds = set(own[own.row == r].seed)
+        wide[r] = g[g.seed.isin(seeds)].pivot(index="seed", columns="estimator", values="best_nmse")
+    first = next(iter(wide.values()))
+    names = [name] + [n for n in first.columns if n != name]
+    lo, hi = int(first.index.min()), int(first.index.max())
+    lines = [
+        "",
+        f"## {name}: {len(first)} seeds per row ({lo}..{hi})",
+        "",
+        f"Mean normalized min MSE after 11 iterations on the seeds {name} ran.",
+        "",
+        "| row | " + " | ".join(names) + " |",
+        "|---|" + "---|" * len(names),
+    ]
+    for r, w in wide.items():
+        lines.append(f"| {r} | " + " | ".join(f"{w[n].mean():.2e}" for n in names) + " |")
+    lines += ["", f"Paired ratios of means on the same {len(first)} seeds, as above.", ""]
+    return lines + _ratio_lines(wide, [(name, b) for b in SUBSET_AGAINST])
+
+
 def report(final: pd.DataFrame) -> str:
+    counts = final.groupby("estimator").size()
+    partial = sorted(counts[counts < counts.max()].index)
+    full = final[~final.estimator.isin(partial)]
     wide = {
         r: g.pivot(index="seed", columns="estimator", values="best_nmse")
-        for r, g in final.groupby("row")
+        for r, g in full.groupby("row")
     }
     names = list(next(iter(wide.values())).columns)
     seeds = len(next(iter(wide.values())))
@@ -79,25 +130,29 @@ def report(final: pd.DataFrame) -> str:
         "last column: the geometric mean over the rows with a 95 % interval (seeds resampled",
         "within rows).",
         "",
-        "| estimator / against | " + " | ".join(wide) + " | all rows |",
-        "|---|" + "---|" * (len(wide) + 1),
+        *_ratio_lines(wide, PAIRS),
     ]
-    for a, b in PAIRS:
-        cells = []
-        for w in wide.values():
-            p, lo, hi = ratio_ci(w[a].to_numpy(), w[b].to_numpy(), level=0.95)
-            cells.append(f"{p:.2f} [{lo:.2f}, {hi:.2f}]")
-        g, glo, ghi = geo_ratio(wide, a, b)
-        lines.append(f"| {a} / {b} | " + " | ".join(cells) + f" | {g:.2f} [{glo:.2f}, {ghi:.2f}] |")
+    for name in partial:
+        lines += subset_report(final, name)
     return "\n".join(lines) + "\n"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     ap.add_argument("folder", nargs="?", default="results/small_budget", type=Path)
-    folder = ap.parse_args().folder
-    final = final_values(folder)
+    ap.add_argument("--add", type=Path, action="append", default=[], metavar="FOLDER")
+    args = ap.parse_args()
+    folder = args.folder
+    if (folder / "results.parquet").is_file():
+        final = final_values(folder)
+    else:
+        final = pd.read_csv(folder / "final.csv")
+    for extra in args.add:
+        more = final_values(extra)
+        final = final[~final.estimator.isin(set(more.estimator))]
+        final = pd.concat([final, more]).sort_values(["row", "estimator", "seed"])
     final.to_csv(folder / "final.csv", index=False, float_format="%.6g")
+    final = pd.read_csv(folder / "final.csv")  # the report reads what the tests read
     text = report(final)
     (folder / "small_budget.md").write_text(text)
     print(text)

@@ -1,36 +1,73 @@
 """The committed held-out study of ``gp`` at the paper's budget (``results/gp_small_budget``,
-made by ``physbench bench benchmarks/gp_small_budget.toml``, about a minute on one core): the
-figures docs/results.md states, read back from the table."""
+made by ``physbench bench benchmarks/gp_small_budget.toml``, about 10 minutes on one shared core):
+the figures docs/results.md states, read back from the table. Issue 29 item 3 asked for a mean of
+at most 5e-3 on three_circles mass after 11 iterations over at least 200 held-out seeds, with a
+BCa interval."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import pandas as pd
+import pytest
+
+from physbench.bench.tables import bootstrap_ci, ratio_ci
 
 ROOT = Path(__file__).resolve().parents[2]
-TABLE = ROOT / "results" / "gp_small_budget" / "results.parquet"
+FOLDER = ROOT / "results" / "gp_small_budget"
 
 
-def _final() -> pd.DataFrame:
-    d = pd.read_parquet(TABLE)
+@pytest.fixture(scope="module")
+def final() -> pd.DataFrame:
+    d = pd.read_parquet(FOLDER / "results.parquet")
     d = d[d.iteration == d.iteration.max()]
     return d.pivot_table(index="seed", columns="estimator", values="best_nmse")
 
 
-def test_every_estimator_ran_the_same_100_held_out_seeds() -> None:
-    w = _final()
-    assert list(w.index) == list(range(600, 700))
-    assert set(w.columns) == {"gp", "optuna", "tpe", "cmaes", "random"}
-    assert not w.isna().any().any()
+def test_every_estimator_ran_the_same_300_held_out_seeds(final: pd.DataFrame) -> None:
+    # 600..899: none is among the seeds any estimator's defaults were chosen on (gp: 1000..1199,
+    # tpe and cmaes: 100..399)
+    assert list(final.index) == list(range(600, 900))
+    assert set(final.columns) == {"gp", "optuna", "tpe", "cmaes", "random"}
+    assert not final.isna().any().any()
 
 
-def test_gp_beats_the_others_on_most_seeds_but_not_on_the_mean_by_half() -> None:
-    w = _final()
-    assert round(w["gp"].mean(), 4) == 0.0040 and round(w["optuna"].mean(), 4) == 0.0062
-    assert w["gp"].median() < w["optuna"].median() / 10  # 3.0e-4 against 3.5e-3
-    assert (w["gp"] < w["optuna"]).mean() == 0.76
-    # One seed (629) ends at 0.215 and holds half of gp's mean: the mean is 0.65 of optuna's.
-    assert w["gp"].idxmax() == 629 and w["gp"].max() > 0.2
-    assert 0.6 < w["gp"].mean() / w["optuna"].mean() < 0.7
-    assert w["gp"].mean() < 1.1e-2 / 2  # below half the paper's Hyperopt (1.1e-2)
+def test_gp_mean_is_below_5e_3_with_its_bca_interval(final: pd.DataFrame) -> None:
+    gp = final["gp"].to_numpy()
+    lo, hi = bootstrap_ci(gp, level=0.95)
+    assert gp.mean() <= 5e-3
+    assert round(gp.mean(), 5) == 0.00285
+    assert (round(lo, 5), round(hi, 5)) == (0.00186, 0.0057)
+    # the interval's upper end is above 5e-3: the target is met by the mean, not by the interval
+    assert lo < 5e-3 < hi
+    # the sweep's own statistics say the same
+    stats = pd.read_csv(FOLDER / "stats.csv").set_index("estimator")
+    assert stats.loc["gp", "n"] == 300
+    assert (stats.loc["gp", "ci_low"], stats.loc["gp", "ci_high"]) == pytest.approx((lo, hi))
+
+
+def test_gp_is_below_the_others_paired_on_the_same_seeds(final: pd.DataFrame) -> None:
+    means = final.mean()
+    assert means.idxmin() == "gp"
+    assert [round(means[e], 4) for e in ("optuna", "cmaes", "tpe", "random")] == [
+        0.0075,
+        0.0117,
+        0.0154,
+        0.0167,
+    ]
+    point, lo, hi = ratio_ci(final["gp"], final["optuna"], level=0.95)
+    assert round(point, 2) == 0.38 and (round(lo, 2), round(hi, 2)) == (0.25, 0.70)
+    assert hi < 1  # lower than optuna's, significantly; half of it is inside the interval
+    for other in ("cmaes", "tpe", "random"):
+        assert ratio_ci(final["gp"], final[other], level=0.95)[2] < 0.55, other
+    assert (final["gp"] < final["optuna"]).sum() == 242
+    assert final["gp"].median() < final["optuna"].median() / 10  # 3.2e-4 against 4.1e-3
+    assert final["gp"].mean() < 1.1e-2 / 2  # below half the paper's Hyperopt (1.1e-2)
+
+
+def test_one_seed_holds_a_quarter_of_gps_error(final: pd.DataFrame) -> None:
+    # seed 629: the start-up points all fell on the plateau of b's mass (gp.py's docstring)
+    gp = final["gp"]
+    assert gp.idxmax() == 629 and round(gp.max(), 3) == 0.215
+    assert 0.24 < gp[629] / gp.sum() < 0.26
+    assert gp.drop(629).max() < 0.07

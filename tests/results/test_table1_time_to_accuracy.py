@@ -42,7 +42,7 @@ def test_resnet3d_reaches_the_papers_value_in_a_median_of_two_simulations(
 def test_the_gradient_free_estimators_mostly_do_not_within_11_simulations(
     committed: pd.DataFrame,
 ) -> None:
-    g = committed[committed["estimator"] != "resnet3d"]
+    g = committed[committed["estimator"].isin(["tpe", "cmaes", "optuna", "random"])]
     assert len(g) == 32 and g["share"].max() == 0.6
     finite = g[g["median_simulations"] < float("inf")]
     # only second order elasticity, where TPE, CMA-ES and Optuna need 11, 11 and 8.5 of the 11
@@ -50,4 +50,21 @@ def test_the_gradient_free_estimators_mostly_do_not_within_11_simulations(
         ("second_order", "elasticity", "tpe"),
         ("second_order", "elasticity", "cmaes"),
         ("second_order", "elasticity", "optuna"),
+    }
+
+
+def test_gp_reaches_the_papers_nn_value_more_often_and_within_11_on_five_rows(
+    committed: pd.DataFrame,
+) -> None:
+    g = committed[committed["estimator"] == "gp"].set_index(["scene", "unknowns"])
+    assert len(g) == 8
+    assert g.loc[("three_circles", "mass"), "share"] == 0.9  # the others: at most 0.34
+    assert g.loc[("three_circles", "mass"), "median_simulations"] == 8
+    finite = g[g["median_simulations"] < float("inf")]
+    assert set(finite.index) == {
+        ("three_circles", "mass"),
+        ("three_circles", "mass+elasticity"),
+        ("second_order", "mass"),
+        ("second_order", "elasticity"),
+        ("stacked_boxes", "friction"),
     }
