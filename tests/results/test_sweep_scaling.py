@@ -9,16 +9,26 @@ import re
 import statistics
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "results" / "sweep_scaling"
+#: The same benchmark on a 16-core machine (``benchmarks/sweep_scaling_device.sh``).
+CORES16 = RESULTS / "cores16"
+FOLDERS = [RESULTS, CORES16]
 
 
-def _all() -> dict:
-    return json.loads((RESULTS / "results.json").read_text())
+def _all(folder: Path = RESULTS) -> dict:
+    return json.loads((folder / "results.json").read_text())
 
 
 def _specs() -> list[tuple[str, dict]]:
-    return [(name, s) for name, s in _all()["specs"].items() if "prediction" in s]
+    return [
+        (name, s)
+        for folder in FOLDERS
+        for name, s in _all(folder)["specs"].items()
+        if "prediction" in s
+    ]
 
 
 def test_medians_and_ratios_follow_from_the_runs() -> None:
@@ -55,8 +65,15 @@ def test_the_projections_follow_from_the_measured_parts() -> None:
 
 
 def test_the_summary_shows_the_json() -> None:
-    text = (RESULTS / "summary.md").read_text()
-    for name, s in _specs():
+    for folder in FOLDERS:
+        _summary_shows(folder)
+
+
+def _summary_shows(folder: Path) -> None:
+    text = (folder / "summary.md").read_text()
+    for name, s in _all(folder)["specs"].items():
+        if "prediction" not in s:
+            continue
         assert f"## {name} " in text
         for key, m in s["median"].items():
             if key.startswith("raw"):
@@ -66,3 +83,16 @@ def test_the_summary_shows_the_json() -> None:
             assert re.search(row, text, re.M), row
     docs = (ROOT / "docs" / "results.md").read_text()
     assert "../results/sweep_scaling/summary.md" in docs
+
+
+@pytest.mark.xfail(strict=True, reason="16 cores: smoke48 4.83x at 16 workers, Dask 1.53x local")
+def test_on_16_cores_smoke48_scales_8x_and_dask_is_within_1_2x() -> None:
+    # Issue 29's targets, measured once on a 16-core machine (results/sweep_scaling/cores16):
+    # local processes reached 4.83x at 16 workers (52.2 s -> 10.8 s); each worker's start-up and
+    # first cells cost 6-7.5 s of CPU against 2.9 s of cells. Dask's LocalCluster took 1.53x the
+    # local processes' time at 16 workers and 1.28x at 8.
+    data = _all(CORES16)
+    assert data["machine"] == "16 cores"
+    s = data["specs"]["smoke48"]
+    assert s["ratios"]["processes_16"] >= 8.0
+    assert s["dask_vs_processes"]["16"] <= 1.2
