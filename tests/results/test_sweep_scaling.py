@@ -85,14 +85,21 @@ def _summary_shows(folder: Path) -> None:
     assert "../results/sweep_scaling/summary.md" in docs
 
 
-@pytest.mark.xfail(strict=True, reason="16 cores: smoke48 4.83x at 16 workers, Dask 1.53x local")
-def test_on_16_cores_smoke48_scales_8x_and_dask_is_within_1_2x() -> None:
-    # Issue 29's targets, measured once on a 16-core machine (results/sweep_scaling/cores16):
-    # local processes reached 4.83x at 16 workers (52.2 s -> 10.8 s); each worker's start-up and
-    # first cells cost 6-7.5 s of CPU against 2.9 s of cells. Dask's LocalCluster took 1.53x the
-    # local processes' time at 16 workers and 1.28x at 8.
+@pytest.mark.xfail(strict=True, reason="16 cores: smoke48 5.14x at 16 workers, not 8x")
+def test_on_16_cores_smoke48_scales_8x() -> None:
+    # Issue 29's target, measured on a 16-core machine (results/sweep_scaling/cores16): local
+    # processes reached 5.14x at 16 workers (56.9 s -> 11.1 s). Each worker imports its
+    # estimators' libraries (there: hyperopt 2.1 s, nevergrad 2.9 s, cma 2.1 s) and starts up:
+    # 5.5-6.7 s of CPU for the busiest, against 3.1 s of cells per worker.
     data = _all(CORES16)
     assert data["machine"] == "16 cores"
-    s = data["specs"]["smoke48"]
-    assert s["ratios"]["processes_16"] >= 8.0
-    assert s["dask_vs_processes"]["16"] <= 1.2
+    assert data["specs"]["smoke48"]["ratios"]["processes_16"] >= 8.0
+
+
+def test_on_16_cores_dask_is_within_1_2x_of_local_processes() -> None:
+    # Measured there: a LocalCluster took 1.16x the local processes' wall time at 8 workers and
+    # 1.17x at 16 (1.28x and 1.53x before the machine's install compiled its byte code once).
+    data = _all(CORES16)
+    ratios = data["specs"]["smoke48"]["dask_vs_processes"]
+    assert set(ratios) == {"8", "16"}
+    assert max(ratios.values()) <= 1.2
