@@ -20,9 +20,12 @@ tag (the H.264/HEVC VUI ``transfer_characteristics``, ITU-T H.273 codes: :data:`
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from physbench.errors import PhysbenchError
+
+if TYPE_CHECKING:  # the commands read the names at argument parsing, before numpy is needed
+    import numpy as np
 
 #: The transfer functions known, by name.
 TRANSFERS = ("linear", "srgb", "bt709", "gamma2.2", "gamma2.8")
@@ -86,6 +89,8 @@ def resolve(option: str | None, tag: str | None) -> tuple[str, str]:
 def to_linear(name: str, values: np.ndarray) -> np.ndarray:
     """Code values in ``[0, 1]`` -> linear light in ``[0, 1]`` through transfer ``name``'s
     inverse."""
+    import numpy as np
+
     v = np.clip(np.asarray(values, dtype=float), 0.0, 1.0)
     name = check_transfer(name, auto=False)
     if name == "srgb":
@@ -107,4 +112,6 @@ class Decoder:
     def __call__(self, levels: np.ndarray) -> np.ndarray:
         if self.name == "linear":
             return levels
+        import numpy as np
+
         return 255.0 * to_linear(self.name, np.asarray(levels, dtype=float) / 255.0)

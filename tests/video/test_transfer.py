@@ -92,8 +92,10 @@ def test_a_bad_transfer_is_named_with_those_accepted(tmp_path: Path) -> None:
 def test_a_gamma_camera_is_tracked_in_linear_light(tmp_path: Path) -> None:
     """A swinging arm filmed by the field camera (gamma 2.2, shutter open 70 % of the frame):
     read as linear light, its blur is unmixed wrong and the centre is pulled along the arm
-    (measured over runs, x264 is not bit-exact: 2.9-3.1 px median, 4.7-5.1 px p95 at 320x240);
-    decoded by the stream's tag, 1.5-1.6 and 2.7-2.8 px."""
+    (measured over runs, x264 is not bit-exact: 2.2-2.3 px median, 3.2 px p95 at 320x240);
+    decoded by the stream's tag, 0.5 and 0.8-1.0 px. Before the arm's faint far end was measured
+    too (tests/video/test_track.py): 2.9-3.1 and 4.7-5.1 px read as linear, 1.5-1.6 and 2.7-2.8
+    decoded."""
     scene = replace(pendulum(np.random.default_rng(2), (0.9, 1.3)), frames=12)
     traj = create("simulator", "pymunk").simulate(scene)
     still = {"drift": 0.0, "oblique": 0.0, "k1": 0.0, "k2": 0.0}
@@ -104,5 +106,5 @@ def test_a_gamma_camera_is_tracked_in_linear_light(tmp_path: Path) -> None:
     for transfer in ("linear", None):
         got = track_video(path, scene, cal, background=plate, transfer=transfer)
         errors[transfer] = centre_errors(cam, scene, traj, got.recording)["arm"]
-    assert errors["linear"]["median"] > 2.4 and errors["linear"]["p95"] > 4.0
-    assert errors[None]["median"] < 2.0 and errors[None]["p95"] < 3.4
+    assert errors["linear"]["median"] > 1.6 and errors["linear"]["p95"] > 2.6
+    assert errors[None]["median"] < 1.0 and errors[None]["p95"] < 1.5
