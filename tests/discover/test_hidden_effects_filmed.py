@@ -16,10 +16,10 @@ ENGINES = {"pymunk": PymunkSimulator, "box2d": Box2DSimulator}
 
 CASES = [
     ("linear_drag", "projectile", "pymunk"),
-    ("constant_force", "two_pucks", "pymunk"),
 ]
 #: 10-19 s a run: ``nox -s extended`` runs them
 EXTENDED = [
+    ("constant_force", "two_pucks", "pymunk"),
     ("joint_viscous_damping", "pendulum", "box2d"),
     ("velocity_dependent_restitution", "bouncer", "box2d"),
 ]
@@ -27,10 +27,13 @@ EXTENDED = [
 # two arms in one blob, a bounce's blurred V).
 CONTROLS = [
     ("projectile", "box2d", 0),
-    ("pendulum", "pymunk", 0),
     ("pendulum_xy", "box2d", 0),
-    ("double_pendulum", "pymunk", 1),
     ("bouncer", "pymunk", 1),
+]
+#: 6-8 s a run: ``nox -s extended`` runs them.
+EXTENDED_CONTROLS = [
+    ("pendulum", "pymunk", 0),
+    ("double_pendulum", "pymunk", 1),
 ]
 
 
@@ -50,7 +53,12 @@ def test_a_filmed_hidden_effect_is_named_with_its_magnitude(effect, scene, engin
 
 
 @pytest.mark.parametrize(
-    ("scene", "engine", "seed"), CONTROLS, ids=["/".join(map(str, c)) for c in CONTROLS]
+    ("scene", "engine", "seed"),
+    [pytest.param(*c, id="/".join(map(str, c))) for c in CONTROLS]
+    + [
+        pytest.param(*c, id="/".join(map(str, c)), marks=pytest.mark.extended)
+        for c in EXTENDED_CONTROLS
+    ],
 )
 def test_a_filmed_control_gives_no_cause(scene, engine, seed) -> None:
     sim = ENGINES[engine]()
