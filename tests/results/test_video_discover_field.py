@@ -99,3 +99,31 @@ def test_the_refused_tiny_balls_are_mostly_absent_from_the_coded_pixels() -> Non
         assert row["radius_px"] < TINY and row["in_view"] == 41
         worst[row["case"]] = max(worst.get(row["case"], 0.0), row["absent"] / row["in_view"])
     assert sum(v > 0.10 for v in worst.values()) == vis["summary"]["clips_absent_over_10pct"] == 46
+
+
+def test_the_arms_rerun_holds_what_each_tracker_gave() -> None:
+    # results/video_discover_field/pendulum_rerun (benchmarks/field_rerun.py): the 42 swinging-arm
+    # clips of the grid, rerun with the camera's gamma decoded and then with the arm's faint far
+    # end measured too. Its summaries follow from its rows, and the rows of its first stage are
+    # the grid's.
+    data = json.loads((FOLDER / "pendulum_rerun.json").read_text())
+    stages = data["stages"]
+    assert [s["name"] for s in stages] == [
+        "before (results.json)",
+        "gamma decoded",
+        "+ faint end",
+    ]
+    key = "{effect}/{scene}/{engine}/{seed}"
+    grid = {key.format(**r): r for r in ROWS if r["scene"] in ARMS}
+    assert {key.format(**r): r for r in stages[0]["rows"]} == grid and len(grid) == 42
+    got = []
+    for s in stages:
+        rows = s["rows"]
+        assert not any(r["field"].get("failure") for r in rows)
+        summary = {
+            "right": sum(right(r) for r in rows),
+            "false_alarms": sum(1 for r in rows if not r["effect"] and r["filmed"]["causes"]),
+        }
+        assert summary.items() <= s["summary"].items(), s["name"]
+        got.append((summary["right"], summary["false_alarms"], s["summary"]["centre_px_median"]))
+    assert got == [(23, 12, 3.5), (26, 11, 1.99), (33, 8, 1.13)]
