@@ -12,7 +12,7 @@
 # so a run cut short keeps what it measured.
 set -euo pipefail
 OUT=${OUT:-out/sweep_scaling}
-export SITE=${SITE:-/tmp/site}  # where the wheels are installed
+export SITE=${SITE:-$PWD/out/sweep_site}  # where the wheels are installed (out/ is ignored)
 mkdir -p "$OUT"
 LOG="$OUT/log.txt"
 exec > >(tee -a "$LOG") 2>&1
