@@ -49,7 +49,6 @@ def visibility(row: dict) -> list[dict]:
     from physbench.video.photometry import LightMeter
     from physbench.video.writer import write_clip
 
-    faint.SIGNIFICANCE = -np.inf  # the significance everywhere, not only above the tracker's bar
     case = _case(row)
     sc = case.run.scene
     traj = frame_trajectory(case.trajectory, np.arange(sc.frames) / sc.fps)
@@ -80,12 +79,16 @@ def visibility(row: dict) -> list[dict]:
                 image, [(float(u), float(v), 8.0 + 3 * radius) for u, v in uv[k : k + 1]]
             )
             smear = 0.5 * (uv[k] - uv[k - 1]) if k else np.zeros(2)
-            got = faint.find_faint(image, plate, light, uv[k], 1.5, radius, smear)
+            got = faint.find_faint(
+                image, plate, light, uv[k], 1.5, radius, smear, significance=-np.inf
+            )
             truth.append(got.significance if got is not None else 0.0)
             for _ in range(NULLS):
                 a = rng.uniform(0, 2 * np.pi)
                 place = uv[k] + rng.uniform(15, 40) * np.array([np.cos(a), np.sin(a)])
-                q = faint.find_faint(image, plate, light, place, 1.5, radius, smear)
+                q = faint.find_faint(
+                    image, plate, light, place, 1.5, radius, smear, significance=-np.inf
+                )
                 null.append(q.significance if q is not None else 0.0)
         truth_a, null_a = np.array(truth), np.array(null)
         floor = float(np.percentile(null_a, 99))

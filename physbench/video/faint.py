@@ -82,14 +82,15 @@ def find_faint(
     smear: np.ndarray,
     taken: Sequence[np.ndarray] = (),
     last: np.ndarray | None = None,
+    significance: float = SIGNIFICANCE,
 ) -> Faint | None:
     """The disc of ``radius`` px nearest-by-significance to ``pred`` (px) within ``gate`` px in
     ``image`` against ``background`` (both ``(H, W, 3)`` uint8) in the frame's ``light``, smeared
     by ``smear`` px over the exposure (see the module docstring); ``taken``: centres (px) of
     other bodies found in this frame, whose footprints are not this body; ``last``: where this
     body was last seen (px), not it either where the prediction has moved away from it (a lossy
-    codec's skipped blocks leave a faint ghost of the body where it was). ``None`` where nothing
-    within the gate is significant."""
+    codec's skipped blocks leave a faint ghost of the body where it was); ``significance``: the
+    robust deviations a detection must reach. ``None`` where nothing within the gate reaches it."""
     h, w = image.shape[:2]
     half = max(MIN_HALF, math.ceil(gate + radius + float(np.hypot(*smear)) + 3))
     u0, v0 = round(float(pred[0])), round(float(pred[1]))
@@ -118,7 +119,7 @@ def find_faint(
     z = np.where(allowed, z, -np.inf)
     k = int(np.argmax(z))
     best = float(z.flat[k])
-    if best < SIGNIFICANCE:
+    if best < significance:
         return None
     uv = np.array([uu.flat[k], vv.flat[k]], dtype=np.float64)
     weight = np.maximum(diff, 0.0).astype(np.float64)

@@ -71,18 +71,24 @@ class TrackSummary:
         """Frames where ``body`` was in view but not found."""
         return self.in_view.get(body, 0) - self.detections.get(body, 0)
 
+    def lost_bodies(self, share: float = LOST_SHARE) -> list[str]:
+        """The bodies unseen in more than ``share`` of the frames where they were in view."""
+        return [
+            name
+            for name in self.detections
+            if self.in_view.get(name, 0) and self.unseen(name) > share * self.in_view[name]
+        ]
+
     def failures(self, share: float = LOST_SHARE) -> list[str]:
-        """One sentence per body unseen in more than ``share`` of the frames where it was in
-        view."""
+        """One sentence per body of :meth:`lost_bodies`."""
         out = []
-        for name in self.detections:
-            n, unseen = self.in_view.get(name, 0), self.unseen(name)
-            if n and unseen > share * n:
-                out.append(
-                    f"body {name!r} was lost in {unseen} of the {n} frames where it was in view "
-                    f"({unseen / n:.0%}, more than {share:.0%}): lost "
-                    f"{lost_words(self.lost.get(name, []))}"
-                )
+        for name in self.lost_bodies(share):
+            n, unseen = self.in_view[name], self.unseen(name)
+            out.append(
+                f"body {name!r} was lost in {unseen} of the {n} frames where it was in view "
+                f"({unseen / n:.0%}, more than {share:.0%}): lost "
+                f"{lost_words(self.lost.get(name, []))}"
+            )
         return out
 
     def format(self) -> str:

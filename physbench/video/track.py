@@ -1236,7 +1236,7 @@ def track_frames(
             "; ".join(failures) + ". A track with such gaps is not the motion; find why in a "
             "--preview (an occluder, too little contrast, a body leaving the view), or pass "
             f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{held}"
-            f"{_tiny(tracker, failures)}",
+            f"{_tiny(tracker, result.summary.lost_bodies())}",
             result,
         )
     return result
@@ -1307,12 +1307,12 @@ def track_video(
         raise TrackError(str(exc)) from None
 
 
-def _tiny(tracker: Tracker, failures: list[str]) -> str:
-    """What a lost body's size says, where it is under :data:`TINY` px in radius."""
+def _tiny(tracker: Tracker, lost: list[str]) -> str:
+    """What the size of each ``lost`` body says, where it is under :data:`TINY` px in radius."""
     small = [
         f"{s.body.name!r} is {s.radius:.1f} px in radius"
         for s in tracker.states
-        if s.radius < TINY and any(f"body {s.body.name!r} " in f for f in failures)
+        if s.radius < TINY and s.body.name in lost
     ]
     if not small:
         return ""
