@@ -16,7 +16,8 @@ may be sampled at its own, irregular times. Rules:
   hold whatever the tracker filled in): ``# fields: y`` for every run, ``# fields of run "drop 1":
   x, y`` for one run (its label as a JSON string), which overrides the former. Without such a
   line, every field a run's tracks hold counts as measured. ``# accuracy: 0.0021`` states the
-  sensor's accuracy in metres (:attr:`Recording.accuracy`) for every run of the file.
+  sensor's accuracy in metres (:attr:`Recording.accuracy`) for every run of the file, and
+  ``# angle accuracy: 0.003`` that of its angles in radians (:attr:`Recording.angle_accuracy`).
 
 Errors name the line (1 = header), the data row (1 = first row after the header) and the column.
 """
@@ -49,6 +50,7 @@ POSE_FIELDS = ("x", "y", "angle")
 _STATE_COLUMN = {"x": (0, 3), "y": (1, 4), "angle": (2, 5)}
 #: A comment line naming measured fields: an optional run label (a JSON string), then the fields.
 _ACCURACY_LINE = re.compile(r"#\s*accuracy\s*:\s*(\S+?)\s*(?:m)?")
+_ANGLE_ACCURACY_LINE = re.compile(r"#\s*angle\s+accuracy\s*:\s*(\S+?)\s*(?:rad)?")
 _FIELDS_LINE = re.compile(r'#\s*fields(?:\s+of\s+run\s+(".*"|[^:]*?))?\s*:(.*)')
 #: The largest |value| of each numeric column (a scene's limits, physbench.limits), its unit, and
 #: why: a value beyond it fits no scene (and its square overflows). Negative times have their own
@@ -148,7 +150,8 @@ class Recording:
     default of :meth:`residuals`; ``None`` = all the tracks hold), since a loader may have to fill
     in a coordinate the format requires but the sensor did not see. ``accuracy``: the sensor's
     systematic accuracy (m): a model that disagrees with the recording by less is not wrong as
-    far as this sensor can tell (0: not stated)."""
+    far as this sensor can tell (0: not stated); ``angle_accuracy``: the same for its angles
+    (rad), which is what counts where only angles were measured."""
 
     tracks: Mapping[str, Track]
     run: str = ""
@@ -156,12 +159,16 @@ class Recording:
     source: str = ""
     meta: Mapping[str, object] = field(default_factory=dict)
     accuracy: float = 0.0
+    angle_accuracy: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.tracks:
             raise RecordingError("a recording needs at least one tracked body")
         if not (isinstance(self.accuracy, int | float) and 0 <= self.accuracy < math.inf):
             raise RecordingError(f"accuracy = {self.accuracy!r}: expected metres >= 0")
+        ok = isinstance(self.angle_accuracy, int | float) and 0 <= self.angle_accuracy < math.inf
+        if not ok:
+            raise RecordingError(f"angle_accuracy = {self.angle_accuracy!r}: expected radians >= 0")
         if self.fields is not None:
             for f in self.fields:
                 if f not in POSE_FIELDS:
@@ -343,13 +350,16 @@ def _known_bodies(bodies: Scene | Iterable[str] | None) -> tuple[str, ...] | Non
     return bodies.body_names if isinstance(bodies, Scene) else tuple(bodies)
 
 
-def _declared_accuracy(text: str, source: str) -> float:
-    """The ``# accuracy: METRES`` line before the header (0 without one)."""
+def _declared_accuracy(text: str, source: str, *, angle: bool = False) -> float:
+    """The ``# accuracy: METRES`` line before the header (``angle``: the ``# angle accuracy:
+    RADIANS`` line; 0 without one)."""
+    pattern, unit = (_ANGLE_ACCURACY_LINE, "radians") if angle else (_ACCURACY_LINE, "metres")
+    example = "# angle accuracy: 0.003" if angle else "# accuracy: 0.002"
     for line, raw in enumerate(io.StringIO(text), start=1):
         stripped = raw.strip()
         if stripped and not stripped.startswith("#"):
             break
-        m = _ACCURACY_LINE.fullmatch(stripped)
+        m = pattern.fullmatch(stripped)
         if m is None:
             continue
         try:
@@ -358,7 +368,8 @@ def _declared_accuracy(text: str, source: str) -> float:
             value = math.nan
         if not 0 <= value < math.inf:
             raise RecordingError(
-                f"accuracy {m.group(1)!r} is not metres >= 0; expected e.g. # accuracy: 0.002",
+                f"{'angle ' if angle else ''}accuracy {m.group(1)!r} is not {unit} >= 0; "
+                f"expected e.g. {example}",
                 source=source,
                 line=line,
                 comment=True,
@@ -436,6 +447,7 @@ def parse_recordings(
     known = _known_bodies(bodies)
     text = text.removeprefix("\ufeff")
     accuracy = _declared_accuracy(text, source)
+    angle_accuracy = _declared_accuracy(text, source, angle=True)
     declared, text = _declared_fields(text, source)
     runs = _read_samples(text, source, known).tracks()
     _check_declared_runs(declared, runs, source)
@@ -447,6 +459,7 @@ def parse_recordings(
             fields=declared.get(run, (every, 0))[0],
             source=source,
             accuracy=accuracy,
+            angle_accuracy=angle_accuracy,
         )
         for run, tracks in runs.items()
     ]
@@ -720,6 +733,9 @@ def format_recordings(recordings: Sequence[Recording]) -> str:
     accuracy = max(r.accuracy for r in recordings)
     if accuracy > 0:  # one line for the file: the coarsest of its runs
         buf.write(f"# accuracy: {accuracy!r}\n")
+    angle_accuracy = max(r.angle_accuracy for r in recordings)
+    if angle_accuracy > 0:
+        buf.write(f"# angle accuracy: {angle_accuracy!r}\n")
     for r in recordings:
         if r.fields is not None:
             which = f" of run {json.dumps(r.run)}" if with_run else ""

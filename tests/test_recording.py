@@ -376,6 +376,25 @@ def test_the_accuracy_a_recording_states_survives_its_csv():
         parse_recordings("# accuracy: x\nt,body,x,y\n0,b,0,0\n")
 
 
+def test_the_angle_accuracy_a_recording_states_survives_its_csv() -> None:
+    track = Track(np.arange(3.0), np.zeros(3), np.ones(3), np.zeros(3))
+    runs = [
+        Recording({"b": track}, run="a", accuracy=2e-3, angle_accuracy=3e-3),
+        Recording({"b": track}, run="b", angle_accuracy=1e-3),
+    ]
+    text = format_recordings(runs)
+    assert "# accuracy: 0.002\n# angle accuracy: 0.003\n" in text
+    back = parse_recordings(text)
+    assert [(r.accuracy, r.angle_accuracy) for r in back] == [(2e-3, 3e-3)] * 2
+    assert parse_recordings("t,body,x,y\n0,b,0,0\n")[0].angle_accuracy == 0.0
+    text = "# angle accuracy: 0.004 rad\nt,body,x,y\n0,b,0,0\n"
+    assert [(r.accuracy, r.angle_accuracy) for r in parse_recordings(text)] == [(0.0, 0.004)]
+    with pytest.raises(RecordingError, match=r"line 2 \(comment\): angle accuracy '-1' is not rad"):
+        parse_recordings("# accuracy: 0.002\n# angle accuracy: -1\nt,body,x,y\n0,b,0,0\n")
+    with pytest.raises(RecordingError, match=r"angle_accuracy = inf: expected radians >= 0"):
+        Recording({"b": track}, angle_accuracy=math.inf)
+
+
 def test_a_cell_over_the_csv_field_limit_is_a_recording_error() -> None:
     text = "t,body,x,y\n0,a,0,0\n0.1,a," + "9" * 140_000 + ",0\n"
     with pytest.raises(RecordingError, match=r"rec.csv: line 3: not readable as CSV .*131072"):

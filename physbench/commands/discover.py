@@ -155,9 +155,9 @@ def _add_threshold_arguments(p: argparse.ArgumentParser) -> None:
         type=numeric.FLOOR,
         default=None,
         metavar="METRES",
-        help="the data's accuracy: held-out errors count in quadrature with it, so a smaller "
-        "disagreement names no cause (default: what the recording states; a video's tracker "
-        "states half a pixel)",
+        help="the data's accuracy (radians where only angles were measured): held-out errors "
+        "count in quadrature with it, so a smaller disagreement names no cause (default: what "
+        "the recording states; a video's tracker states it from each track's noise)",
     )
     p.add_argument(
         "--max-causes", type=positive_int, default=None, help="most effects added (default 3)"

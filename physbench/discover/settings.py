@@ -33,8 +33,9 @@ class Settings:
     seed: int = 0
     min_gain: float = 0.1
     min_delta_bic: float = 10.0
-    #: Measurement floor (m): held-out errors count in quadrature with it, so a disagreement
-    #: below what the sensor can tell is no evidence; None: the recordings' stated accuracy.
+    #: Measurement floor (m; rad where only angles were measured): held-out errors count in
+    #: quadrature with it, so a disagreement below what the sensor can tell is no evidence;
+    #: None: the recordings' stated accuracy.
     floor: float | None = None
     max_causes: int = 3
     shortlist: int = 4

@@ -21,17 +21,28 @@ from physbench.discover.settings import Settings
 
 if TYPE_CHECKING:
     from physbench.discover.model import Problem
+    from physbench.recording import Recording
 
 
 def measurement_floor(problem: Problem | None, settings: Settings) -> float:
-    """The accuracy below which the data cannot tell a model wrong (m, or rad for angle-only
-    data): ``settings.floor`` when given, else the largest ``accuracy`` the recordings of
-    ``problem`` state (a tracker states its own; 0 for data that states none)."""
+    """The accuracy below which the data cannot tell a model wrong: ``settings.floor`` when
+    given, else the largest accuracy the recordings of ``problem`` state (a tracker states its
+    own; 0 for data that states none): their ``angle_accuracy`` (rad) where every recording
+    measured angles only, their ``accuracy`` (m) otherwise."""
     if settings.floor is not None:
         return float(settings.floor)
     if problem is None:
         return 0.0
-    return max((r.recording.accuracy for r in problem.runs if r.recording is not None), default=0.0)
+    recordings = [r.recording for r in problem.runs if r.recording is not None]
+    if recordings and all(_angles_only(rec) for rec in recordings):
+        return max(rec.angle_accuracy for rec in recordings)
+    return max((rec.accuracy for rec in recordings), default=0.0)
+
+
+def _angles_only(rec: Recording) -> bool:
+    """Whether ``rec`` measured angles and nothing else (its residuals are in radians)."""
+    held = {f for tr in rec.tracks.values() for f in tr.fields}
+    return set(rec.fields if rec.fields is not None else held) == {"angle"}
 
 
 def floored_gain(new: float, old: float, floor: float) -> float:

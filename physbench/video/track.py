@@ -52,7 +52,7 @@ from scipy import ndimage
 
 from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
-from physbench.video.accuracy import stated_accuracy
+from physbench.video.accuracy import stated_accuracy, stated_angle_accuracy
 from physbench.video.appearance import (
     HIDDEN,
     Appearance,
@@ -118,6 +118,10 @@ SMALL_DISC = 5.0
 #: A turning body is measured on its pixels down to this share of the frame's threshold that
 #: are joined to its blob (its blurred far end).
 FAINT_END = 0.5
+#: The quantiles of a turning rod's pixels along its axis taken as its ends, and the range of
+#: their span (over the quantiles' share) as a fraction of its length in which they are trusted.
+ENDS_QUANTILE = 0.01
+ENDS_SPAN = (0.9, 1.1)
 #: A body lost with a smaller radius (px) is said to be too small for the video's coding: on the
 #: field camera at CRF 18-30, balls of 0.8-1.9 px were absent from the coded pixels themselves
 #: (benchmarks/field_visibility.py) in more than a tenth of the frames in 46 of 51 refused clips.
@@ -172,6 +176,21 @@ def _symmetry(body: Body) -> tuple[int, float]:
     return 0, 0.0
 
 
+def _long_extent(body: Body, offset: float) -> float | None:
+    """The length (m) of an elongated body along its long axis (at ``offset`` in its frame), if
+    its outline is symmetric under a half turn about its centroid (a box, a rod), so that the
+    middle of its two ends is its centre; ``None`` otherwise."""
+    if isinstance(body.shape, Circle):
+        return None
+    pts = np.asarray(body.shape.vertices(), dtype=float)
+    pts = pts - _area_centroid(pts)
+    scale = float(np.abs(pts).max())
+    if scale <= 0 or any(np.hypot(*(pts + p).T).min() > 1e-6 * scale for p in pts):
+        return None
+    s = pts @ np.array([math.cos(offset), math.sin(offset)])
+    return float(s.max() - s.min())
+
+
 def _area_centroid(pts: np.ndarray) -> np.ndarray:
     """The centroid of the polygon ``pts`` ``(K, 2)``'s area (its vertex mean if degenerate)."""
     q = np.roll(pts, -1, axis=0)
@@ -193,6 +212,7 @@ class _State:
     area: float  # px, expected covered area at the start
     k: int
     offset: float
+    length: float | None  # m along the long axis, where its ends' middle is its centre
     free: bool
     xy: np.ndarray
     v: np.ndarray
@@ -297,6 +317,7 @@ class Tracker:
                     body.shape.area() / mpp**2,
                     k,
                     offset,
+                    _long_extent(body, offset) if k == 2 else None,
                     self.motion.free[body.name],
                     xy,
                     np.asarray(body.velocity, dtype=float),
@@ -634,6 +655,23 @@ class Tracker:
         fr, fc = np.nonzero(faint)
         return (fc + c0).astype(np.float64), (fr + r0).astype(np.float64), diff[fr, fc]
 
+    def _between_ends(self, i: int, u: np.ndarray, v: np.ndarray, pose: PlanePose) -> PlanePose:
+        """``pose`` with its centre moved along the long axis to the middle of the blob's two
+        ends, for an elongated body symmetric under a half turn whose pixels ``(u, v)`` span its
+        length (:data:`ENDS_SPAN`). A swinging arm's weighted centroid leans towards the pivot,
+        where the blob is sharp, by 3-5 mm on field-camera arms of 0.37-0.46 m; the middle of its
+        ends (each the :data:`ENDS_QUANTILE` of the pixels along the axis) by 0.2-0.4 mm."""
+        length = self.states[i].length
+        if length is None:
+            return pose
+        axis = np.array([math.cos(pose.axis), math.sin(pose.axis)])
+        along = (self.cal.to_scene(np.column_stack([u, v])) - pose.xy) @ axis
+        lo, hi = np.quantile(along, [ENDS_QUANTILE, 1.0 - ENDS_QUANTILE])
+        span = (hi - lo) / (1.0 - 2.0 * ENDS_QUANTILE)
+        if not ENDS_SPAN[0] <= span / length <= ENDS_SPAN[1]:
+            return pose  # an end hidden, cut off or joined to something: the centroid it is
+        return replace(pose, xy=pose.xy + 0.5 * (lo + hi) * axis)
+
     def _outline(self, i: int) -> Outline:
         """Body ``i``'s outline in the image at its prediction (px, about the predicted pixel):
         its polygon at the predicted angle through the calibration, or a disc."""
@@ -869,7 +907,7 @@ class Tracker:
                 gu, gv, gd = self._with_faint_end(window, u, v)
                 rows_g, cols_g = gv.astype(np.intp), gu.astype(np.intp)
                 weights = self._weights(i, gd, gd, image[rows_g, cols_g], self.bg[rows_g, cols_g])
-                pose = plane_pose(gu, gv, weights, self.cal)
+                pose = self._between_ends(i, gu, gv, plane_pose(gu, gv, weights, self.cal))
                 got = _Found(pose.xy, blob.centre, pose, self._look(i, blob.area, img, w))
             elif not shared:
                 pose = plane_pose(u, v, self._weights(i, w, d, img, bg), self.cal)
@@ -1137,8 +1175,20 @@ class Tracker:
             angle = rows[:, 3] if s.k and not np.isnan(rows[:, 3]).any() else None
             tracks[s.body.name] = Track(rows[:, 0], rows[:, 1], rows[:, 2], angle)
         fields = ("x", "y", "angle") if any(t.angle is not None for t in tracks.values()) else None
+        angle_accuracy = [
+            stated_angle_accuracy(
+                tr.t, tr.angle, s.body.shape.extent() / max(self._coarsest(pixels[name]), 1e-12)
+            )
+            for s in self.states
+            if (tr := tracks[name := s.body.name]).angle is not None
+        ]
         recording = Recording(
-            tracks, fields=fields, source="video", meta={}, accuracy=max(accuracy_m.values())
+            tracks,
+            fields=fields,
+            source="video",
+            meta={},
+            accuracy=max(accuracy_m.values()),
+            angle_accuracy=max(angle_accuracy, default=0.0),
         )
         names = [s.body.name for s in self.states]
         summary = TrackSummary(

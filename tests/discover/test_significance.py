@@ -75,3 +75,24 @@ def test_the_floor_is_the_largest_accuracy_the_recordings_state():
     assert measurement_floor(None, Settings()) == 0.0
     with pytest.raises(RecordingError, match=r"accuracy = -0\.1"):
         Recording({"b": track}, accuracy=-0.1)
+
+
+def test_where_only_angles_were_measured_the_floor_is_the_angle_accuracy() -> None:
+    # the residuals of angle-only data are radians: a tracker's metres are not their floor
+    track = Track(np.arange(3.0), np.zeros(3), np.zeros(3), np.zeros(3))
+
+    def problem(*fields: tuple[str, ...] | None) -> SimpleNamespace:
+        return SimpleNamespace(
+            runs=[
+                SimpleNamespace(
+                    recording=Recording({"b": track}, fields=f, accuracy=1e-3, angle_accuracy=a)
+                )
+                for f, a in zip(fields, (3e-3, 5e-3), strict=False)
+            ]
+        )
+
+    assert measurement_floor(problem(("angle",)), Settings()) == 3e-3
+    assert measurement_floor(problem(("angle",), ("angle",)), Settings()) == 5e-3
+    assert measurement_floor(problem(("angle",), ("x", "y", "angle")), Settings()) == 1e-3
+    assert measurement_floor(problem(None), Settings()) == 1e-3  # x, y and angle held
+    assert measurement_floor(problem(("angle",)), Settings(floor=0.0)) == 0.0
