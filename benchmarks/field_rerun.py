@@ -2,14 +2,15 @@
 
 ``benchmarks/video_discover.py --camera field --only SCENE/ ... --out DIR`` reruns part of the grid
 (same cases, same camera domains); this script puts each rerun's rows beside the same cases of
-``results/video_discover_field/results.json`` and of earlier reruns, and writes one JSON (every
-stage's rows) and a Markdown table (per stage: right, wrong, refused, false alarms, effects named
-with other causes, the median of the cases' median centre errors; per case: what each stage
-named and its centre error).
+the grid (``--grid``, default ``results/video_discover_field/results.json``) and of earlier
+reruns, and writes one JSON (every stage's rows) and a Markdown table (per stage: right, wrong,
+refused, false alarms, effects named with other causes, the median of the cases' median centre
+errors; per case: what each stage named and its centre error).
 
-    python benchmarks/field_rerun.py --stage "gamma decoded=git 65a02a1:OLD.json" \\
+    python benchmarks/field_rerun.py --grid results/video_discover_field/earlier/results.json \\
+        --stage "gamma decoded=git 65a02a1:OLD.json" \\
         --stage "+ faint end=git HEAD:DIR1/results.json,DIR2/results.json" \\
-        --out results/video_discover_field/pendulum_rerun
+        --out results/video_discover_field/earlier/pendulum_rerun
 
 A stage is ``NAME=CODE:FILE[,FILE...]``; a FILE may be an earlier output of this script (its
 last stage's rows are read).

@@ -7,7 +7,10 @@ can be told apart from a tracker's miss. A body is "not in the frame" where its 
 significance is below the 99th percentile of that clip's places without it.
 
     python benchmarks/field_visibility.py --results results/video_discover_field/results.json \\
-        --out results/video_discover_field/visibility.json
+        --out results/video_discover_field/visibility.json [--max-px 2.5]
+
+A results file of a rerun at another resolution (``video_discover.py --resolution``) is filmed
+at that resolution.
 
 Reads the refused rows (their ``field.failure``) whose smallest body is under ``--max-px`` px in
 radius (default 2.5), films each clip again exactly as the field grid did, and writes one row per
@@ -38,8 +41,9 @@ def _case(row: dict):
     return make_case(row["effect"], row["scene"], int(row["seed"]), sim)
 
 
-def visibility(row: dict) -> list[dict]:
-    """One refused field-grid row -> per body: how often its true position shows in the pixels."""
+def visibility(row: dict, resolution: int = 640) -> list[dict]:
+    """One refused field-grid row, filmed ``resolution`` pixels wide -> per body: how often its
+    true position shows in the pixels."""
     import av
 
     from physbench.testing.field_camera import FieldCamera
@@ -56,7 +60,7 @@ def visibility(row: dict) -> list[dict]:
         str(row[k]) if row[k] is not None else "control"
         for k in ("effect", "scene", "engine", "seed")
     )
-    cam = FieldCamera(seed=camera_seed(name), view=motion_view(sc, traj))
+    cam = FieldCamera(resolution, seed=camera_seed(name), view=motion_view(sc, traj))
     plate = cam.plate(sc)
     meter = LightMeter(plate)
     with tempfile.TemporaryDirectory() as tmp:
@@ -119,11 +123,13 @@ def main() -> None:
     )
     ap.add_argument("--max-px", type=float, default=2.5)
     a = ap.parse_args()
-    rows = json.loads(a.results.read_text())["rows"]
+    results = json.loads(a.results.read_text())
+    resolution = results.get("resolution", 640)  # the grid's, or a rerun's --resolution
+    rows = results["rows"]
     todo = [r for r in rows if r["field"].get("failure") and r["body_px"] < a.max_px]
     table = []
     for i, r in enumerate(todo):
-        for got in visibility(r):
+        for got in visibility(r, resolution):
             table.append(got)
             print(
                 f"[{i + 1}/{len(todo)}] {got['case']} {got['body']}: r {got['radius_px']} px, "
@@ -134,6 +140,7 @@ def main() -> None:
     for t in table:
         worst[t["case"]] = max(worst.get(t["case"], 0.0), t["absent"] / max(t["in_view"], 1))
     summary = {
+        "resolution": resolution,
         "clips": len(worst),
         "clips_absent_over_10pct": sum(v > 0.10 for v in worst.values()),
         "note": "absent: the matched filter's significance at the true centre is below the "

@@ -100,7 +100,13 @@ FAILED = {"causes": None, "error": None, "gain": None, "ok": False}
 
 
 def run_case(
-    effect: str | None, scene: str, engine: str, seed: int, camera: str, clean: dict | None
+    effect: str | None,
+    scene: str,
+    engine: str,
+    seed: int,
+    camera: str,
+    clean: dict | None,
+    resolution: int = 640,
 ) -> dict:
     sim = ENGINES[engine]()
     case = make_case(effect, scene, seed, sim)
@@ -123,7 +129,8 @@ def run_case(
         return row
     from physbench.testing.field_footage import camera_seed, film_case
 
-    film = film_case(case, camera_seed(f"{effect or 'control'}/{scene}/{engine}/{seed}"))
+    name = f"{effect or 'control'}/{scene}/{engine}/{seed}"
+    film = film_case(case, camera_seed(name), resolution)
     row["body_px"] = film.body_px
     row["field"] = film.info()
     filmed = film.run
@@ -144,7 +151,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seeds", type=int, nargs="+", default=[0])
     p.add_argument("--camera", choices=CAMERAS, default="camera", help="which camera films")
     p.add_argument("--out", default=None, help="default results/video_discover[_field]")
-    p.add_argument("--only", default=None, help="run only cases whose name contains this")
+    p.add_argument(
+        "--only", nargs="+", default=None, help="run only cases whose name contains one of these"
+    )
+    p.add_argument(
+        "--resolution",
+        type=int,
+        default=640,
+        help="--camera field: the clips' width in pixels (4:3; default 640, the grid's)",
+    )
     p.add_argument(
         "--clean-from",
         metavar="RESULTS.json",
@@ -200,7 +215,11 @@ def main(argv: list[str] | None = None) -> int:
         clean = {key(r): r["clean"] for r in json.loads(Path(args.clean_from).read_text())["rows"]}
     todo = cases(args.seeds)
     if args.only:
-        todo = [c for c in todo if args.only in f"{c[0]}/{c[1]}/{c[2]}/{c[3]}"]
+        todo = [
+            c
+            for c in todo
+            if any(o in f"{c[0] or 'control'}/{c[1]}/{c[2]}/{c[3]}" for o in args.only)
+        ]
     partial = out / "partial.jsonl"  # one row per finished case: --resume goes on from there
     rows = []
     if args.resume and partial.exists():
@@ -212,7 +231,7 @@ def main(argv: list[str] | None = None) -> int:
     for i, c in enumerate(todo):
         if c in done:
             continue
-        row = run_case(*c, args.camera, clean.get(c))
+        row = run_case(*c, args.camera, clean.get(c), args.resolution)
         rows.append(row)
         with partial.open("a") as fh:
             fh.write(json.dumps(row) + "\n")
@@ -234,6 +253,8 @@ def main(argv: list[str] | None = None) -> int:
         "tolerance": tolerance,
         "rows": rows,
     }
+    if args.camera == "field" and args.resolution != 640:
+        payload["resolution"] = args.resolution
     write(out, payload, other)
     partial.unlink()
     return 0
@@ -246,15 +267,28 @@ def _commit() -> str:
         out = subprocess.run(
             ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
         )
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no", "physbench"],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
-    return f"git {out.stdout.strip()}"
+    return f"git {out.stdout.strip()}" + (
+        " with uncommitted changes to physbench/" if dirty else ""
+    )
 
 
 def write(out: Path, payload: dict, other: list[dict] | None) -> None:
     (out / "results.json").write_text(json.dumps(payload, indent=1) + "\n")
     kind = payload.get("camera_kind", "camera")
     text = table(payload["rows"], other, kind, payload.get("tolerance", TOLERANCE))
+    if "resolution" in payload:
+        w = payload["resolution"]
+        text = (
+            f"Clips {w}x{w * 3 // 4} px (the grid's: 640x480). Code: {payload['code']}.\n\n" + text
+        )
     (out / "table.md").write_text(text)
     print(text)
 

@@ -57,9 +57,9 @@ def camera_seed(name: str) -> int:
     return zlib.crc32(name.encode())
 
 
-def film_case(case: SyntheticRun, cam_seed: int) -> Filmed:
-    """Film ``case``'s true motion with the field camera of ``cam_seed`` and track it (see the
-    module docstring)."""
+def film_case(case: SyntheticRun, cam_seed: int, resolution: int = 640) -> Filmed:
+    """Film ``case``'s true motion with the field camera of ``cam_seed``, ``resolution`` pixels
+    wide (4:3), and track it (see the module docstring)."""
     from physbench.calibration import Calibration
     from physbench.testing.field_camera import FieldCamera
     from physbench.video.footage import frame_trajectory, motion_view
@@ -71,7 +71,7 @@ def film_case(case: SyntheticRun, cam_seed: int) -> Filmed:
         raise ValueError(f"case {case.name!r} has no true trajectory to film")
     sc = run.scene
     traj = frame_trajectory(case.trajectory, np.arange(sc.frames) / sc.fps)
-    cam = FieldCamera(seed=cam_seed, view=motion_view(sc, traj))
+    cam = FieldCamera(resolution, seed=cam_seed, view=motion_view(sc, traj))
     assert cam.view is not None
     x0, y0, x1, y1 = cam.view
     corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])

@@ -3,7 +3,9 @@
 grid ran, each clip in a domain of its own, and what it measured, held against issue 26's targets
 (every effect named first within 10 %, no false alarm, no clip refused). The targets are not met;
 these tests hold the measured figures and where the misses lie, so that a change that moves them
-must update the table and the docs (docs/video.md)."""
+must update the table and the docs (docs/video.md). ``earlier/`` holds the grid before the arms
+were centred between their ends, with the reruns and the visibility study made against it;
+``hires_1280/`` the small-ball clips filmed at twice the resolution."""
 
 from __future__ import annotations
 
@@ -15,15 +17,23 @@ from physbench.discover.synthetic import EFFECT_SCENES, SCENES
 
 ROOT = Path(__file__).resolve().parents[2]
 FOLDER = ROOT / "results" / "video_discover_field"
+EARLIER = FOLDER / "earlier"
 DATA = json.loads((FOLDER / "results.json").read_text())
 ROWS = DATA["rows"]
 HIDDEN = [r for r in ROWS if r["effect"]]
 CONTROLS = [r for r in ROWS if not r["effect"]]
+EARLIER_ROWS = json.loads((EARLIER / "results.json").read_text())["rows"]
 TOLERANCE = 0.10
 #: Balls below this radius (px) are below the noise of this camera in many frames.
 TINY = 2.0
-#: The scenes whose swinging arm's centre is biased under this camera's gamma and light drift.
+#: The scenes whose swinging arm's centre was biased under this camera's gamma and light drift.
 ARMS = {"pendulum_xy", "pendulum_both"}
+#: Every scene with a turning arm.
+TURNING = ARMS | {"pendulum", "pendulum_large", "double_pendulum"}
+
+
+def name(row: dict) -> str:
+    return f"{row['effect'] or 'control'}/{row['scene']}/{row['engine']}/{row['seed']}"
 
 
 def right(row: dict) -> bool:
@@ -60,40 +70,49 @@ def test_the_table_is_the_results() -> None:
     assert f"False alarms on controls: {alarms} of {len(CONTROLS)}" in table
 
 
-def test_bodies_of_two_pixels_or_more_are_right_but_on_a_swinging_arm() -> None:
+def test_bodies_of_two_pixels_or_more_are_right_but_three_pucks_and_a_bounce() -> None:
     big = [r for r in ROWS if r["body_px"] >= TINY]
-    assert (len(big), sum(right(r) for r in big)) == (200, 175)
-    wrong = [r for r in big if not right(r) and "filmed_failure" not in r]
-    # every wrong answer on a filmed clip: a measurement cause named beside or instead of the
-    # truth, where the arm's centre is biased (an expected failure of issue 26's target)
-    assert {r["scene"] for r in wrong} == ARMS and len(wrong) == 19
+    assert (len(big), sum(right(r) for r in big)) == (200, 196)
+    # Refused: two pucks not found in the first frame, one lost for 17 % of its frames, on
+    # bricks (the frame's threshold, six robust deviations, is above every background pixel's
+    # difference; docs/video.md).
     refused = Counter(r["scene"] for r in big if "filmed_failure" in r)
-    assert refused == Counter({"drops": 3, "two_pucks": 1, "puck_kicked": 1, "puck": 1})
-    rest = [r for r in big if r["scene"] not in ARMS]
-    assert (len(rest), sum(right(r) for r in rest)) == (158, 152)
+    assert refused == Counter({"two_pucks": 1, "puck_kicked": 1, "puck": 1})
+    wrong = [r for r in big if not right(r) and "filmed_failure" not in r]
+    # the frames after a bounce are about a pixel off and one of them is kept: a false clock_scale
+    assert [(name(r), r["filmed"]["causes"]) for r in wrong] == [
+        ("control/bouncer/pymunk/0", ["clock_scale"])
+    ]
 
 
-def test_balls_under_two_pixels_are_mostly_lost_and_every_false_alarm_is_an_arm() -> None:
+def test_every_turning_arm_is_right_since_it_is_centred_between_its_ends() -> None:
+    arms = [r for r in ROWS if r["scene"] in TURNING]
+    assert len(arms) == 90 and all(right(r) for r in arms)
+    before = [r for r in EARLIER_ROWS if r["scene"] in TURNING]
+    assert sum(right(r) for r in before) == 71  # 12 false alarms and 7 wrong, all on ARMS
+    centre = sorted(r["field"]["centre_px"]["arm"]["median"] for r in arms if r["scene"] in ARMS)
+    assert centre[len(centre) // 2] < 0.3  # the clips' median arm centre, px (3.5 before)
+
+
+def test_balls_under_two_pixels_are_mostly_lost() -> None:
     tiny = [r for r in ROWS if r["body_px"] < TINY]
     assert (len(tiny), sum(right(r) for r in tiny)) == (70, 15)
     assert sum("filmed_failure" in r for r in tiny) == 51
     alarms = [r for r in CONTROLS if not right(r) and "filmed_failure" not in r]
-    assert len(alarms) == 12 and {r["scene"] for r in alarms} == ARMS
+    assert [name(r) for r in alarms] == ["control/bouncer/pymunk/0"]
 
 
 def test_the_refused_tiny_balls_are_mostly_absent_from_the_coded_pixels() -> None:
     # benchmarks/field_visibility.py: no tracker, only whether the matched filter responds at a
-    # refused small ball's true centre above what it gives at places without it. In 46 of the 51
-    # refused clips a ball under 2 px radius is absent in more than a tenth of its frames, so the
-    # clip fails the lost-share rule whatever tracks it.
-    vis = json.loads((FOLDER / "visibility.json").read_text())
-    refused = {
-        f"{r['effect'] or 'control'}/{r['scene']}/{r['engine']}/{r['seed']}"
-        for r in ROWS
-        if r["field"].get("failure") and r["body_px"] < 2.5
-    }
+    # refused small ball's true centre above what it gives at places without it. Measured on
+    # the earlier grid's 51 refused clips, which are this grid's 51 too (the same clips, each in
+    # its own domain). In 46 a ball under 2 px radius is absent in more than a tenth of its
+    # frames, so the clip fails the lost-share rule whatever tracks it.
+    vis = json.loads((EARLIER / "visibility.json").read_text())
+    refused = {name(r) for r in ROWS if r["field"].get("failure") and r["body_px"] < 2.5}
+    before = {name(r) for r in EARLIER_ROWS if r["field"].get("failure") and r["body_px"] < 2.5}
     cases = {row["case"] for row in vis["rows"]}
-    assert cases == refused and len(cases) == 51
+    assert cases == refused == before and len(cases) == 51
     worst: dict[str, float] = {}
     for row in vis["rows"]:
         assert row["radius_px"] < TINY and row["in_view"] == 41
@@ -101,12 +120,38 @@ def test_the_refused_tiny_balls_are_mostly_absent_from_the_coded_pixels() -> Non
     assert sum(v > 0.10 for v in worst.values()) == vis["summary"]["clips_absent_over_10pct"] == 46
 
 
+def test_at_twice_the_resolution_half_the_refused_small_balls_are_right() -> None:
+    # results/video_discover_field/hires_1280: the 70 clips of balls under 2 px radius, filmed
+    # at 1280x960 in the same domains (balls of 1.7-3.9 px): 37 right, 25 refused (51 at
+    # 640x480), no false alarm. In 22 of the 25 refused, a ball is absent from the coded pixels
+    # in more than a tenth of its frames; the other 3 are the tracker's misses.
+    hires = json.loads((FOLDER / "hires_1280" / "results.json").read_text())
+    rows = hires["rows"]
+    assert hires["resolution"] == 1280
+    assert {name(r) for r in rows} == {name(r) for r in ROWS if r["body_px"] < TINY}
+    refused = {name(r) for r in rows if "filmed_failure" in r}
+    alarms = [r for r in rows if not r["effect"] and not right(r) and "filmed_failure" not in r]
+    assert (sum(right(r) for r in rows), len(refused), len(alarms)) == (37, 25, 0)
+    vis = json.loads((FOLDER / "hires_1280" / "visibility.json").read_text())
+    assert vis["summary"]["resolution"] == 1280
+    worst: dict[str, float] = {}
+    for row in vis["rows"]:
+        worst[row["case"]] = max(worst.get(row["case"], 0.0), row["absent"] / row["in_view"])
+    assert set(worst) == refused
+    assert sum(v > 0.10 for v in worst.values()) == vis["summary"]["clips_absent_over_10pct"] == 22
+    assert {c for c, v in worst.items() if v <= 0.10} == {
+        "axis_rotation/projectile_kicked/box2d/1",
+        "control/projectile/box2d/2",
+        "control/projectile_kicked/box2d/1",
+    }
+
+
 def test_the_arms_rerun_holds_what_each_tracker_gave() -> None:
-    # results/video_discover_field/pendulum_rerun (benchmarks/field_rerun.py): the 42 swinging-arm
-    # clips of the grid, rerun with the camera's gamma decoded and then with the arm's faint far
-    # end measured too. Its summaries follow from its rows, and the rows of its first stage are
-    # the grid's.
-    data = json.loads((FOLDER / "pendulum_rerun.json").read_text())
+    # results/video_discover_field/earlier/pendulum_rerun (benchmarks/field_rerun.py): the 42
+    # swinging-arm clips of the earlier grid, rerun with the camera's gamma decoded and then
+    # with the arm's faint far end measured too. Its summaries follow from its rows, and the
+    # rows of its first stage are the earlier grid's.
+    data = json.loads((EARLIER / "pendulum_rerun.json").read_text())
     stages = data["stages"]
     assert [s["name"] for s in stages] == [
         "before (results.json)",
@@ -114,7 +159,7 @@ def test_the_arms_rerun_holds_what_each_tracker_gave() -> None:
         "+ faint end",
     ]
     key = "{effect}/{scene}/{engine}/{seed}"
-    grid = {key.format(**r): r for r in ROWS if r["scene"] in ARMS}
+    grid = {key.format(**r): r for r in EARLIER_ROWS if r["scene"] in ARMS}
     assert {key.format(**r): r for r in stages[0]["rows"]} == grid and len(grid) == 42
     got = []
     for s in stages:
@@ -130,14 +175,16 @@ def test_the_arms_rerun_holds_what_each_tracker_gave() -> None:
 
 
 def test_the_drops_rerun_has_no_refused_clip() -> None:
-    # results/video_discover_field/drops_rerun: the 12 clips of two balls dropped onto a floor,
-    # rerun since a body that hits a surface is predicted to bounce off it. Three were refused
-    # in the grid (a ball lost for the 6 frames of its rise); rerun, all 12 are right.
-    stages = json.loads((FOLDER / "drops_rerun.json").read_text())["stages"]
+    # results/video_discover_field/earlier/drops_rerun: the 12 clips of two balls dropped onto a
+    # floor, rerun since a body that hits a surface is predicted to bounce off it. Three were
+    # refused in the earlier grid (a ball lost for the 6 frames of its rise); rerun, all 12 are
+    # right, as in the grid now.
+    stages = json.loads((EARLIER / "drops_rerun.json").read_text())["stages"]
     key = "{effect}/{scene}/{engine}/{seed}"
-    grid = {key.format(**r): r for r in ROWS if r["scene"] == "drops"}
+    grid = {key.format(**r): r for r in EARLIER_ROWS if r["scene"] == "drops"}
     assert {key.format(**r): r for r in stages[0]["rows"]} == grid and len(grid) == 12
     assert sum(1 for r in grid.values() if r["field"].get("failure")) == 3
     rerun = stages[-1]["rows"]
     assert not any(r["field"].get("failure") for r in rerun)
     assert all(right(r) for r in rerun) and len(rerun) == 12
+    assert all(right(r) for r in ROWS if r["scene"] == "drops")
