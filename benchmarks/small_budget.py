@@ -9,9 +9,10 @@ that resamples seeds within each row.
 Writes ``final.csv`` (each cell's final value: the compact record the test reads; the 23 MB
 results.parquet is not committed) and ``small_budget.md`` into the folder. ``--add FOLDER`` adds
 the final values of another sweep of the same rows (benchmarks/small_budget_gp.toml: ``gp`` on
-the first seeds of the same range) to ``final.csv``; ``final.csv`` already holding them is read
-as it is (the long table may be gone). An estimator that ran on fewer seeds than the others is
-compared with them on its own seeds only, in a section of its own.
+the same seeds) to ``final.csv``, in place of that estimator's earlier values; ``final.csv``
+already holding them is read as it is (the long table may be gone). An estimator that ran on
+fewer seeds than the others is compared with them on its own seeds only, in a section of its
+own.
 """
 
 from __future__ import annotations
@@ -34,6 +35,9 @@ PAIRS = [
     ("tpe", "random"),
     ("cmaes", "random"),
     ("cmaes at the guess", "random"),
+    ("gp", "random"),
+    ("gp", "tpe"),
+    ("gp", "cmaes"),
 ]
 
 #: The comparisons for an estimator that ran on a subset of the seeds (``gp``), on that subset.
@@ -130,7 +134,7 @@ def report(final: pd.DataFrame) -> str:
         "last column: the geometric mean over the rows with a 95 % interval (seeds resampled",
         "within rows).",
         "",
-        *_ratio_lines(wide, PAIRS),
+        *_ratio_lines(wide, [(a, b) for a, b in PAIRS if {a, b} <= set(names)]),
     ]
     for name in partial:
         lines += subset_report(final, name)
