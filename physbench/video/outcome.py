@@ -48,8 +48,8 @@ class TrackSummary:
     (s) of frames where it was in view but ``lost``, and those where it was ``out_of_view``; the
     calibration's reprojection error (px), the processing speed (frames/s), the samples left out
     at collisions (``contacts``), the detections ``rejected`` for not looking like the body,
-    each track's stated accuracy (px, ``accuracy_px``), and a disc's frames measured by their
-    ``centroids`` for want of an outline."""
+    each track's stated accuracy (px, ``accuracy_px``), a disc's frames measured by their
+    ``centroids`` for want of an outline, and a turning body's stated ``angle_accuracy`` (rad)."""
 
     frames: int
     duration: float
@@ -66,6 +66,7 @@ class TrackSummary:
     accuracy_px: dict[str, float] = field(default_factory=dict)
     #: Per disc, the frames measured by their centroid (no outline could be fitted).
     centroids: dict[str, int] = field(default_factory=dict)
+    angle_accuracy: dict[str, float] = field(default_factory=dict)
 
     def unseen(self, body: str) -> int:
         """Frames where ``body`` was in view but not found."""
@@ -122,6 +123,8 @@ class TrackSummary:
                 )
             if name in self.accuracy_px:
                 parts.append(f"accuracy {self.accuracy_px[name]:.2f} px")
+            if name in self.angle_accuracy:
+                parts.append(f"angles to {1e3 * self.angle_accuracy[name]:.1f} mrad")
             lines.append(f"  {name:>8}: " + "; ".join(parts))
         return "\n".join(lines)
 

@@ -1175,20 +1175,20 @@ class Tracker:
             angle = rows[:, 3] if s.k and not np.isnan(rows[:, 3]).any() else None
             tracks[s.body.name] = Track(rows[:, 0], rows[:, 1], rows[:, 2], angle)
         fields = ("x", "y", "angle") if any(t.angle is not None for t in tracks.values()) else None
-        angle_accuracy = [
-            stated_angle_accuracy(
+        angle_accuracy = {
+            name: stated_angle_accuracy(
                 tr.t, tr.angle, s.body.shape.extent() / max(self._coarsest(pixels[name]), 1e-12)
             )
             for s in self.states
             if (tr := tracks[name := s.body.name]).angle is not None
-        ]
+        }
         recording = Recording(
             tracks,
             fields=fields,
             source="video",
             meta={},
             accuracy=max(accuracy_m.values()),
-            angle_accuracy=max(angle_accuracy, default=0.0),
+            angle_accuracy=max(angle_accuracy.values(), default=0.0),
         )
         names = [s.body.name for s in self.states]
         summary = TrackSummary(
@@ -1204,6 +1204,7 @@ class Tracker:
             {s.body.name: s.rejected for s in self.states if s.rejected},
             {n: round(accuracy_px[n], 3) for n in names},
             {s.body.name: s.centroids for s in self.states if s.centroids},
+            {n: round(a, 5) for n, a in angle_accuracy.items()},
         )
         return TrackResult(recording, summary, pixels)
 

@@ -43,3 +43,19 @@ def test_filmed_hidden_effects_are_named_with_their_magnitude() -> None:
 def test_no_false_alarm_on_filmed_controls() -> None:
     alarms = [(r["scene"], r["engine"], r["seed"]) for r in CONTROLS if not r["filmed"]["ok"]]
     assert alarms == []  # measured: 0 of 90 (11 before the shared-blob and collision fixes)
+
+
+def test_the_arm_clips_rerun_with_rods_centred_between_their_ends_are_all_right() -> None:
+    # results/video_discover/arms_rerun: the grid's 90 clips with a turning arm, filmed and
+    # tracked again after the tracker began to centre turning rods between their ends and to
+    # state angles' accuracy in radians (git d5135fc): still every one right on this camera.
+    rerun = json.loads(
+        (ROOT / "results" / "video_discover" / "arms_rerun" / "results.json").read_text()
+    )
+    arms = {"pendulum", "pendulum_xy", "pendulum_both", "pendulum_large", "double_pendulum"}
+    key = "{effect}/{scene}/{engine}/{seed}"
+    assert {key.format(**r) for r in rerun["rows"]} == {
+        key.format(**r) for r in ROWS if r["scene"] in arms
+    }
+    assert len(rerun["rows"]) == 90 and rerun["code"] == "git 54016d3"
+    assert all(r["filmed"]["ok"] and "filmed_failure" not in r for r in rerun["rows"])

@@ -565,6 +565,9 @@ def test_a_swinging_arms_centre_is_between_its_ends(tmp_path, monkeypatch) -> No
     truth = np.interp(arm.t, np.asarray(traj.times), np.asarray(traj.states)[:, 0, 2])
     assert arm.angle is not None
     assert np.abs(arm.angle - truth).max() < got.recording.angle_accuracy < 0.01
+    said = got.summary.angle_accuracy["arm"]
+    assert said == round(got.recording.angle_accuracy, 5)
+    assert f"angles to {1e3 * said:.1f} mrad" in got.summary.format()
     assert errors["centroid"]["median"] > 1.0 and errors["centroid"]["p95"] > 2.0
     assert errors["centroid with faint end"]["median"] > 0.4
     assert errors["centroid with faint end"]["median"] < errors["centroid"]["median"] / 2
