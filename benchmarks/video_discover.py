@@ -190,6 +190,8 @@ def main(argv: list[str] | None = None) -> int:
         help="run nothing: join these results files (e.g. seeds run in parallel) into --out",
     )
     args = p.parse_args(argv)
+    if args.resolution != 640 and args.camera != "field":
+        p.error(f"--resolution {args.resolution}: only --camera field films at another width")
     tolerance = args.tolerance or (TOLERANCE if args.camera == "camera" else FIELD_TOLERANCE)
     out = Path(
         args.out or ("results/video_discover" + ("_field" if args.camera == "field" else ""))

@@ -211,17 +211,30 @@ class PlanePose:
     square: float
 
 
-def plane_pose(u: np.ndarray, v: np.ndarray, w: np.ndarray, calibration: Calibration) -> PlanePose:
-    """The :class:`PlanePose` of pixels at ``(u, v)`` with coverage ``w``: each pixel mapped
-    into the plane and weighted by its coverage times the plane area it sees (the homography's
-    Jacobian; a lens's is neglected)."""
+def plane_points(
+    u: np.ndarray, v: np.ndarray, calibration: Calibration
+) -> tuple[np.ndarray, np.ndarray]:
+    """Pixels ``(u, v)`` on the scene's plane: their points ``(n, 2)`` (m) and the plane area
+    each sees (the homography's Jacobian; a lens's is neglected), with one lens undistortion."""
     uv = np.column_stack([u, v])
-    xy = calibration.to_scene(uv)
     und = uv if calibration.lens is None else calibration.lens.undistort(uv)
     h = calibration.homography
-    den = und @ h[2, :2] + h[2, 2]
-    weights = w * np.abs(np.linalg.det(h) / den**3)
-    blob = blob_from_pixels(xy[:, 0], xy[:, 1], weights)
+    q = und @ h[:, :2].T + h[:, 2]
+    return q[:, :2] / q[:, 2:3], np.abs(np.linalg.det(h) / q[:, 2] ** 3)
+
+
+def plane_pose(
+    u: np.ndarray,
+    v: np.ndarray,
+    w: np.ndarray,
+    calibration: Calibration,
+    points: tuple[np.ndarray, np.ndarray] | None = None,
+) -> PlanePose:
+    """The :class:`PlanePose` of pixels at ``(u, v)`` with coverage ``w``: each pixel mapped
+    into the plane and weighted by its coverage times the plane area it sees
+    (:func:`plane_points`, or ``points`` where the caller has them)."""
+    xy, area = plane_points(u, v, calibration) if points is None else points
+    blob = blob_from_pixels(xy[:, 0], xy[:, 1], w * area)
     if blob is None:
         return PlanePose(xy.mean(axis=0), 0.0, 1.0, 0.0)
     return PlanePose(blob.centre, blob.axis, blob.elongation, blob.square)

@@ -67,6 +67,7 @@ from physbench.video.detect import (
     PlanePose,
     blob_from_pixels,
     find_blobs,
+    plane_points,
     plane_pose,
     split_pixels,
 )
@@ -655,17 +656,18 @@ class Tracker:
         fr, fc = np.nonzero(faint)
         return (fc + c0).astype(np.float64), (fr + r0).astype(np.float64), diff[fr, fc]
 
-    def _between_ends(self, i: int, u: np.ndarray, v: np.ndarray, pose: PlanePose) -> PlanePose:
+    def _between_ends(self, i: int, xy: np.ndarray, pose: PlanePose) -> PlanePose:
         """``pose`` with its centre moved along the long axis to the middle of the blob's two
-        ends, for an elongated body symmetric under a half turn whose pixels ``(u, v)`` span its
-        length (:data:`ENDS_SPAN`). A swinging arm's weighted centroid leans towards the pivot,
-        where the blob is sharp, by 3-5 mm on field-camera arms of 0.37-0.46 m; the middle of its
-        ends (each the :data:`ENDS_QUANTILE` of the pixels along the axis) by 0.2-0.4 mm."""
+        ends, for an elongated body symmetric under a half turn whose pixels (``xy``, on the
+        plane) span its length (:data:`ENDS_SPAN`). A swinging arm's weighted centroid leans
+        towards the pivot, where the blob is sharp, by 3-5 mm on field-camera arms of 0.37-0.46
+        m; the middle of its ends (each the :data:`ENDS_QUANTILE` of the pixels along the axis)
+        by 0.2-0.4 mm."""
         length = self.states[i].length
         if length is None:
             return pose
         axis = np.array([math.cos(pose.axis), math.sin(pose.axis)])
-        along = (self.cal.to_scene(np.column_stack([u, v])) - pose.xy) @ axis
+        along = (xy - pose.xy) @ axis
         lo, hi = np.quantile(along, [ENDS_QUANTILE, 1.0 - ENDS_QUANTILE])
         span = (hi - lo) / (1.0 - 2.0 * ENDS_QUANTILE)
         if not ENDS_SPAN[0] <= span / length <= ENDS_SPAN[1]:
@@ -907,7 +909,9 @@ class Tracker:
                 gu, gv, gd = self._with_faint_end(window, u, v)
                 rows_g, cols_g = gv.astype(np.intp), gu.astype(np.intp)
                 weights = self._weights(i, gd, gd, image[rows_g, cols_g], self.bg[rows_g, cols_g])
-                pose = self._between_ends(i, gu, gv, plane_pose(gu, gv, weights, self.cal))
+                points = plane_points(gu, gv, self.cal)
+                pose = plane_pose(gu, gv, weights, self.cal, points)
+                pose = self._between_ends(i, points[0], pose)
                 got = _Found(pose.xy, blob.centre, pose, self._look(i, blob.area, img, w))
             elif not shared:
                 pose = plane_pose(u, v, self._weights(i, w, d, img, bg), self.cal)
@@ -1154,9 +1158,8 @@ class Tracker:
         accuracy_px = {
             s.body.name: stated_accuracy(pixels[s.body.name], disc=s.disc) for s in self.states
         }
-        accuracy_m = {
-            name: accuracy_px[name] * self._coarsest(pixels[name]) for name in accuracy_px
-        }
+        mpp = {name: self._coarsest(tuv) for name, tuv in pixels.items()}
+        accuracy_m = {name: accuracy_px[name] * mpp[name] for name in accuracy_px}
         tracks = {}
         contacts: dict[str, int] = {}
         for s in self.states:
@@ -1177,7 +1180,7 @@ class Tracker:
         fields = ("x", "y", "angle") if any(t.angle is not None for t in tracks.values()) else None
         angle_accuracy = {
             name: stated_angle_accuracy(
-                tr.t, tr.angle, s.body.shape.extent() / max(self._coarsest(pixels[name]), 1e-12)
+                tr.t, tr.angle, s.body.shape.extent() / max(mpp[name], 1e-12)
             )
             for s in self.states
             if (tr := tracks[name := s.body.name]).angle is not None

@@ -4,8 +4,11 @@ clean tracks are, and no filmed control raises a cause (docs/results.md, docs/vi
 
 from __future__ import annotations
 
+import importlib.util
 import json
 from pathlib import Path
+
+import pytest
 
 from physbench.discover.synthetic import EFFECT_SCENES, SCENES
 
@@ -59,3 +62,15 @@ def test_the_arm_clips_rerun_with_rods_centred_between_their_ends_are_all_right(
     }
     assert len(rerun["rows"]) == 90 and rerun["code"] == "git 54016d3"
     assert all(r["filmed"]["ok"] and "filmed_failure" not in r for r in rerun["rows"])
+
+
+def test_only_the_field_camera_films_at_another_resolution(capsys) -> None:
+    spec = importlib.util.spec_from_file_location(
+        "video_discover", ROOT / "benchmarks" / "video_discover.py"
+    )
+    assert spec and spec.loader
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    with pytest.raises(SystemExit):
+        bench.main(["--camera", "camera", "--resolution", "1280", "--out", "unused"])
+    assert "--resolution 1280: only --camera field" in capsys.readouterr().err
