@@ -56,9 +56,11 @@ ACCURACY_PX = 0.5
 #: A track's stated accuracy is at least this many times its measured noise.
 NOISE_K = 2.0
 #: The floor of a turning body's stated angle accuracy: this many pixels across at its far end
-#: (its extent from the centre). On six field-camera arms the angle's 95th-percentile error was
-#: 0.8-4.2 mrad, under this floor (2.6-5.7 mrad) on each; part of it is systematic (on a large
-#: swing, 0.2 % of the angle), which the noise alone does not show.
+#: (its extent from the centre). On five single field-camera arms the angle's 95th-percentile
+#: error was 0.8-4.2 mrad, under this floor (2.6-5.7 mrad) on each; part of it is systematic (on
+#: a large swing, 0.1 % of the angle), which the noise alone does not show. Not on a double
+#: pendulum's upper arm, joined to the lower at the elbow: 22.6 mrad, above both its floor and
+#: twice its noise (14 mrad).
 ANGLE_ACCURACY_PX = 0.25
 
 
