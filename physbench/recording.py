@@ -200,10 +200,16 @@ class Recording:
         :class:`~physbench.effects.ClockScale`)."""
         return math.ceil(self.t_end * scale * fps - 1e-9) + 1
 
+    @property
+    def measured(self) -> tuple[str, ...]:
+        """The fields the residuals compare by default: those named in :attr:`fields` (all
+        without it) that a track holds."""
+        fields = self.fields if self.fields is not None else POSE_FIELDS
+        return tuple(f for f in fields if any(f in tr.fields for tr in self.tracks.values()))
+
     def _fields(self, fields: Sequence[str] | None) -> tuple[str, ...]:
         if fields is None:
-            fields = self.fields if self.fields is not None else POSE_FIELDS
-            return tuple(f for f in fields if any(f in tr.fields for tr in self.tracks.values()))
+            return self.measured
         for f in fields:
             if f not in POSE_FIELDS:
                 raise RecordingError(f"unknown field {f!r}; fields: {', '.join(POSE_FIELDS)}")

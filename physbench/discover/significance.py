@@ -21,7 +21,6 @@ from physbench.discover.settings import Settings
 
 if TYPE_CHECKING:
     from physbench.discover.model import Problem
-    from physbench.recording import Recording
 
 
 def measurement_floor(problem: Problem | None, settings: Settings) -> float:
@@ -34,15 +33,9 @@ def measurement_floor(problem: Problem | None, settings: Settings) -> float:
     if problem is None:
         return 0.0
     recordings = [r.recording for r in problem.runs if r.recording is not None]
-    if recordings and all(_angles_only(rec) for rec in recordings):
+    if recordings and all(rec.measured == ("angle",) for rec in recordings):
         return max(rec.angle_accuracy for rec in recordings)
     return max((rec.accuracy for rec in recordings), default=0.0)
-
-
-def _angles_only(rec: Recording) -> bool:
-    """Whether ``rec`` measured angles and nothing else (its residuals are in radians)."""
-    held = {f for tr in rec.tracks.values() for f in tr.fields}
-    return set(rec.fields if rec.fields is not None else held) == {"angle"}
 
 
 def floored_gain(new: float, old: float, floor: float) -> float:
