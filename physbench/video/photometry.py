@@ -35,6 +35,8 @@ TUKEY = 4.685
 MIN_SPREAD = 6.0
 #: The smallest noise threshold (grey levels): 8-bit rounding and lossy coding.
 FLOOR = 12.0
+#: The noise threshold, in robust standard deviations of the frame's difference.
+DEVIATIONS = 6.0
 
 
 @dataclass(frozen=True)
@@ -63,10 +65,10 @@ class Light:
         """How much a contrast against the background grows in this light (the mean gain)."""
         return float(np.mean(self.gain))
 
-    def threshold(self, floor: float = FLOOR) -> float:
-        """The noise threshold of this frame's difference: 6 robust standard deviations, at
-        least ``floor`` grey levels."""
-        return max(floor, 6.0 * self.sigma)
+    def threshold(self, floor: float = FLOOR, deviations: float = DEVIATIONS) -> float:
+        """The noise threshold of this frame's difference: ``deviations`` robust standard
+        deviations, at least ``floor`` grey levels."""
+        return max(floor, deviations * self.sigma)
 
     @cached_property
     def lut(self) -> np.ndarray:

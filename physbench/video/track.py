@@ -75,7 +75,7 @@ from physbench.video.faint import SHUTTER, find_faint
 from physbench.video.medians import median
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
-from physbench.video.photometry import Light, LightMeter, plate_index
+from physbench.video.photometry import DEVIATIONS, Light, LightMeter, plate_index
 from physbench.video.silhouette import (
     DiscFit,
     Rays,
@@ -116,6 +116,14 @@ SMEAR = 0.2
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
 SMALL_DISC = 5.0
+#: A disc whose median contrast in the first frame is under this multiple of the noise threshold
+#: loses a share of its pixels to it (a mid-grey puck on bricks): the threshold then comes down
+#: to what the background's difference measured (:meth:`Tracker._tail_deviations`).
+FAINT_DISC = 1.5
+#: The quantile of the first frame's difference, away from the bodies, that the noise threshold
+#: may come down to for a faint disc, and how far it may come down (robust deviations).
+TAIL_QUANTILE = 0.9999
+MIN_DEVIATIONS = 3.0
 #: A turning body is measured on its pixels down to this share of the frame's threshold that
 #: are joined to its blob (its blurred far end).
 FAINT_END = 0.5
@@ -332,6 +340,7 @@ class Tracker:
         self.t_last = 0.0
         self.low = self.high = self.edge_low = 0.0
         self.contrast = 0.0  # the bodies' median contrast in the first frame's light
+        self.deviations = DEVIATIONS  # the noise threshold in robust deviations
         self.scale0 = 1.0  # the first frame's gain
         self.max_gate = 0.5 * max(self.h, self.w)
         self.pred_xy = np.zeros((len(self.states), 2))
@@ -395,10 +404,12 @@ class Tracker:
 
     # ----------------------------------------------------------------- light and thresholds
 
-    def _first_contrast(self, image: np.ndarray, visible: list[bool]) -> None:
+    def _first_contrast(self, image: np.ndarray, visible: list[bool], reach: np.ndarray) -> None:
         """The bodies' contrast in the first frame: the 90th percentile of the difference near
-        each prediction (a thin body, an arm, covers little of the square)."""
-        values = []
+        each prediction (a thin body, an arm, covers little of the square). Where a disc's median
+        there is faint for the noise threshold, the threshold comes down to the background's
+        measured tail (:meth:`_tail_deviations`)."""
+        values, faint = [], False
         for i, s in enumerate(self.states):
             if not visible[i]:
                 continue
@@ -407,23 +418,52 @@ class Tracker:
             if r <= iu < self.w - r and r <= iv < self.h - r:
                 box = (slice(iv - r, iv + r + 1), slice(iu - r, iu + r + 1))
                 patch = self.light.difference(image[box], self.bg[box], self.bg_index[box])
-                s.contrast = float(np.percentile(patch, 90))
+                mid, s.contrast = (float(q) for q in np.percentile(patch, [50, 90]))
                 values.append(s.contrast)
+                faint |= s.disc and mid < FAINT_DISC * self.light.threshold()
         self.contrast = float(np.median(values)) if values else 4 * self.light.threshold()
         for s in self.states:
             s.contrast = s.contrast or self.contrast
         self.scale0 = max(self.light.scale, 1e-3)
+        if faint:
+            self.deviations = self._tail_deviations(image, reach)
+
+    def _tail_deviations(self, image: np.ndarray, reach: np.ndarray) -> float:
+        """Called once, in the first frame, where a disc is faint for the noise threshold: the
+        :data:`TAIL_QUANTILE` of the frame's difference away from every body's reach, in robust
+        deviations, between :data:`MIN_DEVIATIONS` and :data:`DEVIATIONS`. Six deviations are
+        a Gaussian guard; a textured, coded background's own tail is measured instead (on a
+        brick wall at CRF 27: 4.3 deviations, against a puck whose median is 6.3)."""
+        if self.light.sigma <= 0:
+            return DEVIATIONS
+        diff = self.light.difference(image, self.bg, self.bg_index)
+        vv, uu = np.ogrid[: self.h, : self.w]
+        away = np.ones((self.h, self.w), dtype=bool)
+        for (u, v), r in zip(self.pred_uv, reach, strict=True):
+            away &= (uu - u) ** 2 + (vv - v) ** 2 > r * r
+        if away.sum() < 1.0 / (1.0 - TAIL_QUANTILE):
+            return DEVIATIONS
+        tail = float(np.quantile(diff[away], TAIL_QUANTILE))
+        return min(DEVIATIONS, max(MIN_DEVIATIONS, tail / self.light.sigma))
 
     def _thresholds(self) -> None:
         """This frame's thresholds: above its noise, and a share of the bodies' contrast in its
         light."""
         contrast = self.contrast * self.light.scale / self.scale0
-        self.low = max(self.light.threshold(), 0.2 * contrast)
+        self.low = max(self.light.threshold(deviations=self.deviations), 0.2 * contrast)
         self.high = max(self.low + 1.0, 0.5 * contrast)
         # An edge is placed by its own half-way point, so it may be fainter than what makes a
         # blob: half the threshold, above 3 robust noise deviations (a lit limb nearly as bright
         # as the wall).
         self.edge_low = max(EDGE_SHARE * self.low, 3.0 * self.light.sigma, 8.0)
+
+    def _high(self, group: list[int]) -> float:
+        """The threshold a blob of a window holding ``group`` must reach somewhere: half the
+        faintest of their contrasts in this frame's light, where that is under the frame's
+        (half the bodies' median): a light puck beside a dark one was lost in 7 of 41 frames
+        of its blurred, faintest moments, none of its pixels above the dark one's half."""
+        faintest = min(self.states[i].contrast for i in group) * self.light.scale / self.scale0
+        return max(self.low + 1.0, min(self.high, 0.5 * faintest))
 
     # ----------------------------------------------------------------- one frame
 
@@ -447,7 +487,7 @@ class Tracker:
         if first:
             if not any(visible):
                 raise BodyNotFoundError(self._none_in_view())
-            self._first_contrast(image, visible)
+            self._first_contrast(image, visible, reach)
         self._thresholds()
         found = self._measure(image, gates, reach, t, visible)
         if first:
@@ -710,7 +750,7 @@ class Tracker:
             )
             small = min(self.states[i].area for i in group)
             blobs = find_blobs(
-                window[0], self.low, self.high, offset=(r0, c0), min_area=0.15 * small
+                window[0], self.low, self._high(group), offset=(r0, c0), min_area=0.15 * small
             )
             if not blobs:
                 continue
