@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from physbench.video.detect import find_blobs
-from physbench.video.photometry import Light
+from physbench.video.photometry import DEVIATIONS, Light
 
 #: How far (in radii) to look for a blob of the body's size.
 SEARCH_RADII = 8.0
@@ -49,10 +49,12 @@ def not_found(
     low: float,
     *,
     median: bool,
+    deviations: float = DEVIATIONS,
 ) -> str:
     """The message for ``body`` missing from ``image`` (``(H, W, 3)`` uint8) against
     ``background`` in the frame's ``light``, where ``low`` (grey levels) is the foreground
-    threshold; ``median``: the background is the clip's median."""
+    threshold; ``median``: the background is the clip's median; ``deviations``: the noise
+    threshold in the frame's robust deviations that the tracker used."""
     h, w = image.shape[:2]
     u, v = body.uv
     head = (
@@ -67,7 +69,7 @@ def not_found(
     vv, uu = np.mgrid[r0:r1, c0:c1]
     spot = (uu - u) ** 2 + (vv - v) ** 2 <= max(body.radius, 2.0) ** 2
     peak = float(np.percentile(diff[spot], 90)) if spot.any() else 0.0
-    noise = light.threshold()
+    noise = light.threshold(deviations=deviations)
     shift = light.change
     lit = (
         f"; frame 0 is {abs(shift):.0%} {'brighter' if shift > 0 else 'darker'} than the "
@@ -105,9 +107,9 @@ def not_found(
         f"it evenly, and film a plate of the empty scene (--background){lit}"
     )
     if low <= peak:
-        covered = sum(b.area for b, *_ in blobs if np.hypot(b.u - u, b.v - v) <= body.radius)
+        covered = float((diff[spot] > low).mean())
         return (
-            f"{head}; only {covered / body.area:.0%} of its area there differs from the "
+            f"{head}; only {covered:.0%} of its area there differs from the "
             f"background by more than the threshold of {low:.0f} grey levels (the frame's noise: "
             f"{noise:.0f}; the most contrasted tenth of it: {peak:.0f}): {fix}"
         )

@@ -565,7 +565,15 @@ class Tracker:
 
         s = self.states[i]
         missing = Missing(s.body.name, self.pred_uv[i], s.radius, s.area, s.body.position)
-        return not_found(missing, image, self.bg, self.light, self.low, median=self.median)
+        return not_found(
+            missing,
+            image,
+            self.bg,
+            self.light,
+            self.low,
+            median=self.median,
+            deviations=self.deviations,
+        )
 
     def _none_in_view(self) -> str:
         where = ", ".join(
