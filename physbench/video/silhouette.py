@@ -35,6 +35,9 @@ STEP = 0.5
 #: A smeared disc's outline is fitted as a stadium where its circle leaves this RMS (px) in its
 #: edges (a still disc's: 0.1-0.2 px).
 STADIUM_RMS = 0.25
+#: Directions (over half a turn) a smear is fitted along where the track's last direction of
+#: motion fits its edges worse than a circle.
+TURNS = 12
 #: Samples of foreground in a row that make the body's rim (1.5 px).
 RUN = 3
 #: Rays are this far apart (px) along the disc's outline: 43 rays on a 27 px disc, whose centre
@@ -434,6 +437,16 @@ def fit_discs(
             continue
         mine = own == d
         c, rd, spread, inner = _stadium(xy[mine], weight[mine], centre[d], r[d], along[d])
+        if spread / mpp_[d] >= rms[d]:
+            # Not a smear along the track's last direction of motion (a bounce has turned it
+            # since): the direction that fits the edges best, if any fits better than a circle.
+            for a in np.arange(0.0, math.pi, math.pi / TURNS):
+                way = np.array([math.cos(a), math.sin(a)])
+                other = _stadium(xy[mine], weight[mine], centre[d], r[d], way)
+                if other[2] < spread:
+                    c, rd, spread, inner = other
+            if spread / mpp_[d] >= rms[d]:
+                continue
         centre[d], r[d], rms[d] = c, rd, spread / mpp_[d]
         kept[d] = inner.sum()
     good = (kept >= 6) & ((gaps <= MAX_ARC_GAP) | fixed) & np.isfinite(r)
