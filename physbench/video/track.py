@@ -116,9 +116,10 @@ SMEAR = 0.2
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
 SMALL_DISC = 5.0
-#: A disc whose median contrast in the first frame is under this multiple of the noise threshold
-#: loses a share of its pixels to it (a mid-grey puck on bricks): the threshold then comes down
-#: to what the background's difference measured (:meth:`Tracker._tail_deviations`).
+#: A disc (of :data:`SMALL_DISC` px or more) whose median contrast in the first frame is under
+#: this multiple of the noise threshold loses a share of its pixels to it (a mid-grey puck on
+#: bricks): the threshold then comes down to what the background's difference measured
+#: (:meth:`Tracker._tail_deviations`).
 FAINT_DISC = 1.5
 #: The quantile of the first frame's difference, away from the bodies, that the noise threshold
 #: may come down to for a faint disc, and how far it may come down (robust deviations).
@@ -420,7 +421,10 @@ class Tracker:
                 patch = self.light.difference(image[box], self.bg[box], self.bg_index[box])
                 mid, s.contrast = (float(q) for q in np.percentile(patch, [50, 90]))
                 values.append(s.contrast)
-                faint |= s.disc and mid < FAINT_DISC * self.light.threshold()
+                # A disc of a few pixels has no inside to take a median over (its box is
+                # mostly rim and wall); it is found by its centroid or a matched filter instead.
+                outlined = s.disc and s.radius >= SMALL_DISC
+                faint |= outlined and mid < FAINT_DISC * self.light.threshold()
         self.contrast = float(np.median(values)) if values else 4 * self.light.threshold()
         for s in self.states:
             s.contrast = s.contrast or self.contrast
