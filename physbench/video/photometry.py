@@ -91,7 +91,7 @@ class Light:
             return difference(image, plate)
         if index is None:
             index = plate_index(plate)
-        return difference(image, self.lut.ravel().take(index))
+        return difference(image, self.lut.ravel().take(index, mode="clip"))  # no bounds check
 
 
 def plate_index(plate: np.ndarray) -> np.ndarray:
