@@ -214,7 +214,9 @@ def _edges_on(
     # steepest point near the threshold crossing: the rim's own brightness, not the shading
     # further in (a lit sphere brightens inwards from a limb as dark as the wall).
     rows = np.arange(len(p))
-    idx = np.clip(last[:, None] + np.arange(-k, 2), 0, m - 1)  # (n, k + 2): inside out
+    idx = np.minimum(
+        np.maximum(last[:, None] + np.arange(-k, 2), 0), m - 1
+    )  # (n, k + 2): inside out
     near = p[rows[:, None], idx]
     slope = near[:, :-1] - near[:, 1:]  # (n, k + 1): the fall over each step outwards
     outer = max(1, round(2.0 / STEP))
@@ -232,7 +234,7 @@ def _edges_on(
     at = near[:, :-1] >= level[:, None]
     j = k - np.argmax(at[:, ::-1], axis=1)
     pj, pn = near[rows, j], near[rows, j + 1]
-    frac = np.clip((pj - level) / np.maximum(pj - pn, 1e-6), 0.0, 1.0)
+    frac = np.minimum(np.maximum((pj - level) / np.maximum(pj - pn, 1e-6), 0.0), 1.0)
     dist = s[rows, idx[rows, j]] + STEP * frac
     width = s[rows, last] + 0.5 * STEP - dist
     return ok, dist, contrast, width

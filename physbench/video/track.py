@@ -1442,7 +1442,7 @@ def _alpha(colour: np.ndarray, behind: np.ndarray, diff: np.ndarray) -> np.ndarr
     flat = det < 0.05 * bb * gg  # hues too alike to unmix
     if flat.any():
         alpha[flat] = _project(c[flat], g[flat], np.broadcast_to(hue, c[flat].shape))
-    return np.clip(alpha, 0.0, None)
+    return np.maximum(alpha, 0.0)
 
 
 def _project(colour: np.ndarray, behind: np.ndarray, body: np.ndarray) -> np.ndarray:
