@@ -81,6 +81,14 @@ class Appearance:
     hue_spread: float = 0.0
     seen: int = 1
 
+    def __post_init__(self) -> None:
+        self._colour_changed()
+
+    def _colour_changed(self) -> None:
+        """Its colour's direction and brightness, which every detection is compared with."""
+        self._unit = _direction(self.colour)
+        self._brightness = float(np.sum(self.colour)) + 3 * DARK
+
     @classmethod
     def first(cls, look: Look) -> Appearance:
         return cls(look.size, np.asarray(look.colour, dtype=float))
@@ -99,10 +107,10 @@ class Appearance:
             return f"{ratio:.2f} times its size"
         if look.pixels < COLOUR_PIXELS:
             return None
-        hue = _length(_direction(look.colour) - _direction(self.colour))
+        hue = _length(_direction(look.colour) - self._unit)
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread):
             return f"another colour (hue {hue:.2f} off)"
-        bright = (float(np.sum(look.colour)) + 3 * DARK) / (float(np.sum(self.colour)) + 3 * DARK)
+        bright = (float(np.sum(look.colour)) + 3 * DARK) / self._brightness
         if not 1 / BRIGHTNESS_RATIO <= bright <= BRIGHTNESS_RATIO:
             return f"{bright:.2f} times its brightness"
         return None
@@ -114,10 +122,11 @@ class Appearance:
 
     def update(self, look: Look) -> None:
         """Called by the tracker with each accepted detection's appearance."""
-        hue = _length(_direction(look.colour) - _direction(self.colour))
+        hue = _length(_direction(look.colour) - self._unit)
         self.hue_spread += RATE * (hue - self.hue_spread)
         self.size += RATE * (look.size - self.size)
         self.colour = self.colour + RATE * (np.asarray(look.colour, dtype=float) - self.colour)
+        self._colour_changed()
         self.seen += 1
 
 

@@ -93,7 +93,7 @@ class Light:
             return difference(image, plate)
         if index is None:
             index = plate_index(plate)
-        return difference(image, self.lut.ravel().take(index))
+        return difference(image, self.lut.ravel().take(index, mode="clip"))  # no bounds check
 
 
 def plate_index(plate: np.ndarray) -> np.ndarray:
@@ -144,7 +144,7 @@ def _fit(x: np.ndarray, y: np.ndarray) -> Light:
     w = np.ones_like(x)
     for _ in range(2):
         z = r / scale
-        w = np.clip(1 - z * z, 0.0, None) ** 2
+        w = np.maximum(1 - z * z, 0.0) ** 2
         # Weighted sums of 1, x, y, xx and xy per channel, at once.
         wx = w * x
         sw, sx, sy = w.sum(axis=1), wx.sum(axis=1), (w * y).sum(axis=1)

@@ -217,7 +217,9 @@ def _edges_on(
     # steepest point near the threshold crossing: the rim's own brightness, not the shading
     # further in (a lit sphere brightens inwards from a limb as dark as the wall).
     rows = np.arange(len(p))
-    idx = np.clip(last[:, None] + np.arange(-k, 2), 0, m - 1)  # (n, k + 2): inside out
+    idx = np.minimum(
+        np.maximum(last[:, None] + np.arange(-k, 2), 0), m - 1
+    )  # (n, k + 2): inside out
     near = p[rows[:, None], idx]
     slope = near[:, :-1] - near[:, 1:]  # (n, k + 1): the fall over each step outwards
     outer = max(1, round(2.0 / STEP))
@@ -235,7 +237,7 @@ def _edges_on(
     at = near[:, :-1] >= level[:, None]
     j = k - np.argmax(at[:, ::-1], axis=1)
     pj, pn = near[rows, j], near[rows, j + 1]
-    frac = np.clip((pj - level) / np.maximum(pj - pn, 1e-6), 0.0, 1.0)
+    frac = np.minimum(np.maximum((pj - level) / np.maximum(pj - pn, 1e-6), 0.0), 1.0)
     dist = s[rows, idx[rows, j]] + STEP * frac
     width = s[rows, last] + 0.5 * STEP - dist
     return ok, dist, contrast, width
@@ -274,32 +276,48 @@ class _Groups:
 
 
 _ROW, _COLUMN = np.repeat(np.arange(3), 4), np.tile(np.arange(4), 3)
+_EYE = np.eye(3)
 
 
-def _circles(xy: np.ndarray, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray, np.ndarray]:
-    """Each group's weighted least-squares circle through its points ``xy`` (algebraic: Kasa, by
+@dataclass(frozen=True)
+class _Centred:
+    """Points ``xy`` ``(n, 2)`` about their group's mean, as the algebraic circle fit's normal
+    equations use them: built once for the weightings :func:`fit_discs` tries."""
+
+    mean: np.ndarray  # (count, 2)
+    rows: np.ndarray  # (n, 12): a_i of the products a_i a_j (i < 3, j < 4)
+    columns: np.ndarray  # (n, 12): a_j
+
+    @classmethod
+    def of(cls, xy: np.ndarray, g: _Groups) -> _Centred:
+        some = g.sizes > 0
+        mean = np.zeros((g.count, 2))
+        mean[some] = np.add.reduceat(xy, g.starts[some], axis=0) / g.sizes[some, None]
+        a = np.ones((len(xy), 4))
+        a[:, :2] = xy - mean[g.owner]
+        a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
+        return cls(mean, a[:, _ROW], a[:, _COLUMN])
+
+
+def _circles(points: _Centred, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray, np.ndarray]:
+    """Each group's weighted least-squares circle through its ``points`` (algebraic: Kasa, by
     its normal equations), as centres ``(count, 2)`` and radii ``(count,)``; NaN for a group
     without three weighted points."""
     some = g.sizes > 0
-    mean = np.zeros((g.count, 2))
-    mean[some] = np.add.reduceat(xy, g.starts[some], axis=0) / g.sizes[some, None]
-    a = np.ones((len(xy), 4))
-    a[:, :2] = xy - mean[g.owner]
-    a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
     # The products a_i a_j (weighted, i < 3, j < 4) as 12 columns: an (n, 3, 4) broadcast costs
     # several times as much for the same values.
-    outer = (a[:, :3] * weight[:, None])[:, _ROW] * a[:, _COLUMN]  # (n, 12)
+    outer = points.rows * weight[:, None] * points.columns  # (n, 12)
     m = np.zeros((g.count, 3, 4))
     m[some] = np.add.reduceat(outer, g.starts[some], axis=0).reshape(-1, 3, 4)
     sol = np.full((g.count, 3), np.nan)
     ok = g.total(weight > 0) >= 3
     if ok.any():
         lhs = m[ok, :, :3]
-        lhs += 1e-12 * np.trace(lhs, axis1=1, axis2=2)[:, None, None] * np.eye(3)
+        lhs += 1e-12 * np.trace(lhs, axis1=1, axis2=2)[:, None, None] * _EYE
         sol[ok] = np.linalg.solve(lhs, m[ok, :, 3:])[:, :, 0]
     c = sol[:, :2] / 2
     r = np.sqrt(np.maximum(sol[:, 2] + (c * c).sum(axis=1), 0.0))
-    return c + mean, r
+    return c + points.mean, r
 
 
 def _circle_of_radius(
@@ -409,18 +427,19 @@ def fit_discs(
     np.maximum.at(top, own, e.contrast)
     sharp = np.minimum(1.0, g.median(e.width)[own] / np.maximum(e.width, 1e-3))
     weight = (np.minimum(1.0, e.contrast / (0.5 * top[own])) * sharp) ** 2
-    centre, r = _circles(xy, weight, g)
+    points = _Centred.of(xy, g)
+    centre, r = _circles(points, weight, g)
     res = np.abs(np.hypot(*(xy - centre[own]).T) - r[own])
     # Least trimmed squares: the three quarters nearest the circle (a highlight's rim is a tight
     # cluster of edges inside the outline, which a fit to all of them leans to).
     trim = g.rank(np.where(np.isnan(res), np.inf, res)) < np.maximum(6, 3 * g.sizes // 4)[own]
-    centre, r = _circles(xy, weight * trim, g)
+    centre, r = _circles(points, weight * trim, g)
     dist = np.hypot(*(xy - centre[own]).T)
     res = dist - r[own]
     scale = 1.4826 * g.median(np.where(trim, np.abs(res), np.inf))
     bound = np.maximum(3.0 * scale, 0.75 * mpp_)
     keep = (np.abs(res) <= bound[own]) & (dist >= 0.7 * np.maximum(r, radius * mpp_)[own])
-    centre, r = _circles(xy, weight * keep, g)
+    centre, r = _circles(points, weight * keep, g)
     kept = g.total(keep)
     gaps = _arc_gaps(e.theta[keep], _Groups.of(own[keep], count))
     fixed = np.zeros(count, dtype=bool)

@@ -79,8 +79,6 @@ from physbench.video.photometry import DEVIATIONS, Light, LightMeter, plate_inde
 from physbench.video.silhouette import (
     DiscFit,
     Rays,
-    edge_points,
-    fit_disc,
     fit_discs,
     window_edges,
 )
@@ -766,7 +764,8 @@ class Tracker:
             )
             if not blobs:
                 continue
-            own = [_Split(self._own_colours, image, blob, group) for blob in blobs]
+            colours = _Lazy(self._own_colours, image, blobs, group)
+            own = [_Split(colours, c) for c in range(len(blobs))]
             owner, dist = self._assign(group, blobs, gates, own)
             for c, members in owner.items():
                 mixed = len(members) > 1 or (
@@ -848,6 +847,8 @@ class Tracker:
         preds = self.pred_uv[ids]
         centres = np.array([b[0].centre for b in blobs])
         dist = np.hypot(*(preds[:, None, :] - centres[None]).transpose(2, 0, 1))
+        if len(ids) == 1 and len(blobs) == 1 and dist[0, 0] <= gates[ids[0]]:
+            return {0: list(ids)}, dist  # most windows: what the general case gives it
         big = 1e9
         cost = np.where(dist <= gates[ids][:, None], dist, big)
         rows, cols = linear_sum_assignment(cost)
@@ -907,15 +908,23 @@ class Tracker:
                     owner.setdefault(int(c), []).append(i)
                     break
 
-    def _own_colours(self, image: np.ndarray, found_blob: tuple, ids: list[int]) -> dict:
-        """Which pixels of a blob are of each body's colour, for the bodies of ``ids`` whose
-        looks are known."""
+    def _own_colours(
+        self, image: np.ndarray, blobs: list, ids: list[int]
+    ) -> list[dict[int, np.ndarray]]:
+        """Which pixels of each of a window's blobs are of each body's colour, for the bodies of
+        ``ids`` whose looks are known (all the window's blobs in one pass)."""
         looks = {i: self.states[i].look for i in ids}
         known = {i: look for i, look in looks.items() if look is not None}
         if not known:
-            return {}
-        masks = matching(list(known.values()), *self._colours(image, found_blob))
-        return {i: masks[:, k] for k, i in enumerate(known)}
+            return [{} for _ in blobs]
+        u = np.concatenate([b[1] for b in blobs])
+        v = np.concatenate([b[2] for b in blobs])
+        masks = matching(list(known.values()), *self._colours(image, u, v))
+        ends = np.cumsum([len(b[1]) for b in blobs]).tolist()
+        return [
+            {i: masks[a:b, k] for k, i in enumerate(known)}
+            for a, b in zip([0, *ends[:-1]], ends, strict=True)
+        ]
 
     def _members(
         self,
@@ -996,10 +1005,11 @@ class Tracker:
             out[i] = got
         return out
 
-    def _colours(self, image: np.ndarray, found_blob: tuple) -> tuple[np.ndarray, np.ndarray]:
-        """A blob's pixels' colours in the background's light, as directions and lengths
+    def _colours(
+        self, image: np.ndarray, u: np.ndarray, v: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The colours of pixels ``(u, v)`` in the background's light, as directions and lengths
         (:func:`~physbench.video.appearance.colour_directions`)."""
-        _, u, v, _ = found_blob
         raw = image[v.astype(np.intp), u.astype(np.intp)]
         return colour_directions((raw - self.light.offset) / self.light.gain)
 
@@ -1068,13 +1078,13 @@ class Tracker:
                 [self._smeared(i) for i in order],
             )
             fits.update(zip(order, got, strict=True))
-        for i in outside:
-            fits[i] = self._fit_one(image, plans[i][0])
+        fits.update(zip(outside, self._fit_own(image, [plans[i][0] for i in outside]), strict=True))
+        again = {}
         for i, fit in fits.items():
             rays = plans[i][0].rays
             if fit is not None and float(np.hypot(*(fit.uv - rays.centre))) > 0.25 * rays.radius:
-                again = replace(plans[i][0], rays=replace(rays, centre=fit.uv))
-                fits[i] = self._fit_one(image, again)
+                again[i] = replace(plans[i][0], rays=replace(rays, centre=fit.uv))
+        fits.update(zip(again, self._fit_own(image, list(again.values())), strict=True))
         return fits
 
     def _smeared(self, i: int) -> np.ndarray | None:
@@ -1087,19 +1097,33 @@ class Tracker:
             return None
         return s.v / speed
 
-    def _fit_one(self, image: np.ndarray, plan: _Plan) -> DiscFit | None:
-        """One disc's outline fit on a crop of its own."""
-        rays = plan.rays
-        c, m = rays.centre, rays.reach + 2.0
-        r0, r1 = max(0, math.floor(c[1] - m)), min(self.h, math.ceil(c[1] + m) + 1)
-        c0, c1 = max(0, math.floor(c[0] - m)), min(self.w, math.ceil(c[0] + m) + 1)
-        if r1 - r0 < 3 or c1 - c0 < 3:
-            return None
-        diff = self.light.difference(
-            image[r0:r1, c0:c1], self.bg[r0:r1, c0:c1], self.bg_index[r0:r1, c0:c1]
-        )
-        edges = edge_points(diff, (r0, c0), [rays], self.edge_low)
-        return fit_disc(edges, rays.radius, self.cal, plan.mpp, plan.known)
+    def _fit_own(self, image: np.ndarray, plans: list[_Plan]) -> list[DiscFit | None]:
+        """Each disc's outline fit on a crop of its own (all in one pass)."""
+        crops, fitted = [], []
+        for k, plan in enumerate(plans):
+            rays = plan.rays
+            c, m = rays.centre, rays.reach + 2.0
+            r0, r1 = max(0, math.floor(c[1] - m)), min(self.h, math.ceil(c[1] + m) + 1)
+            c0, c1 = max(0, math.floor(c[0] - m)), min(self.w, math.ceil(c[0] + m) + 1)
+            if r1 - r0 < 3 or c1 - c0 < 3:
+                continue
+            box = (slice(r0, r1), slice(c0, c1))
+            diff = self.light.difference(image[box], self.bg[box], self.bg_index[box])
+            crops.append((diff, (r0, c0), [rays]))
+            fitted.append(k)
+        fits: list[DiscFit | None] = [None] * len(plans)
+        if fitted:
+            mine = [plans[k] for k in fitted]
+            got = fit_discs(
+                window_edges(crops, self.edge_low),
+                [p.rays.radius for p in mine],
+                self.cal,
+                [p.mpp for p in mine],
+                [p.known for p in mine],
+            )
+            for k, fit in zip(fitted, got, strict=True):
+                fits[k] = fit
+        return fits
 
     def _disc(
         self,
@@ -1131,9 +1155,11 @@ class Tracker:
             u, v, w = plan.pixels
         near = (u - fit.uv[0]) ** 2 + (v - fit.uv[1]) ** 2
         area = float(w[near <= (rf + 1.0) ** 2].sum())
-        inner = near <= (0.6 * rf) ** 2
+        inner = np.flatnonzero(near <= (0.6 * rf) ** 2)
+        if len(inner) > 64:
+            inner = inner[::4]  # the pixels _look would keep, gathered alone
         colours = image[v[inner].astype(np.intp), u[inner].astype(np.intp)]
-        look = self._look(i, area, colours, None, mpp=plan.mpp)
+        look = self._look(i, area, colours, None, mpp=plan.mpp, thinned=True)
         radius = None if fit.fixed else fit.radius
         return _Found(fit.xy, fit.uv, PlanePose(fit.xy, 0.0, 1.0, 0.0), look, radius)
 
@@ -1177,18 +1203,19 @@ class Tracker:
         *,
         mpp: float | None = None,
         at: np.ndarray | None = None,
+        thinned: bool = False,
     ) -> Look:
         """What body ``i``'s detection looks like: its covered ``area`` (px) over the scene's
         area for the body (``mpp`` metres per pixel, or at pixel ``at``, or at its prediction),
         and the median colour of ``colours`` (``(n, 3)``; with ``weights``, of the best covered
-        quarter, which motion blur mixes least with the wall; every 4th of many) in the
-        background's light."""
+        quarter, which motion blur mixes least with the wall; every 4th of many, unless
+        ``thinned`` so already) in the background's light."""
         if mpp is None:
             mpp = self._mpp(self.pred_uv[i] if at is None else at)
         expected = self.states[i].body.shape.area() / mpp**2
         if weights is not None and len(colours) > 3:
             colours = colours[weights >= np.percentile(weights, 75)]
-        if len(colours) > 64:
+        if len(colours) > 64 and not thinned:
             colours = colours[::4]
         raw = median(colours, axis=0) if len(colours) else np.zeros(3)
         colour = (raw - self.light.offset) / np.maximum(self.light.gain, 1e-3)
@@ -1467,7 +1494,7 @@ def _alpha(colour: np.ndarray, behind: np.ndarray, diff: np.ndarray) -> np.ndarr
     flat = det < 0.05 * bb * gg  # hues too alike to unmix
     if flat.any():
         alpha[flat] = _project(c[flat], g[flat], np.broadcast_to(hue, c[flat].shape))
-    return np.clip(alpha, 0.0, None)
+    return np.maximum(alpha, 0.0)
 
 
 def _project(colour: np.ndarray, behind: np.ndarray, body: np.ndarray) -> np.ndarray:
@@ -1483,18 +1510,29 @@ def _colours_of(found_blob: tuple, own: Mapping[int, np.ndarray], states: list[_
     return sum(float(w[mask].sum()) >= 0.2 * states[i].area for i, mask in own.items())
 
 
-class _Split(Mapping[int, np.ndarray]):
-    """A blob's pixels of each body's colour, ``split(*args)`` (:meth:`Tracker._own_colours`),
-    split when first asked for: most blobs are one body's alone, which never asks."""
+class _Lazy:
+    """``split(*args)`` (:meth:`Tracker._own_colours`: every blob of a window's pixels of each
+    body's colour), computed when first asked for: most windows' blobs are one body's alone,
+    which never asks."""
 
-    def __init__(self, split: Callable[..., dict[int, np.ndarray]], *args: object) -> None:
+    def __init__(self, split: Callable[..., list[dict[int, np.ndarray]]], *args: object) -> None:
         self._split, self._args = split, args
-        self._masks: dict[int, np.ndarray] | None = None
+        self._masks: list[dict[int, np.ndarray]] | None = None
 
-    def _get(self) -> dict[int, np.ndarray]:
+    def get(self) -> list[dict[int, np.ndarray]]:
         if self._masks is None:
             self._masks = self._split(*self._args)
         return self._masks
+
+
+class _Split(Mapping[int, np.ndarray]):
+    """Blob ``c``'s pixels of each body's colour, from its window's :class:`_Lazy` masks."""
+
+    def __init__(self, window: _Lazy, c: int) -> None:
+        self._window, self._c = window, c
+
+    def _get(self) -> dict[int, np.ndarray]:
+        return self._window.get()[self._c]
 
     def __getitem__(self, i: int) -> np.ndarray:
         return self._get()[i]

@@ -40,7 +40,7 @@ def test_the_median_removes_a_moving_body_and_holds_few_frames() -> None:
         median_background(iter([]))
 
 
-@pytest.mark.parametrize("n", [7, 8])
+@pytest.mark.parametrize("n", [1, 2, 7, 8, 15, 31])
 def test_the_median_is_numpys_median(n: int) -> None:
     from physbench.video.background import _median
 
