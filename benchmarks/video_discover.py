@@ -229,6 +229,7 @@ def main(argv: list[str] | None = None) -> int:
     elif partial.exists():
         partial.unlink()
     done = {key(r) for r in rows}
+    code = args.label or _commit()  # the code that runs: taken before, not after, a long run
     t0 = time.perf_counter()
     for i, c in enumerate(todo):
         if c in done:
@@ -248,7 +249,7 @@ def main(argv: list[str] | None = None) -> int:
             flush=True,
         )
     payload = {
-        "code": args.label or _commit(),
+        "code": code,
         "camera_kind": args.camera,
         "camera": FILM if args.camera == "camera" else "field (a domain per case: rows[].field)",
         "seeds": args.seeds,
