@@ -341,6 +341,7 @@ class Tracker:
         self.contrast = 0.0  # the bodies' median contrast in the first frame's light
         self.deviations = DEVIATIONS  # the noise threshold in robust deviations
         self.scale0 = 1.0  # the first frame's gain
+        self.brighter = 1.0  # this frame's gain over the first's
         self.max_gate = 0.5 * max(self.h, self.w)
         self.pred_xy = np.zeros((len(self.states), 2))
         self.pred_uv = np.zeros((len(self.states), 2))
@@ -451,7 +452,8 @@ class Tracker:
     def _thresholds(self) -> None:
         """This frame's thresholds: above its noise, and a share of the bodies' contrast in its
         light."""
-        contrast = self.contrast * self.light.scale / self.scale0
+        self.brighter = self.light.scale / self.scale0  # contrasts grow with the light
+        contrast = self.contrast * self.brighter
         self.low = max(self.light.threshold(deviations=self.deviations), 0.2 * contrast)
         self.high = max(self.low + 1.0, 0.5 * contrast)
         # An edge is placed by its own half-way point, so it may be fainter than what makes a
@@ -464,7 +466,7 @@ class Tracker:
         faintest of their contrasts in this frame's light, where that is under the frame's
         (half the bodies' median): a light puck beside a dark one was lost in 7 of 41 frames
         of its blurred, faintest moments, none of its pixels above the dark one's half."""
-        faintest = min(self.states[i].contrast for i in group) * self.light.scale / self.scale0
+        faintest = min(self.states[i].contrast for i in group) * self.brighter
         return max(self.low + 1.0, min(self.high, 0.5 * faintest))
 
     # ----------------------------------------------------------------- one frame
