@@ -70,19 +70,23 @@ def test_the_table_is_the_results() -> None:
     assert f"False alarms on controls: {alarms} of {len(CONTROLS)}" in table
 
 
-def test_bodies_of_two_pixels_or_more_are_right_but_three_pucks_and_a_bounce() -> None:
+def test_bodies_of_two_pixels_or_more_are_right_but_one_magnitude_at_the_line() -> None:
     big = [r for r in ROWS if r["body_px"] >= TINY]
-    assert (len(big), sum(right(r) for r in big)) == (200, 196)
-    # Refused: two pucks not found in the first frame, one lost for 17 % of its frames, on
-    # bricks (the frame's threshold, six robust deviations, is above every background pixel's
-    # difference; docs/video.md).
-    refused = Counter(r["scene"] for r in big if "filmed_failure" in r)
-    assert refused == Counter({"two_pucks": 1, "puck_kicked": 1, "puck": 1})
-    wrong = [r for r in big if not right(r) and "filmed_failure" not in r]
-    # the frames after a bounce are about a pixel off and one of them is kept: a false clock_scale
+    assert (len(big), sum(right(r) for r in big)) == (200, 199)
+    # None refused: the three pucks on bricks refused before (a threshold of six robust
+    # deviations above most of their pixels) are found since a faint disc brings it down to
+    # the background's own tail, and a light puck beside a dark one is seeded by its own
+    # contrast (docs/video.md).
+    assert not any("filmed_failure" in r for r in big)
+    for case in ("quadratic_drag/puck/pymunk/2", "table_tilt/two_pucks/box2d/0"):
+        assert right(next(r for r in big if name(r) == case))
+    # The one miss: a 6 % calibration scale named first, its magnitude 10.7 % off (8.7 % in
+    # the grid before): a weak measurement effect at the tolerance's line.
+    wrong = [r for r in big if not right(r)]
     assert [(name(r), r["filmed"]["causes"]) for r in wrong] == [
-        ("control/bouncer/pymunk/0", ["clock_scale"])
+        ("calibration_scale/puck_kicked/pymunk/1", ["calibration_scale"])
     ]
+    assert wrong[0]["filmed"]["error"] < 0.11
 
 
 def test_every_turning_arm_is_right_since_it_is_centred_between_its_ends() -> None:
@@ -96,10 +100,21 @@ def test_every_turning_arm_is_right_since_it_is_centred_between_its_ends() -> No
 
 def test_balls_under_two_pixels_are_mostly_lost() -> None:
     tiny = [r for r in ROWS if r["body_px"] < TINY]
-    assert (len(tiny), sum(right(r) for r in tiny)) == (70, 15)
+    assert (len(tiny), sum(right(r) for r in tiny)) == (70, 16)
     assert sum("filmed_failure" in r for r in tiny) == 51
+
+
+def test_no_control_raises_a_false_alarm() -> None:
+    # The bouncing-ball control named clock_scale before: after a bounce its smear was fitted
+    # along the direction before the bounce (the first frame after it 1.7 px off). Its stadium
+    # is now kept only where it fits better than a circle, else searched over twelve
+    # directions: that frame is 0.9 px off, the next is left out at the wall's bounce, and the
+    # one after, whose exposure may span that bounce, is 1.7 px off (1.3 before). Whether the
+    # alarm is gone for good or by the frames' new balance is not established (docs/video.md).
     alarms = [r for r in CONTROLS if not right(r) and "filmed_failure" not in r]
-    assert [name(r) for r in alarms] == ["control/bouncer/pymunk/0"]
+    assert alarms == []
+    bouncer = next(r for r in CONTROLS if name(r) == "control/bouncer/pymunk/0")
+    assert right(bouncer) and bouncer["field"]["centre_px"]["ball"]["max"] < 1.7
 
 
 def test_the_refused_tiny_balls_are_mostly_absent_from_the_coded_pixels() -> None:
