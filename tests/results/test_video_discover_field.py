@@ -10,7 +10,6 @@ were centred between their ends, with the reruns and the visibility study made a
 from __future__ import annotations
 
 import json
-from collections import Counter
 from pathlib import Path
 
 from physbench.discover.synthetic import EFFECT_SCENES, SCENES
