@@ -1071,14 +1071,7 @@ class Tracker:
         fits: dict[int, DiscFit | None] = {}
         if order:
             mine = [plans[i][0] for i in order]
-            got = fit_discs(
-                window_edges(found, self.edge_low),
-                [p.rays.radius for p in mine],
-                self.cal,
-                [p.mpp for p in mine],
-                [p.known for p in mine],
-                [self._smeared(i) for i in order],
-            )
+            got = self._fit_on(found, mine, [self._smeared(i) for i in order])
             fits.update(zip(order, got, strict=True))
         fits.update(zip(outside, self._fit_own(image, [plans[i][0] for i in outside]), strict=True))
         again = {}
@@ -1115,17 +1108,27 @@ class Tracker:
             fitted.append(k)
         fits: list[DiscFit | None] = [None] * len(plans)
         if fitted:
-            mine = [plans[k] for k in fitted]
-            got = fit_discs(
-                window_edges(crops, self.edge_low),
-                [p.rays.radius for p in mine],
-                self.cal,
-                [p.mpp for p in mine],
-                [p.known for p in mine],
-            )
+            got = self._fit_on(crops, [plans[k] for k in fitted])
             for k, fit in zip(fitted, got, strict=True):
                 fits[k] = fit
         return fits
+
+    def _fit_on(
+        self,
+        windows: list[tuple[np.ndarray, tuple[int, int], list[Rays]]],
+        plans: list[_Plan],
+        along: list[np.ndarray | None] | None = None,
+    ) -> list[DiscFit | None]:
+        """The discs of ``plans`` fitted to the edges their rays find on ``windows`` (each a
+        difference, its origin and its rays, in the plans' order), in one call."""
+        return fit_discs(
+            window_edges(windows, self.edge_low),
+            [p.rays.radius for p in plans],
+            self.cal,
+            [p.mpp for p in plans],
+            [p.known for p in plans],
+            along,
+        )
 
     def _disc(
         self,
