@@ -52,7 +52,7 @@ def test_no_false_alarm_on_filmed_controls() -> None:
     alarms = [(r["scene"], r["engine"], r["seed"]) for r in tracked if not r["filmed"]["ok"]]
     assert alarms == []  # measured: 0 of 90 (11 before the shared-blob and collision fixes)
     # three controls of two 1 px balls are refused (a ball lost for 20-27 % of its frames);
-    # five of six were with the tracker this session started from
+    # (five of six were with the tracker before the threshold and stadium changes, e8832a0)
     refused = [r for r in CONTROLS if "filmed_failure" in r]
     assert {r["scene"] for r in refused} == {"two_projectiles"} and len(refused) == 3
     assert all(r["body_px"] < 1.0 for r in refused)
