@@ -463,11 +463,16 @@ class Tracker:
 
     def _high(self, group: list[int]) -> float:
         """The threshold a blob of a window holding ``group`` must reach somewhere: half the
-        faintest of their contrasts in this frame's light, where that is under the frame's
-        (half the bodies' median): a light puck beside a dark one was lost in 7 of 41 frames
-        of its blurred, faintest moments, none of its pixels above the dark one's half."""
-        faintest = min(self.states[i].contrast for i in group) * self.brighter
-        return max(self.low + 1.0, min(self.high, 0.5 * faintest))
+        faintest contrast in this frame's light of those of :data:`SMALL_DISC` px or more, where
+        that is under the frame's (half the bodies' median): a light puck beside a dark one was
+        lost in 7 of 41 frames of its blurred, faintest moments, none of its pixels above the
+        dark one's half. A body of a few pixels keeps the frame's: its smallest blob is a pixel
+        or two, which a seed just above the noise threshold lets noise make (two balls of 2-3 px
+        were then swapped, 50-60 px off)."""
+        sized = [self.states[i].contrast for i in group if self.states[i].radius >= SMALL_DISC]
+        if not sized:
+            return self.high
+        return max(self.low + 1.0, min(self.high, 0.5 * min(sized) * self.brighter))
 
     # ----------------------------------------------------------------- one frame
 
