@@ -466,9 +466,10 @@ class Tracker:
         faintest contrast in this frame's light of those of :data:`SMALL_DISC` px or more, where
         that is under the frame's (half the bodies' median): a light puck beside a dark one was
         lost in 7 of 41 frames of its blurred, faintest moments, none of its pixels above the
-        dark one's half. A body of a few pixels keeps the frame's: its smallest blob is a pixel
-        or two, which a seed just above the noise threshold lets noise make (two balls of 2-3 px
-        were then swapped, 50-60 px off)."""
+        dark one's half. A body of a few pixels keeps the frame's: with the lower seed, two
+        balls of 1.7-3.5 px at 1280x960 were tracked 50-60 px off (95th percentile) and a
+        control named a cause; likely, as a blob of such a body is a pixel or two, noise just
+        above the threshold made some (not measured)."""
         sized = [self.states[i].contrast for i in group if self.states[i].radius >= SMALL_DISC]
         if not sized:
             return self.high
