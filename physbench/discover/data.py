@@ -179,18 +179,30 @@ def load_runs(
 
 
 def _tracker_run(path: Path, scene: Scene) -> Run:
-    """The hand-marked points of a Tracker project as one run; every marked track must be a
-    body of the scene."""
+    """The hand-marked points of a Tracker project as one run: its tracks named after the
+    scene's bodies (a project may mark more than the scene models, such as both ends of a
+    spinning body, or a second ball; those left out are said on stderr)."""
+    import sys
+    from dataclasses import replace
+
     from physbench.tracker_files import read_tracker_project
 
     rec = read_tracker_project(path).recording()
-    unknown = [b for b in rec.bodies if b not in scene.body_names]
-    if unknown:
+    kept = [b for b in rec.bodies if b in scene.body_names]
+    left = [b for b in rec.bodies if b not in scene.body_names]
+    if not kept:
         raise DiscoverError(
-            f"{path}: Tracker track {unknown[0]!r} is not a body of scene {scene.name!r} "
-            f"(bodies: {', '.join(scene.body_names)}); name the scene's body after the track "
-            "(physbench scene new --from the project does)"
+            f"{path}: no Tracker track is a body of scene {scene.name!r} (tracks: "
+            f"{', '.join(map(repr, left))}; bodies: {', '.join(scene.body_names)}); name the "
+            "scene's body after the track (physbench scene new --from the project does)"
         )
+    if left:
+        print(
+            f"{path}: Tracker track{'s' if len(left) > 1 else ''} {', '.join(map(repr, left))} "
+            f"left out: not a body of scene {scene.name!r}",
+            file=sys.stderr,
+        )
+        rec = replace(rec, tracks={b: rec.tracks[b] for b in kept})
     return Run(path.stem, scene, recording=rec, source=str(path))
 
 

@@ -138,4 +138,26 @@ def test_discover_names_a_track_the_scene_lacks(tmp_path, throw, capsys) -> None
     scene_file.write_text(scene_file.read_text().replace('name = "ball"', 'name = "stone"'))
     capsys.readouterr()
     assert cli(["discover", str(path), "--scene", str(scene_file)]) == 2
-    assert "Tracker track 'ball' is not a body of scene" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "no Tracker track is a body of scene" in err
+    assert "tracks: 'ball'; bodies: stone" in err
+
+
+def test_a_project_with_more_tracks_than_the_scene_keeps_the_scenes(tmp_path, trk, capsys) -> None:  # type: ignore[no-untyped-def]
+    """A project that marks more than the scene models (both ends of a spinning diabolo, a
+    second ball) gives the tracks named after the scene's bodies, and says which it left out."""
+    from physbench.discover.data import load_runs
+
+    ball = {5 + 2 * k: (100.0 + 3 * k, 200.0 - 2 * k) for k in range(10)}
+    hand = {5 + 2 * k: (300.0, 100.0 + k) for k in range(10)}
+    text = trk(
+        origin=ORIGIN, angle=ANGLE, scale=SCALE, unit="cm", marks={"ball": ball, "hand": hand}
+    )
+    two = tmp_path / "two.trk"
+    two.write_text(text)
+    scene = Scene("throw", (Body("ball", Circle(0.03), (1.0, 1.0)),), fps=15.0, frames=14)
+    (run,) = load_runs(two, scene)
+    assert run.recording is not None
+    assert run.recording.bodies == ("ball",)
+    assert len(run.recording.track("ball").t) == 10
+    assert "Tracker track 'hand' left out: not a body of scene 'throw'" in capsys.readouterr().err
