@@ -12,6 +12,13 @@ import numpy as np
 
 from physbench.errors import PhysbenchError
 
+#: Threads every encoder runs with. x264's output depends on its thread count, which FFmpeg sets
+#: from the machine's cores by default: the same frames coded on one core and on two differ (a
+#: ball's highlight came out with a hole on one core only). A fixed count makes a clip the same
+#: on every machine; 2 is what the committed results were filmed with (2-core machines), so they
+#: are unchanged, byte for byte.
+ENCODER_THREADS = 2
+
 
 class CodecError(PhysbenchError, ValueError):
     """PyAV is missing, or a codec failed: names what to install or what went wrong."""
@@ -47,6 +54,7 @@ def h264_round_trip(frames: np.ndarray, fps: float, bitrate: float, crf: int | N
     enc = av.CodecContext.create("libx264", "w")
     enc.width, enc.height = padded.shape[2], padded.shape[1]
     enc.pix_fmt = "yuv420p"
+    enc.thread_count = ENCODER_THREADS
     rate = Fraction(fps).limit_denominator(1001)
     enc.framerate = rate
     enc.time_base = 1 / rate

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.codec import even, load_av
+from physbench.codec import ENCODER_THREADS, even, load_av
 from physbench.video.reader import VideoError
 from physbench.video.transfer import CODES, check_transfer
 
@@ -57,6 +57,7 @@ def write_video(
         stream.time_base = TIME_BASE
         stream.codec_context.time_base = TIME_BASE  # frame pts are in these ticks, not 1/fps
         stream.pix_fmt = "yuv420p"
+        stream.codec_context.thread_count = ENCODER_THREADS  # the same file on any machine
         if bitrate is not None:
             stream.bit_rate = int(bitrate)
         if crf is not None:
