@@ -282,11 +282,17 @@ class _Plan:
 @dataclass(frozen=True)
 class TrackResult:
     """The :class:`~physbench.recording.Recording` (scene metres, t = 0 at the first frame), the
-    :class:`TrackSummary`, and each body's image track ``(t, u, v)`` (px) for overlays."""
+    :class:`TrackSummary`, each body's image track ``(t, u, v)`` (px) for overlays, and
+    ``measured``: the recording with every frame where a body was measured, those whose exposure
+    spans a collision included. The recording leaves those out (a blurred pose across a
+    collision is no state to fit); where a frame's pixels are split among the bodies
+    (:func:`~physbench.video.footage.video_observation`) the measured pose is still the best
+    guess, and one interpolated across the collision is not."""
 
     recording: Recording
     summary: TrackSummary
     pixels: dict[str, np.ndarray]
+    measured: Recording
 
 
 class Tracker:
@@ -1250,10 +1256,12 @@ class Tracker:
         }
         mpp = {name: self._coarsest(tuv) for name, tuv in pixels.items()}
         accuracy_m = {name: accuracy_px[name] * mpp[name] for name in accuracy_px}
-        tracks = {}
+        tracks, measured = {}, {}
         contacts: dict[str, int] = {}
         for s in self.states:
             rows = np.array(s.rows, dtype=float)
+            every = rows[:, 3] if s.k and not np.isnan(rows[:, 3]).any() else None
+            measured[s.body.name] = Track(rows[:, 0], rows[:, 1], rows[:, 2], every)
             if s.free:
                 hit = contact_samples(
                     rows[:, 0],
@@ -1299,7 +1307,7 @@ class Tracker:
             {s.body.name: s.centroids for s in self.states if s.centroids},
             {n: round(a, 5) for n, a in angle_accuracy.items()},
         )
-        return TrackResult(recording, summary, pixels)
+        return TrackResult(recording, summary, pixels, replace(recording, tracks=measured))
 
     def _explained(self, body: str, t: np.ndarray) -> np.ndarray | None:
         """The second differences' accelerations (m/s², ``(n - 2, 2)``) that the scene's
