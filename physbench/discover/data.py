@@ -181,10 +181,12 @@ def load_runs(
 def _tracker_run(path: Path, scene: Scene) -> Run:
     """The hand-marked points of a Tracker project as one run: its tracks named after the
     scene's bodies (a project may mark more than the scene models, such as both ends of a
-    spinning body, or a second ball; those left out are said on stderr)."""
-    import sys
+    spinning body, or a second ball; those left out are named in a
+    :class:`~physbench.errors.PhysbenchWarning`)."""
+    import warnings
     from dataclasses import replace
 
+    from physbench.errors import PhysbenchWarning
     from physbench.tracker_files import read_tracker_project
 
     rec = read_tracker_project(path).recording()
@@ -197,10 +199,11 @@ def _tracker_run(path: Path, scene: Scene) -> Run:
             "scene's body after the track (physbench scene new --from the project does)"
         )
     if left:
-        print(
+        warnings.warn(
             f"{path}: Tracker track{'s' if len(left) > 1 else ''} {', '.join(map(repr, left))} "
             f"left out: not a body of scene {scene.name!r}",
-            file=sys.stderr,
+            PhysbenchWarning,
+            stacklevel=3,
         )
         rec = replace(rec, tracks={b: rec.tracks[b] for b in kept})
     return Run(path.stem, scene, recording=rec, source=str(path))
