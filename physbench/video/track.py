@@ -86,7 +86,7 @@ from physbench.video.transfer import Decoder
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
-    from physbench.recording import Recording
+    from physbench.recording import Recording, Track
     from physbench.scene import Body, Scene
     from physbench.video.reader import Frame
 
@@ -1243,7 +1243,7 @@ class Tracker:
     def result(self, calibration_error: float | None = None, fps: float = 0.0) -> TrackResult:
         """The recording, summary and image tracks of the frames seen so far. A body never found
         is a :class:`TrackError` that says where the scene put it."""
-        from physbench.recording import Recording, Track
+        from physbench.recording import Recording
 
         if self.frames == 0:
             raise TrackError("no frames were tracked: the video (or its --start/--end) is empty")
@@ -1260,8 +1260,7 @@ class Tracker:
         contacts: dict[str, int] = {}
         for s in self.states:
             rows = np.array(s.rows, dtype=float)
-            every = rows[:, 3] if s.k and not np.isnan(rows[:, 3]).any() else None
-            measured[s.body.name] = Track(rows[:, 0], rows[:, 1], rows[:, 2], every)
+            measured[s.body.name] = _track(rows, turning=bool(s.k))
             if s.free:
                 hit = contact_samples(
                     rows[:, 0],
@@ -1273,8 +1272,7 @@ class Tracker:
                 if hit.any():
                     contacts[s.body.name] = int(hit.sum())
                     rows = rows[~hit]
-            angle = rows[:, 3] if s.k and not np.isnan(rows[:, 3]).any() else None
-            tracks[s.body.name] = Track(rows[:, 0], rows[:, 1], rows[:, 2], angle)
+            tracks[s.body.name] = _track(rows, turning=bool(s.k))
         fields = ("x", "y", "angle") if any(t.angle is not None for t in tracks.values()) else None
         angle_accuracy = {
             name: stated_angle_accuracy(
@@ -1472,6 +1470,15 @@ def _tiny(tracker: Tracker, lost: list[str]) -> str:
         f"; {', '.join(small)}: a lossy video coder leaves a body that small out of many frames "
         "altogether, so film it closer, at a higher resolution or at a higher bitrate"
     )
+
+
+def _track(rows: np.ndarray, *, turning: bool) -> Track:
+    """A body's track from its rows ``(t, x, y, angle)``: with angles where it turns and every
+    row has one."""
+    from physbench.recording import Track
+
+    angle = rows[:, 3] if turning and not np.isnan(rows[:, 3]).any() else None
+    return Track(rows[:, 0], rows[:, 1], rows[:, 2], angle)
 
 
 def _off_surface(v: np.ndarray, normal: np.ndarray, hit: float) -> tuple[np.ndarray, float]:
