@@ -99,7 +99,12 @@ def main(args: argparse.Namespace) -> int:
     if args.video:
         from physbench.video.reader import VideoReader
 
-        info = VideoReader(args.video).info()
+        if Path(args.video).is_dir() and not args.fps:
+            raise PhysbenchError(
+                f"--video {args.video!r} is a folder of images, which carry no frame rate: "
+                "give it with --fps"
+            )
+        info = VideoReader(args.video, fps=args.fps).info()
         fps = fps or info.rate or None
         if frames is None and info.frames:
             frames = info.frames

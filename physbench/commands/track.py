@@ -83,7 +83,14 @@ def main(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(exc.result.summary.format())
         if args.preview:
-            write_overlay(args.preview, video, exc.result.pixels, start=args.start, end=args.end)
+            write_overlay(
+                args.preview,
+                video,
+                exc.result.pixels,
+                start=args.start,
+                end=args.end,
+                fps=scene.fps,
+            )
             wrote(args.preview, args)
         raise
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
@@ -95,7 +102,9 @@ def main(args: argparse.Namespace) -> int:
     wrote(args.out, args)
     wrote(pixels_out, args)
     if args.preview:
-        write_overlay(args.preview, video, result.pixels, start=args.start, end=args.end)
+        write_overlay(
+            args.preview, video, result.pixels, start=args.start, end=args.end, fps=scene.fps
+        )
         wrote(args.preview, args)
     return 0
 

@@ -57,16 +57,18 @@ def write_overlay(
     start: float | None = None,
     end: float | None = None,
     trail: float = 0.5,
+    fps: float | None = None,
 ) -> Path:
     """Write ``video`` (trimmed to ``start``/``end`` as it was tracked) with the tracks of
-    ``pixels`` (times from its first frame) drawn on, to ``path`` (``.mp4`` or ``.gif``)."""
+    ``pixels`` (times from its first frame) drawn on, to ``path`` (``.mp4`` or ``.gif``).
+    ``fps``: the frame rate of a folder of images (the one it was tracked at)."""
     from physbench.video.reader import VideoReader
 
     out = Path(path)
     suffix = out.suffix.lower()
     if suffix not in OVERLAY_SUFFIXES:
         raise OverlayError(f"overlay {str(out)!r}: expected a {' or '.join(OVERLAY_SUFFIXES)} file")
-    reader = VideoReader(video, start=start, end=end)
+    reader = VideoReader(video, start=start, end=end, fps=fps)
     times: list[float] = []
 
     def marked() -> Iterator[np.ndarray]:

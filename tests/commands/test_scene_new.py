@@ -115,6 +115,27 @@ def test_answers_without_a_recording(tmp_path, capsys) -> None:  # type: ignore[
         assert err.startswith("physbench scene: error:") and message in err, err
 
 
+def test_a_folder_of_images_is_a_video_with_the_frame_rate_given(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    from PIL import Image
+
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for k in range(6):
+        Image.new("RGB", (80, 60), (90, 90, 90)).save(folder / f"f{k:02d}.png")
+    cal = tmp_path / "cal.toml"
+    cal.write_text("[scale]\nmetres_per_pixel = 0.01\norigin_pixel = [0, 59]\n")
+    out = tmp_path / "f.toml"
+    argv = ["scene", "new", "flight", "--radius", "0.02", "--video", str(folder)]
+    argv += ["--calibration", str(cal), "--pixel", "40", "30", "--out", str(out)]
+    assert cli(argv) == 2
+    err = capsys.readouterr().err
+    assert "is a folder of images" in err and "--fps" in err, err
+    assert cli([*argv, "--fps", "12"]) == 0
+    scene = load_scene(out)
+    assert scene.fps == 12 and scene.frames == 6
+    assert scene.bounds == pytest.approx((-0.005, -0.005, 0.795, 0.595))
+
+
 def test_discover_names_a_track_the_scene_lacks(tmp_path, throw, capsys) -> None:  # type: ignore[no-untyped-def]
     path, _ = throw
     scene_file = tmp_path / "s.toml"

@@ -142,3 +142,17 @@ def test_a_lost_body_fails_the_command_and_says_when(clip, hidden, capsys) -> No
     (run,) = load_runs(hidden, scene, calibration=tmp / "cal.toml", background=tmp / "plate.png",
                        allow_gaps=True)  # fmt: skip
     assert run.recording is not None and len(run.recording.track("test")) <= 8
+
+
+def test_a_folder_of_images_gets_its_preview_at_the_scenes_frame_rate(clip, hidden, capsys):
+    """A folder of images carries no frame rate: the preview is drawn at the scene's, as the
+    tracking was (it had failed after writing the recording)."""
+    tmp, scene, _ = clip
+    args = ["track", str(hidden), "--scene", "bouncing_balls", "--seed", "4", "--allow-gaps"]
+    args += ["--calibration", str(tmp / "cal.toml"), "--background", str(tmp / "plate.png")]
+    gif = tmp / "folder.gif"
+    assert main([*args, "--out", str(tmp / "folder.csv"), "--preview", str(gif)]) == 0
+    assert "wrote" in capsys.readouterr().err
+    with Image.open(gif) as im:
+        assert im.n_frames == len(list(hidden.glob("*.png")))
+        assert abs(im.info["duration"] - 1000 / scene.fps) < 10  # GIF counts centiseconds
