@@ -1,7 +1,8 @@
 """Summary statistics of the disagreement between a fitted model and the data that point at causes:
 speed lost in free flight beyond the model (and how that loss scales with speed), energy lost at
 impacts beyond the restitution, a uniform acceleration the model lacks, a constant offset, and the
-amplitude envelope, period and centre of oscillations.
+amplitude envelope, period and centre of oscillations; and one that points at the setup instead:
+a body the scene starts at rest that the recording shows moving from its first samples.
 
 Each statistic becomes a :class:`~physbench.discover.results.Finding`: numbers (where it was
 measured, the statistic, its size, how it scales) and the effects it points at;
@@ -31,6 +32,10 @@ if TYPE_CHECKING:
 
 #: A statistic is reported when it is this many standard errors from zero.
 Z_REPORT = 3.0
+#: The first seconds of a recording in which a body the scene starts at rest must not move,
+#: and how far they may stretch to hold 5 samples (a slower clip is not judged).
+START_WINDOW = 0.3
+START_LIMIT = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,6 +106,8 @@ def findings(vs: Sequence[RunView]) -> list[Finding]:
                 continue
             pos = [f for f in ("x", "y") if f in fields]
             if pos:
+                if not jointed and _at_rest(v.scene, body):
+                    out += _start(v.name, body, obs, sim, ev, pos, v.recording.accuracy)
                 out += _free_flight(v.name, body, obs, sim, ev, pos)
                 out += _impacts(v.name, body, obs, sim, ev, pos)
                 out += _drift(v.name, body, obs, sim, pos)
@@ -256,6 +263,66 @@ def _impacts(
             trend,
             values,
             ("velocity_dependent_restitution",),
+        )
+    ]
+
+
+def _at_rest(scene: Scene, body: str) -> bool:
+    """Whether ``scene`` starts ``body`` at rest (so discovery takes its start as known: no
+    initial-state nuisance is fitted for it by default)."""
+    b = scene.bodies[scene.body_index(body)]
+    return math.hypot(*b.velocity) == 0 and b.angular_velocity == 0
+
+
+def _start(
+    run: str,
+    body: str,
+    obs: Track,
+    sim: Track,
+    ev: np.ndarray,
+    pos: Sequence[str],
+    accuracy: float | None,
+) -> list[Finding]:
+    """A body the scene starts at rest that moves in the recording's first samples: the clip
+    began after its release, or the scene's start is wrong. Its initial velocity against the
+    model is the slope at the first sample of a cubic through the residual over the first
+    :data:`START_WINDOW` s of free flight (at least 5 samples, within :data:`START_LIMIT` s).
+    From rest, a missing force bends the residual like t², linear drag like t³ (both taken up
+    by the cubic) and quadratic drag like t⁴; measurement errors add a constant and a t² term:
+    only a start in motion moves it like t. The standard error is from the recording's stated
+    accuracy where it has one, else (with at least 3 degrees of freedom) the scatter."""
+    free = ev == EVENTS.index("free")
+    n = int(np.argmin(free)) if not free.all() else free.size  # samples before the first event
+    t = obs.t[:n] - obs.t[0]
+    k = max(int(np.searchsorted(t, START_WINDOW, side="right")), 5)
+    if n < k or t[k - 1] > START_LIMIT or (not accuracy and k < 7):
+        return []
+    t = t[:k]
+    a = np.stack([np.ones_like(t), t, t * t, t**3], axis=1)
+    inv = np.linalg.pinv(a.T @ a)
+    vel, se = {}, {}
+    for f in pos:
+        r = obs.values(f)[:k] - sim.values(f)[:k]
+        coef, *_ = np.linalg.lstsq(a, r, rcond=None)
+        res = r - a @ coef
+        var = accuracy**2 if accuracy else float(res @ res) / (k - 4)
+        vel[f], se[f] = float(coef[1]), math.sqrt(var * inv[1, 1])
+    if not all(math.isfinite(e) and e > 0 for e in se.values()):
+        return []
+    top = max(pos, key=lambda f: abs(vel[f]) / se[f])
+    if abs(vel[top]) < Z_REPORT * se[top]:
+        return []
+    return [
+        Finding(
+            "start",
+            run,
+            body,
+            "free",
+            f"v{top}0",
+            vel[top],
+            se[top],
+            "",
+            {f"v{f}0": vel[f] for f in pos} | {"seconds": float(t[-1]), "samples": float(k)},
         )
     ]
 

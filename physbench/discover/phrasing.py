@@ -81,6 +81,17 @@ def _offset(f: Finding) -> str:
     return f"{f.body}: observed {field} sits {f.size:+.3g} {unit} from the simulated one throughout"
 
 
+def _start(f: Finding) -> str:
+    vec = ", ".join(f"{k.removesuffix('0')} {x:+.3g}" for k, x in f.values.items() if k[0] == "v")
+    b = f.body
+    return (
+        f"{b}: the scene starts it at rest, but over its first {f.values['seconds']:.2g} s it "
+        f"moves at {vec} m/s against the model ({abs(f.size) / f.stderr:.0f} standard errors): "
+        "the recording starts after its release, or the start is wrong; fit its start "
+        f"(nuisance {b}.x0 {b}.y0 {b}.vx0 {b}.vy0) or give the scene its velocity"
+    )
+
+
 def _envelope(f: Finding) -> str:
     v = f.values
     return (
@@ -104,6 +115,7 @@ _PHRASES: dict[str, Callable[[Finding], str]] = {
     "impacts": _impacts,
     "drift": _drift,
     "offset": _offset,
+    "start": _start,
     "envelope": _envelope,
     "period": _period,
     "centre": _centre,

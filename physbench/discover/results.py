@@ -104,9 +104,11 @@ class Finding:
     """One statistic of the disagreement between a fitted model and the data, as numbers
     (:mod:`physbench.discover.phrasing` puts it into words).
 
-    ``kind``: ``free_flight``, ``impacts``, ``drift``, ``offset``, ``envelope``, ``period`` or
-    ``centre``; ``run`` and ``body`` where it was measured; ``event``: the samples it measures
-    (``free``, ``impact``, ``jointed``, or ``""`` for all of them); ``statistic`` names the headline
+    ``kind``: ``free_flight``, ``impacts``, ``drift``, ``offset``, ``envelope``, ``period``,
+    ``centre`` or ``start`` (a body the scene starts at rest moves in the first samples; it
+    suggests no effect: the scene's start or the nuisance parameters are to change); ``run``
+    and ``body`` where it was measured; ``event``: the samples it measures (``free``,
+    ``impact``, ``jointed``, or ``""`` for all of them); ``statistic`` names the headline
     number, ``size`` is its value and ``stderr`` its standard error (nan where none is estimated);
     ``trend``: how the statistic scales, ``constant``, ``linear`` or ``quadratic`` (with the speed
     in free flight, with the amplitude of a swing), ``growing`` or ``shrinking`` (with the impact

@@ -48,3 +48,33 @@ def test_diagnose_measures_the_excess_deceleration_of_a_dragged_puck(puck, puck_
     assert free.size > 3 * free.stderr and "linear_drag" in free.suggests
     assert set(d.breakdown.per_event["puck"]) == {"free"}
     assert d.breakdown.per_field["puck"]["x"] > d.breakdown.per_field["puck"]["y"]
+
+
+def test_a_body_the_scene_starts_at_rest_that_moves_from_the_first_samples_is_named(noisy):
+    """A clip that begins after the release, against a scene that starts the ball at rest: the
+    start is named (no effect suggested), with the initial velocity the data show; a ball
+    that does start at rest, slowed by drag, gets no such finding."""
+    from dataclasses import replace
+
+    from physbench.discover import Run, Settings, fit_base
+    from physbench.discover.phrasing import describe
+    from physbench.effects import QuadraticDrag
+    from physbench.scene import Body, Circle, Scene
+    from physbench.simulators.pymunk_sim import PymunkSimulator
+
+    ball = Body("ball", Circle(0.05), (1.0, 4.0), mass=0.2)
+    scene = Scene("drop", (ball,), bounds=(-2, -6, 6, 6), fps=20.0, frames=21).validate()
+    sim = PymunkSimulator()
+    moving = replace(scene, bodies=(replace(ball, velocity=(0.4, -0.6)),))
+    for truth, effects, named in ((moving, [], True), (scene, [QuadraticDrag(c=0.05)], False)):
+        rec = noisy(sim.simulate(truth, effects=effects), sigma=0.002, seed=3)
+        base = fit_base([Run("r", scene, recording=rec)], sim, Settings())
+        starts = [f for f in diagnose(base).findings if f.kind == "start"]
+        assert bool(starts) == named, starts
+        if named:
+            (f,) = starts
+            assert f.suggests == () and f.body == "ball" and f.statistic == "vy0"
+            assert abs(f.values["vy0"] + 0.6) < 3 * f.stderr and abs(f.size) > 3 * f.stderr
+            assert abs(f.values["vx0"] - 0.4) < 0.2
+            text = describe(f)
+            assert "starts it at rest" in text and "ball.vx0" in text, text
