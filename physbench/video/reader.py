@@ -8,6 +8,11 @@ bmp, tif) is a video too, in file-name order, at the frame rate the caller gives
 
 Frames are yielded one by one (:meth:`VideoReader.frames`), so a long 1080p video never sits in
 memory whole; ``start`` and ``end`` (seconds) trim it.
+
+Frames come upright, as a player shows them: a phone holds a portrait video as landscape frames
+with a display rotation beside them, which is applied here (quarter turns; FFmpeg's own command
+line and OpenCV do the same), so that pixel coordinates, calibrations and scenes made by looking
+at the video agree with what is tracked.
 """
 
 from __future__ import annotations
@@ -121,13 +126,15 @@ class VideoReader:
     # ----------------------------------------------------------------- header
 
     def info(self) -> VideoInfo:
-        """Size, rate, frame count and duration, from the header (no decoding)."""
+        """Size (upright, as shown), rate, frame count and duration, from the header (and the
+        first frame's display rotation)."""
         if self.images:
             h, w = self._image(self.images[0]).shape[:2]
             n, rate = len(self.images), float(self.fps or 0.0)
             return VideoInfo(w, h, rate, n, n / rate, "images")
         with self._open() as container:
             stream = self._stream(container)
+            turns = _quarter_turns(self.path, _first_rotation(container, stream))
             rate = float(stream.average_rate or stream.guessed_rate or 0.0)
             frames = int(stream.frames) or None
             duration = None
@@ -135,9 +142,10 @@ class VideoReader:
                 duration = float(stream.duration * stream.time_base)
             elif container.duration is not None:
                 duration = container.duration / 1_000_000  # microseconds
+            w, h = stream.codec_context.width, stream.codec_context.height
             return VideoInfo(
-                stream.codec_context.width,
-                stream.codec_context.height,
+                h if turns % 2 else w,
+                w if turns % 2 else h,
                 rate,
                 frames,
                 duration,
@@ -227,9 +235,40 @@ class VideoReader:
                     if self.end is not None and t > self.end + 1e-9:
                         break
                     if select(k):
-                        yield Frame(k, t, frame.to_ndarray(format="rgb24"))
+                        yield Frame(k, t, _upright(frame, self.path))
                     k += 1
             except av.error.FFmpegError as exc:
                 raise VideoError(
                     f"{str(self.path)!r} is damaged after {k} frames ({exc.strerror or exc})"
                 ) from None
+
+
+def _quarter_turns(path: Path, degrees: float) -> int:
+    """Counter-clockwise quarter turns of a display rotation of ``degrees``; refused unless a
+    multiple of 90."""
+    turns = round(degrees / 90.0)
+    if abs(degrees - 90.0 * turns) > 0.5:
+        raise VideoError(
+            f"{str(path)!r} is to be shown turned by {degrees:g} degrees, which physbench cannot "
+            "apply (quarter turns only): rotate it upright first (ffmpeg -i IN OUT does)"
+        )
+    return turns % 4
+
+
+def _upright(frame: Any, path: Path) -> np.ndarray:
+    """``frame`` as RGB, turned as its display rotation says."""
+    image = frame.to_ndarray(format="rgb24")
+    turns = _quarter_turns(path, float(getattr(frame, "rotation", 0) or 0))
+    return np.ascontiguousarray(np.rot90(image, turns)) if turns else image
+
+
+def _first_rotation(container: Any, stream: Any) -> float:
+    """The display rotation of the stream's first frame (degrees counter-clockwise; 0 when the
+    file cannot be decoded here: :meth:`VideoReader.frames` says why)."""
+    av = load_av()
+    try:
+        for frame in container.decode(stream):
+            return float(getattr(frame, "rotation", 0) or 0)
+    except av.error.FFmpegError:
+        pass
+    return 0.0

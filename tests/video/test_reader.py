@@ -108,3 +108,41 @@ def test_frames_can_be_selected_without_converting_the_others(tmp_path: Path) ->
     assert [f.time for f in some] == [every[k].time for k in (0, 3, 6)]
     np.testing.assert_array_equal(some[1].image, every[3].image)
     assert list(VideoReader(clip).frames(lambda k: False)) == []  # decoded, none wanted: no error
+
+
+def _turned_clip(path: Path, upright: np.ndarray, degrees: float, frames: int = 3) -> None:
+    """``upright`` stored as a phone stores a portrait clip: turned against its display rotation
+    (``degrees`` counter-clockwise), the rotation written beside it."""
+    import av
+
+    stored = np.ascontiguousarray(np.rot90(upright, -round(degrees / 90)))
+    with av.open(str(path), "w") as out:
+        s = out.add_stream("libx264", rate=10)
+        s.height, s.width = stored.shape[:2]
+        s.pix_fmt = "yuv420p"
+        s.options = {"crf": "10"}
+        s.set_display_rotation(degrees)
+        for i in range(frames):
+            f = av.VideoFrame.from_ndarray(stored, format="rgb24")
+            f.pts = i
+            for p in s.encode(f):
+                out.mux(p)
+        for p in s.encode():
+            out.mux(p)
+
+
+def test_a_phone_clip_with_a_display_rotation_is_read_upright(tmp_path: Path) -> None:
+    upright = np.full((64, 48, 3), 40, np.uint8)  # portrait, as shown
+    upright[4:16, 6:18] = 230  # a mark near the top-left corner
+    for degrees in (-90, 90, 180):
+        path = tmp_path / f"turned{degrees}.mp4"
+        _turned_clip(path, upright, degrees)
+        reader = VideoReader(path)
+        info = reader.info()
+        assert (info.width, info.height) == (48, 64), degrees
+        for fr in reader.frames():
+            assert fr.image.shape == upright.shape
+            assert np.abs(fr.image.astype(int) - upright).mean() < 3, degrees
+    _turned_clip(tmp_path / "tilted.mp4", upright[:48], 45)
+    with pytest.raises(VideoError, match=r"turned by 45 degrees.*quarter turns"):
+        list(VideoReader(tmp_path / "tilted.mp4").frames())
