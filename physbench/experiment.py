@@ -64,7 +64,8 @@ class RunConfig:
     (:func:`~physbench.unknowns.scene_parameters`); ``allow_gaps``: keep a video's
     tracks where a body was lost for more than the tracker's share of the clip (else that is an
     error); ``transfer``: how the video's pixels encode light (``None``: its tag, else the
-    default; :mod:`physbench.video.transfer`)."""
+    default; :mod:`physbench.video.transfer`); ``capture_fps``: the rate a slow-motion video
+    was filmed at (:class:`~physbench.video.reader.VideoReader`)."""
 
     scene: str | None = DEFAULT_SCENE
     params: tuple[str, ...] = ("mass",)
@@ -100,6 +101,7 @@ class RunConfig:
     #: reference for the run's row and setting). ``None``: on for the estimators in
     #: :data:`RESTART_BY_DEFAULT`.
     restart: bool | None = None
+    capture_fps: float | None = None
 
     def __post_init__(self) -> None:
         """Refuse a numeric setting outside its range (:mod:`physbench.numeric`), NaN and the
@@ -119,6 +121,8 @@ class RunConfig:
         for name in ("video_start", "video_end"):
             if getattr(self, name) is not None:
                 numeric.SECONDS.check(getattr(self, name), f"run setting {name}")
+        if self.capture_fps is not None:
+            numeric.POSITIVE.check(self.capture_fps, "run setting capture_fps")
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready settings (tuples as lists); :meth:`from_dict` inverts it. Settings added
@@ -173,6 +177,7 @@ _LATER = (
     "allow_gaps",
     "transfer",
     "restart",
+    "capture_fps",
 )
 #: Settings added later with a default that is not empty: omitted while at that default.
 _LATER_DEFAULTS: dict[str, Any] = {"predictive_draws": PREDICTIVE_DRAWS}
@@ -204,6 +209,7 @@ def _check_observation(config: RunConfig) -> None:
         "--end": config.video_end,
         "--allow-gaps": config.allow_gaps or None,
         "--transfer": config.transfer,
+        "--capture-fps": config.capture_fps,
     }
     if config.observer_options and not config.observer:
         raise PhysbenchError(
@@ -396,6 +402,7 @@ def make_observation(
             marked=marked,
             allow_gaps=config.allow_gaps,
             transfer=config.transfer,
+            capture_fps=config.capture_fps,
         )
     simulator = create("simulator", config.observer_engine)
     if config.observer:

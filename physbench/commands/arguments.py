@@ -339,8 +339,8 @@ def make_renderer_from(args: argparse.Namespace) -> Any:
 
 def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
     """The flags that say how to read a camera's video: ``--calibration``, ``--background``,
-    ``--start``, ``--end``, ``--allow-gaps``, ``--transfer`` (the same in ``track``, ``run --video``
-    and ``discover VIDEO``)."""
+    ``--start``, ``--end``, ``--allow-gaps``, ``--transfer``, ``--capture-fps`` (the same in
+    ``track``, ``run --video`` and ``discover VIDEO``)."""
     from physbench.video.transfer import AUTO, DEFAULT, TRANSFERS
 
     group.add_argument(
@@ -381,4 +381,13 @@ def add_video_input_arguments(group: argparse._ActionsContainer) -> None:
         default=None,
         help="how the video's pixel values encode light, decoded to linear light before "
         f"tracking (default {AUTO}: the video's tag, else {DEFAULT}; phones tag bt709)",
+    )
+    group.add_argument(
+        "--capture-fps",
+        type=numeric.POSITIVE,
+        default=None,
+        metavar="FPS",
+        help="the rate a slow-motion video was filmed at, where its file plays slower (a "
+        "phone's 240 fps stored to play at 30): the frames' times become real seconds "
+        "(--start and --end stay the player's)",
     )

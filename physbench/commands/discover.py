@@ -241,6 +241,7 @@ def _runs(args: argparse.Namespace) -> list[Any]:
         allow_gaps=args.allow_gaps,
         progress=show_progress(args),
         transfer=args.transfer,
+        capture_fps=args.capture_fps,
     )
     if args.track_out:
         wrote(args.track_out, args)

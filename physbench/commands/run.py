@@ -316,6 +316,7 @@ def _build_config(args: argparse.Namespace) -> Any:
         effects=tuple(args.effect),
         allow_gaps=args.allow_gaps,
         transfer=args.transfer,
+        capture_fps=args.capture_fps,
     )
     check_config(config)  # a bad name or option: fail before the progress bar appears
     return config

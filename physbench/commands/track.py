@@ -77,6 +77,7 @@ def main(args: argparse.Namespace) -> int:
             allow_gaps=args.allow_gaps,
             progress=show_progress(args),
             transfer=args.transfer,
+            capture_fps=args.capture_fps,
         )
     except TrackLostError as exc:
         # A failure: no recording; the summary and a preview, if asked, show what was lost.

@@ -98,15 +98,17 @@ def load_runs(
     allow_gaps: bool = False,
     progress: bool = False,
     transfer: str | None = None,
+    capture_fps: float | None = None,
 ) -> list[Run]:
     """Runs from a recording file (``.csv``: tracked trajectories, one run per ``run`` label;
     ``.npz``: observed frames under key ``frames``; ``.trz``/``.trk``: the hand-marked points of a
     Tracker project, :mod:`physbench.tracker_files`; a video file or a folder of images: tracked
     first, see :func:`~physbench.video.track.track_video`) and a scene (object or ``.toml`` file)
     that every run shares. ``run`` keeps one run of a multi-run CSV. ``calibration``,
-    ``background``, ``start``, ``end``, ``allow_gaps`` and ``transfer`` apply to a video only (a
-    body lost in more than the tracker's share of its frames is an error unless ``allow_gaps``;
-    ``transfer``: how its pixels encode light, :func:`~physbench.video.track.track_video`);
+    ``background``, ``start``, ``end``, ``allow_gaps``, ``transfer`` and ``capture_fps`` apply to
+    a video only (a body lost in more than the tracker's share of its frames is an error unless
+    ``allow_gaps``; ``transfer``: how its pixels encode light; ``capture_fps``: the rate a
+    slow-motion file was filmed at; :func:`~physbench.video.track.track_video`);
     ``track_out`` writes its tracks as a recording CSV."""
     from physbench.scene_toml import load_scene
     from physbench.video.reader import VIDEO_SUFFIXES, is_video
@@ -128,6 +130,7 @@ def load_runs(
         "track_out": track_out,
         "allow_gaps": allow_gaps or None,
         "transfer": transfer,
+        "capture_fps": capture_fps,
     }
     stray_given = [k for k, v in stray.items() if v is not None]
     if stray_given and not video:
@@ -148,6 +151,7 @@ def load_runs(
                 allow_gaps=allow_gaps,
                 progress=progress,
                 transfer=transfer,
+                capture_fps=capture_fps,
             )
         ]
     suffix = path.suffix.lower()
@@ -221,6 +225,7 @@ def _video_run(
     allow_gaps: bool,
     progress: bool,
     transfer: str | None = None,
+    capture_fps: float | None = None,
 ) -> Run:
     """Track the scene's bodies through a video into one run; the summary goes to stderr."""
     import sys
@@ -240,6 +245,7 @@ def _video_run(
         allow_gaps=allow_gaps,
         progress=progress,
         transfer=transfer,
+        capture_fps=capture_fps,
     )
     if progress:
         print(tracked.summary.format(), file=sys.stderr)

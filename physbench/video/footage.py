@@ -93,14 +93,15 @@ def video_observation(
     marked: Iterable[str] = (),
     allow_gaps: bool = False,
     transfer: str | None = None,
+    capture_fps: float | None = None,
 ) -> Observation:
     """The observation of a video file in ``renderer``'s frames (see the module docstring).
     ``calibration``: a :class:`~physbench.calibration.Calibration` or a TOML file (default:
     ``scene.bounds`` fill the frame); ``background``: an image of the empty scene (array or file;
     default: the video's median); ``allow_gaps``: keep tracks where a body was lost for more
     than the tracker's share of the clip (else :class:`~physbench.video.track.TrackLostError`);
-    ``transfer``: how the video's pixels encode light
-    (:func:`~physbench.video.track.track_video`)."""
+    ``transfer``: how the video's pixels encode light, ``capture_fps``: the rate a slow-motion
+    file was filmed at (:func:`~physbench.video.track.track_video`)."""
     from physbench.calibration import load_calibration
     from physbench.observation import Observation
     from physbench.video.background import load_plate, median_background
@@ -109,7 +110,7 @@ def video_observation(
     from physbench.video.segment import Segmenter, body_threshold, fill_holes
     from physbench.video.track import bounds_calibration, track_video
 
-    reader = VideoReader(path, start=start, end=end, fps=scene.fps)
+    reader = VideoReader(path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps)
     info = reader.info()
     if isinstance(calibration, str | Path):
         calibration = load_calibration(calibration)
@@ -126,10 +127,13 @@ def video_observation(
         background=background,
         allow_gaps=allow_gaps,
         transfer=transfer,
+        capture_fps=capture_fps,
     )
     recording = tracked.measured  # collision frames too: their pixels are split by the poses
     if background is None:
-        background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
+        background = median_background(
+            VideoReader(path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps)
+        )
     expected = tuple(renderer.shape(scene))
     seg = Segmenter(
         scene,

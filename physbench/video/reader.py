@@ -71,6 +71,16 @@ class VideoInfo:
     transfer: str | None = None
 
 
+def _positive(name: str, value: float | None) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise VideoError(f"{name} = {value!r}: expected a frame rate > 0 (frames/s)")
+    if not math.isfinite(value):
+        raise VideoError(f"{name} = {value!r}: expected a finite frame rate")
+    return float(value)
+
+
 def _number(name: str, value: float | None, *, low: float = 0.0) -> float | None:
     if value is None:
         return None
@@ -84,7 +94,11 @@ def _number(name: str, value: float | None, *, low: float = 0.0) -> float | None
 class VideoReader:
     """A video file or a folder of images, opened lazily: :meth:`info` reads the header, and
     :meth:`frames` decodes as it is iterated. ``fps`` is needed for a folder of images (and
-    ignored for a file, whose timestamps rule); ``start``/``end`` trim to ``[start, end]`` s."""
+    ignored for a file, whose timestamps rule); ``start``/``end`` trim to ``[start, end]`` s of
+    the file (as a player counts them). ``capture_fps``: the rate a slow-motion file was filmed
+    at, where it plays back slower (a phone's 240 fps stored to play at 30): its frames' times
+    are the file's scaled by its average rate over ``capture_fps``, so that they are the real
+    seconds between the frames (ignored for a folder of images, whose ``fps`` is the rate)."""
 
     def __init__(
         self,
@@ -93,10 +107,12 @@ class VideoReader:
         start: float | None = None,
         end: float | None = None,
         fps: float | None = None,
+        capture_fps: float | None = None,
     ) -> None:
         self.path = Path(path)
         self.start = _number("start", start) or 0.0
         self.end = _number("end", end)
+        self.capture_fps = _positive("capture_fps", capture_fps)
         if self.end is not None and self.end <= self.start:
             raise VideoError(f"end = {end!r}: must come after start = {self.start:g} s")
         if not self.path.exists():
@@ -157,10 +173,11 @@ class VideoReader:
 
     def frames(self, select: Callable[[int], bool] | None = None) -> Iterator[Frame]:
         """The frames inside ``[start, end]``, decoded one at a time, with their times (s from the
-        first frame of the file). ``select(index)``: yield only the frames it accepts (the others
-        are still decoded, as a video's later frames need them, but not converted to images).
-        Raises :class:`VideoError` for a file that cannot be decoded, and when no frame lies
-        inside the trim."""
+        first frame of the file; real seconds where ``capture_fps`` rescales a slow-motion
+        file). ``select(index)``: yield only the frames it accepts (the others are still decoded,
+        as a video's later frames need them, but not converted to images). Raises
+        :class:`VideoError` for a file that cannot be decoded, and when no frame lies inside the
+        trim."""
         count = 0
 
         def chosen(k: int) -> bool:
@@ -213,11 +230,25 @@ class VideoReader:
             raise VideoError(f"{str(self.path)!r}: its video codec is not supported")
         return stream
 
+    def _time_scale(self, stream: Any) -> float:
+        """Real seconds per second of the file: its average rate over ``capture_fps`` (1 without
+        one)."""
+        if self.capture_fps is None:
+            return 1.0
+        rate = float(stream.average_rate or stream.guessed_rate or 0.0)
+        if not rate > 0:
+            raise VideoError(
+                f"{str(self.path)!r} states no frame rate, so capture_fps = {self.capture_fps:g} "
+                "cannot rescale its times; convert it to images and give their rate"
+            )
+        return rate / self.capture_fps
+
     def _decode(self, select: Callable[[int], bool]) -> Iterator[Frame]:
         av = load_av()
         with self._open() as container:
             stream = self._stream(container)
             stream.thread_type = "AUTO"
+            scale = self._time_scale(stream)
             t0: float | None = None
             k = 0
             try:
@@ -235,7 +266,7 @@ class VideoReader:
                     if self.end is not None and t > self.end + 1e-9:
                         break
                     if select(k):
-                        yield Frame(k, t, _upright(frame, self.path))
+                        yield Frame(k, t * scale, _upright(frame, self.path))
                     k += 1
             except av.error.FFmpegError as exc:
                 raise VideoError(

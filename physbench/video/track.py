@@ -1403,6 +1403,7 @@ def track_video(
     allow_gaps: bool = False,
     progress: bool = False,
     transfer: str | None = None,
+    capture_fps: float | None = None,
 ) -> TrackResult:
     """Track ``scene``'s bodies through the video at ``path`` (see the module docstring).
 
@@ -1414,15 +1415,18 @@ def track_video(
     than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view (else
     :class:`TrackLostError`); ``transfer``: the video's transfer function, a name or ``"auto"``
     (default: the video's tag, else :data:`~physbench.video.transfer.DEFAULT`; see
-    :func:`~physbench.video.transfer.resolve`)."""
+    :func:`~physbench.video.transfer.resolve`); ``capture_fps``: the rate a slow-motion file was
+    filmed at (:class:`~physbench.video.reader.VideoReader`; a file playing at under half the
+    scene's rate without it is warned of)."""
     from physbench.video.background import load_plate, median_background
     from physbench.video.reader import VideoError, VideoReader
     from physbench.video.transfer import resolve
 
     try:
         # A folder of images has no timestamps: its frames come at the scene's rate.
-        reader = VideoReader(path, start=start, end=end, fps=scene.fps)
+        reader = VideoReader(path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps)
         info = reader.info()
+        _check_rate(path, scene, info.rate, reader.images, capture_fps)
         curve, _ = resolve(transfer, info.transfer)
         if calibration is None:
             calibration = bounds_calibration(scene, (info.height, info.width))
@@ -1430,7 +1434,9 @@ def track_video(
             background = load_plate(background)
         median = background is None
         if background is None:
-            background = median_background(VideoReader(path, start=start, end=end, fps=scene.fps))
+            background = median_background(
+                VideoReader(path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps)
+            )
         background = np.asarray(background)
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise TrackError(
@@ -1455,6 +1461,28 @@ def track_video(
         )
     except VideoError as exc:
         raise TrackError(str(exc)) from None
+
+
+def _check_rate(
+    path: str | Path, scene: Scene, rate: float, images: list, capture_fps: float | None
+) -> None:
+    """Warn of a video file that plays at under half the scene's frame rate, with no capture
+    rate given: likely slow motion, whose file times are not the real ones."""
+    if images or capture_fps is not None or not rate > 0 or scene.fps < 2 * rate:
+        return
+    import warnings
+
+    from physbench.errors import PhysbenchWarning
+
+    warnings.warn(
+        PhysbenchWarning(
+            f"{str(path)!r} plays at {rate:g} frames/s and scene {scene.name!r} is at "
+            f"{scene.fps:g}: physbench takes the frames' times from the file; if it is slow "
+            f"motion filmed at {scene.fps:g} frames/s, give that rate (--capture-fps "
+            f"{scene.fps:g}, capture_fps=...)"
+        ),
+        stacklevel=3,
+    )
 
 
 def _tiny(tracker: Tracker, lost: list[str]) -> str:

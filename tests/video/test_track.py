@@ -635,3 +635,31 @@ def test_a_swinging_arms_centre_is_between_its_ends(tmp_path, monkeypatch) -> No
     assert errors["centroid with faint end"]["median"] > 0.4
     assert errors["centroid with faint end"]["median"] < errors["centroid"]["median"] / 2
     assert errors["ends"]["median"] < 0.25 and errors["ends"]["p95"] < 0.5
+
+
+def test_a_slow_motion_clip_is_tracked_in_real_seconds_at_its_capture_rate(tmp_path) -> None:
+    """A throw filmed at 240 frames/s, stored to play at 30 (as phones store slow motion): with
+    its capture rate the recording is in real seconds and gives g; without it, the file's
+    rate, under half the scene's, is warned of."""
+    from physbench.errors import PhysbenchWarning
+    from physbench.render.camera import CameraRenderer
+    from physbench.video.writer import write_video
+
+    ball = Body("ball", Circle(0.06), (0.6, 1.2), velocity=(2.0, 2.5))
+    scene = Scene("throw", (ball,), bounds=(0.0, 0.0, 4.0, 3.0), fps=240.0, frames=97).validate()
+    traj = create("simulator", "pymunk").simulate(scene)
+    cam = CameraRenderer(320, seed=5)
+    played = np.arange(scene.frames) / 30.0  # the file's times: 8x slower than real
+    path = write_video(tmp_path / "slowmo.mp4", cam.film(scene, traj), fps=30.0, times=played)
+    plate, cal = cam.plate(scene), cam.calibration(scene)
+    assert VideoReader(path).info().rate == pytest.approx(30.0)
+    tr = track_video(path, scene, cal, background=plate, capture_fps=240.0).recording.track("ball")
+    assert len(tr) == scene.frames
+    np.testing.assert_allclose(tr.t, np.arange(scene.frames) / 240.0, atol=1e-6)
+    assert abs(-2 * np.polyfit(tr.t, tr.y, 2)[0] / 9.81 - 1) < 0.01
+    # --start stays the player's seconds: 0.5 s of the file is frame 15
+    trimmed = VideoReader(path, start=0.5, capture_fps=240.0)
+    first = next(iter(trimmed.frames()))
+    assert first.index == 0 and first.time == pytest.approx(15 / 240.0)
+    with pytest.warns(PhysbenchWarning, match=r"plays at 30 frames/s.*--capture-fps 240"):
+        track_video(path, scene, cal, background=plate, allow_gaps=True)
