@@ -91,6 +91,7 @@ def main(args: argparse.Namespace) -> int:
                 start=args.start,
                 end=args.end,
                 fps=scene.fps,
+                capture_fps=args.capture_fps,
             )
             wrote(args.preview, args)
         raise
@@ -104,7 +105,13 @@ def main(args: argparse.Namespace) -> int:
     wrote(pixels_out, args)
     if args.preview:
         write_overlay(
-            args.preview, video, result.pixels, start=args.start, end=args.end, fps=scene.fps
+            args.preview,
+            video,
+            result.pixels,
+            start=args.start,
+            end=args.end,
+            fps=scene.fps,
+            capture_fps=args.capture_fps,
         )
         wrote(args.preview, args)
     return 0

@@ -58,24 +58,30 @@ def write_overlay(
     end: float | None = None,
     trail: float = 0.5,
     fps: float | None = None,
+    capture_fps: float | None = None,
 ) -> Path:
     """Write ``video`` (trimmed to ``start``/``end`` as it was tracked) with the tracks of
     ``pixels`` (times from its first frame) drawn on, to ``path`` (``.mp4`` or ``.gif``).
-    ``fps``: the frame rate of a folder of images (the one it was tracked at)."""
+    ``fps``: the frame rate of a folder of images (the one it was tracked at); ``capture_fps``:
+    the rate a slow-motion file was tracked at (``pixels`` are in real seconds; the overlay
+    plays as the file does)."""
     from physbench.video.reader import VideoReader
 
     out = Path(path)
     suffix = out.suffix.lower()
     if suffix not in OVERLAY_SUFFIXES:
         raise OverlayError(f"overlay {str(out)!r}: expected a {' or '.join(OVERLAY_SUFFIXES)} file")
-    reader = VideoReader(video, start=start, end=end, fps=fps)
+    reader = VideoReader(video, start=start, end=end, fps=fps, capture_fps=capture_fps)
+    slow = 1.0  # file seconds per real second
+    if capture_fps is not None and not reader.images:
+        slow = capture_fps / (reader.info().rate or capture_fps)
     times: list[float] = []
 
     def marked() -> Iterator[np.ndarray]:
         t0 = None
         for fr in reader.frames():
             t0 = fr.time if t0 is None else t0
-            times.append(fr.time - t0)
+            times.append((fr.time - t0) * slow)
             img = draw_tracks(fr.image, pixels, fr.time - t0, trail=trail)
             h, w = img.shape[:2]
             yield img[: h - h % 2, : w - w % 2]  # H.264 wants even sizes
