@@ -28,13 +28,20 @@ files and usually the video. :func:`read_tracker_project` reads:
 Video filters that move pixels (perspective, radial distortion, rotation, resize) put Tracker's
 image coordinates in the filtered picture: such a project still gives a recording, but
 :meth:`TrackerProject.homography` refuses it, since its pixels are not the video's.
+
+:func:`project_video` finds the video a project names (inside a ``.trz``, or beside a ``.trk``),
+an image sequence (Tracker names its first image) as a folder of its images, so that ``physbench
+track`` can follow the bodies through a teacher's own project.
 """
 
 from __future__ import annotations
 
 import math
+import posixpath
+import re
+import shutil
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -413,3 +420,90 @@ def read_tracker_project(path: str | Path, *, member: str | None = None) -> Trac
             f"{p}: not a zip archive; a .trz is a zipped Tracker project"
         ) from None
     return parse_tracker_xml(data, source=f"{p}:{info.filename}")
+
+
+# --------------------------------------------------------------------------- the video
+
+#: Files Tracker shows as an image sequence (its ``ImageVideo``).
+SEQUENCE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff")
+_NUMBERED = re.compile(r"^(?P<stem>.*?)(?P<number>\d+)(?P<suffix>\.[A-Za-z]+)$")
+
+
+def _sequence(names: list[str], first: str) -> list[str]:
+    """The names of the image sequence that ``first`` begins (same folder, stem and suffix,
+    numbered from ``first``'s number on), in number order; ``[first]`` if it is not numbered."""
+    folder, base = posixpath.split(first)
+    m = _NUMBERED.match(base)
+    if m is None:
+        return [first]
+    found = []
+    for name in names:
+        f, b = posixpath.split(name)
+        n = _NUMBERED.match(b)
+        same = n is not None and (n["stem"], n["suffix"]) == (m["stem"], m["suffix"])
+        if f == folder and same and int(n["number"]) >= int(m["number"]):
+            found.append((int(n["number"]), name))
+    return [name for _, name in sorted(found)]
+
+
+def project_video(
+    path: str | Path, into: str | Path, project: TrackerProject | None = None
+) -> Path:
+    """Where physbench can read the video of the Tracker project at ``path``: a file, or for an
+    image sequence a folder holding its images alone (numbered in order). From a ``.trz`` the
+    video is extracted into the folder ``into``; beside a ``.trk`` it is read where the project
+    names it (relative to the project's folder), a sequence's images linked or copied into
+    ``into``. Raises :class:`TrackerFileError` naming what is missing."""
+    p, into = Path(path), Path(into)
+    project = project or read_tracker_project(p)
+    if not project.video:
+        raise TrackerFileError(f"{p}: the project names no video; give the video itself")
+    name = project.video.replace("\\", "/")
+    sequence = posixpath.splitext(name)[1].lower() in SEQUENCE_SUFFIXES
+    if p.suffix.lower() == ".trk":
+        target = Path(name) if Path(name).is_absolute() else p.parent / name
+        if not target.is_file():
+            raise TrackerFileError(
+                f"{p}: its video {project.video!r} is not at {str(target)!r}; give the video "
+                "itself, with the project as --calibration"
+            )
+        if not sequence:
+            return target
+        names = [f.as_posix() for f in target.parent.iterdir()]
+        return _gather(
+            into, _sequence(names, target.as_posix()), lambda n, dst: shutil.copy(n, dst)
+        )
+    member = project.source.removeprefix(f"{p}:")
+    wanted = posixpath.normpath(posixpath.join(posixpath.dirname(member), name))
+    with zipfile.ZipFile(p) as z:
+        names = z.namelist()
+        if wanted not in names:
+            same = [n for n in names if posixpath.basename(n) == posixpath.basename(wanted)]
+            if len(same) != 1:
+                raise TrackerFileError(
+                    f"{p}: its video {project.video!r} is not in the archive; give the video "
+                    "itself, with the project as --calibration"
+                )
+            wanted = same[0]
+        if not sequence:
+            into.mkdir(parents=True, exist_ok=True)
+            target = into / posixpath.basename(wanted)
+            with z.open(wanted) as src, target.open("wb") as dst:
+                shutil.copyfileobj(src, dst)
+            return target
+
+        def extract(n: str, dst: Path) -> None:
+            with z.open(n) as src, dst.open("wb") as out:
+                shutil.copyfileobj(src, out)
+
+        return _gather(into, _sequence(names, wanted), extract)
+
+
+def _gather(into: Path, names: list[str], put: Callable[[str, Path], object]) -> Path:
+    """A folder in ``into`` holding the images ``names`` in their order (renumbered)."""
+    folder = into / "frames"
+    folder.mkdir(parents=True, exist_ok=True)
+    width = len(str(len(names)))
+    for k, n in enumerate(names):
+        put(n, folder / f"{k:0{width}d}{posixpath.splitext(n)[1].lower()}")
+    return folder

@@ -385,12 +385,13 @@ def tracker_xml(
     size: tuple[int, int] = (640, 480),
     coords_frames: dict[int, tuple[float, float, float, float, float]] | None = None,
     filters: tuple[str, ...] = (),
+    video: str = "videos/clip.mp4",
 ) -> str:
     """A Tracker project (.trk XML) laid out as Tracker 6 saves one: the panel's image size and
     units, the video clip and its clip control, the fixed coordinate system (``angle`` in
     degrees, ``scale`` in px per unit), an axes track, a tape measure, a model particle (which is
     not a measurement) and one point-mass track per entry of ``marks`` (frame -> Tracker image
-    point)."""
+    point); ``video``: the path the clip names (a file, or an image sequence's first image)."""
     media, tracker = "org.opensourcephysics.media.core", "org.opensourcephysics.cabrillo.tracker"
     frames = coords_frames or {0: (*origin, angle, *scale)}
     coords = _obj(
@@ -418,7 +419,7 @@ def tracker_xml(
     )
     video = _obj(
         f"{media}.ImageVideo",
-        _prop("path", "string", "videos/clip.mp4"),
+        _prop("path", "string", video),
         '<property name="filters" type="collection" class="java.util.ArrayList">'
         + "".join(
             f'<property name="item" type="object">{_obj(f"{media}.{f}")}</property>'
