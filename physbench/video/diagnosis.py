@@ -5,6 +5,8 @@ What it measures there, in the frame's light (:class:`~physbench.video.photometr
 
 - **A blob of the body's size elsewhere** (searched out to 8 radii): the scene's initial position,
   the calibration or ``--start`` is off; the message gives the blob's pixel and distance.
+- **A clear blob of another size there**: the scene's radius (or the calibration's scale) is
+  off; the message gives the blob's radius, in metres too.
 - **Some contrast, under the threshold**: the body differs from the wall behind it by fewer grey
   levels than the frame's noise or the other bodies' contrast allow, or does so over too little
   of its area to be found; more contrast is the fix.
@@ -32,13 +34,15 @@ SEARCH_RADII = 8.0
 @dataclass(frozen=True)
 class Missing:
     """A body not found in the first frame: its ``name``, the pixel ``uv`` where the scene puts
-    it, its ``radius`` and covered ``area`` there (px), its initial ``position`` (m)."""
+    it, its ``radius`` and covered ``area`` there (px), its initial ``position`` (m), and a
+    disc's radius in ``metres``."""
 
     name: str
     uv: np.ndarray
     radius: float
     area: float
     position: tuple[float, float]
+    metres: float | None = None  # a disc's radius in the scene (m)
 
 
 def not_found(
@@ -77,18 +81,43 @@ def not_found(
         if abs(shift) >= 0.03
         else ""
     )
-    blobs = find_blobs(diff, low, 2 * low, offset=(r0, c0), min_area=0.3 * body.area)
+    near = max(2 * body.radius, 12.0)
+    blobs = find_blobs(diff, low, 2 * low, offset=(r0, c0), min_area=2.0)
     sized = [b for b, *_ in blobs if 0.4 * body.area <= b.area <= 2.5 * body.area]
     if sized:
         best = min(sized, key=lambda b: float(np.hypot(b.u - u, b.v - v)))
         far = float(np.hypot(best.u - u, best.v - v))
-        if far <= max(2 * body.radius, 12.0):
+        if far <= near:
             return (
                 f"{head}; a blob there, at pixel (u={best.u:.0f}, v={best.v:.0f}), covers "
                 f"{best.area / body.area:.0%} of its area but is not a disc's of {body.radius:.1f} "
                 "px radius nor of its area: check the body's size in the scene and the "
                 f"calibration's scale{lit}"
             )
+    # A clear, solid blob at the start, of another size: the scene's radius (or the scale) is
+    # wrong. (A faint body's blob is a part of it, its pixels barely over the threshold.)
+    odd = [
+        b
+        for b, _, _, cover in blobs
+        if cover.max() >= 1.0
+        and b.area >= 0.6 * b.count
+        and float(np.hypot(b.u - u, b.v - v)) <= near
+    ]
+    if odd:
+        b = max(odd, key=lambda b: b.area)
+        seen = float(np.sqrt(b.area / np.pi))
+        size = ""
+        if body.metres is not None:
+            size = (
+                f" (if it is the body, its radius is about {seen * body.metres / body.radius:.3g} "
+                f"m, not {body.metres:.3g} m)"
+            )
+        return (
+            f"{head}; a blob there, at pixel (u={b.u:.0f}, v={b.v:.0f}), is about {seen:.1f} px "
+            f"in radius, where the scene's radius makes {body.radius:.1f} px{size}: correct the "
+            f"scene's radius (scene new --radius) or the calibration's scale{lit}"
+        )
+    if sized:
         # With the clip's median as the background, a body that stays put is not there at all,
         # and the blob of its size may be another body.
         held = (

@@ -508,6 +508,7 @@ class Tracker:
         found = self._measure(image, gates, reach, t, visible)
         if first:
             self._look_wider(image, gates, reach, t, visible, found)
+            self._sizes_at_start(image, found)
         for i in range(len(self.states)):
             if visible[i] and i not in found:
                 faint = self._faint(i, image, gates[i], found)
@@ -555,6 +556,46 @@ class Tracker:
             if all(np.hypot(*(got.uv - f.uv)) > self.states[i].radius for f in found.values()):
                 found[i] = got
 
+    def _sizes_at_start(self, image: np.ndarray, found: dict[int, _Found]) -> None:
+        """In the first frame, a disc found away from where the scene starts it, while a blob of
+        another size sits nearer that start, is refused with both: the scene's radius is likely
+        wrong, and blobs under a sixth of the area it gives are not taken for the body, so
+        something else near by was (a ball toss with the radius 3.5 times too large followed
+        the thrower's hand)."""
+        for i, got in found.items():
+            s = self.states[i]
+            u, v = self.pred_uv[i]
+            off = float(np.hypot(got.uv[0] - u, got.uv[1] - v))
+            if not s.disc or off <= max(s.radius, 2.0):
+                continue
+            reach = math.ceil(off)
+            r0, r1 = max(0, int(v) - reach), min(self.h, int(v) + reach + 1)
+            c0, c1 = max(0, int(u) - reach), min(self.w, int(u) + reach + 1)
+            crop = (slice(r0, r1), slice(c0, c1))
+            diff = self.light.difference(image[crop], self.bg[crop], self.bg_index[crop])
+            blobs = find_blobs(diff, self.low, self.high, offset=(r0, c0), min_area=2.0)
+            near = [
+                b
+                for b, _, _, w in blobs
+                if w.max() >= 1.0 and np.hypot(b.u - u, b.v - v) < 0.5 * off
+            ]
+            for b in sorted(near, key=lambda b: np.hypot(b.u - u, b.v - v)):
+                ratio = b.area / s.area
+                if 1 / PLAUSIBLE**2 <= ratio <= PLAUSIBLE**2:
+                    continue  # a blob of its size: not a question of size
+                seen = math.sqrt(b.area / math.pi)
+                mpp = self.cal.metres_per_pixel((u, v))
+                raise BodyNotFoundError(
+                    f"body {s.body.name!r} is not clear in the first frame: where the scene starts "
+                    f"it (u={u:.0f}, v={v:.0f}) a blob of about {seen:.1f} px radius sits "
+                    f"{np.hypot(b.u - u, b.v - v):.1f} px away, while the scene's radius makes "
+                    f"{s.radius:.1f} px there; the nearest blob of that size is {off:.0f} px "
+                    f"away (u={got.uv[0]:.0f}, v={got.uv[1]:.0f}). If the blob at the start is "
+                    f"the body, its radius is about {seen * mpp:.3g} m, not "
+                    f"{s.radius * mpp:.3g} m: correct the scene's radius (scene new --radius) "
+                    "or the calibration's scale"
+                )
+
     def _faint(
         self, i: int, image: np.ndarray, gate: float, found: dict[int, _Found]
     ) -> _Found | None:
@@ -580,7 +621,11 @@ class Tracker:
         from physbench.video.diagnosis import Missing, not_found
 
         s = self.states[i]
-        missing = Missing(s.body.name, self.pred_uv[i], s.radius, s.area, s.body.position)
+        shape = s.body.shape
+        metres = shape.radius if isinstance(shape, Circle) else None
+        missing = Missing(
+            s.body.name, self.pred_uv[i], s.radius, s.area, s.body.position, metres=metres
+        )
         return not_found(
             missing,
             image,

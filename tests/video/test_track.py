@@ -663,3 +663,27 @@ def test_a_slow_motion_clip_is_tracked_in_real_seconds_at_its_capture_rate(tmp_p
     assert first.index == 0 and first.time == pytest.approx(15 / 240.0)
     with pytest.warns(PhysbenchWarning, match=r"plays at 30 frames/s.*--capture-fps 240"):
         track_video(path, scene, cal, background=plate, allow_gaps=True)
+
+
+def test_a_scene_radius_far_from_the_balls_is_named_not_a_bigger_blob_near_by() -> None:
+    """A ball of 4 px where the scene's radius makes 14 px, a larger blob 40 px off (a thrower's
+    hand): the first frame is refused with the blob at the start and the radius it shows, not
+    the hand taken for the ball; at 10 px, where no larger blob is near, the diagnosis names the
+    size too (it said "too little contrast"); at the right radius the ball is tracked."""
+    from physbench.video.spheres import Sphere
+
+    ball = Sphere(4.0, (0.95, 0.95, 0.95), ambient=1.0, specular=0.0)
+    hand = Sphere(15.0, (0.85, 0.6, 0.45), ambient=1.0, specular=0.0)
+    frames, plate = _painted([(ball, (160.0, 120.0)), (hand, (122.0, 132.0))])
+    scene, cal = _still("ball", (160.0, 120.0), 14.0)
+    with pytest.raises(TrackError, match=r"not clear in the first frame") as caught:
+        track_frames(frames, scene, cal, plate)
+    text = str(caught.value)
+    assert "a blob of about 4" in text and "its radius is about 0.04" in text, text
+    frames, plate = _painted([(ball, (160.0, 120.0))])
+    scene, cal = _still("ball", (160.0, 120.0), 10.0)
+    with pytest.raises(TrackError, match=r"is about 4\.\d px in radius, where the scene's") as c2:
+        track_frames(frames, scene, cal, plate)
+    assert "not 0.1 m" in str(c2.value) and "too little contrast" not in str(c2.value)
+    scene, cal = _still("ball", (160.0, 120.0), 4.0)
+    assert track_frames(frames, scene, cal, plate).summary.detections == {"ball": 4}
