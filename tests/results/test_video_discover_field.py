@@ -5,7 +5,8 @@ grid ran, each clip in a domain of its own, and what it measured, held against i
 these tests hold the measured figures and where the misses lie, so that a change that moves them
 must update the table and the docs (docs/video.md). ``earlier/`` holds the grid before the arms
 were centred between their ends, with the reruns and the visibility study made against it;
-``hires_1280/`` the small-ball clips filmed at twice the resolution."""
+``hires_1280/`` the small-ball clips filmed at twice the resolution; ``heldout_3_4/`` seeds 3 and
+4, run once after the tracker changes that seeds 0-2 guided."""
 
 from __future__ import annotations
 
@@ -22,6 +23,7 @@ ROWS = DATA["rows"]
 HIDDEN = [r for r in ROWS if r["effect"]]
 CONTROLS = [r for r in ROWS if not r["effect"]]
 EARLIER_ROWS = json.loads((EARLIER / "results.json").read_text())["rows"]
+HELDOUT = json.loads((FOLDER / "heldout_3_4" / "results.json").read_text())
 TOLERANCE = 0.10
 #: Balls below this radius (px) are below the noise of this camera in many frames.
 TINY = 2.0
@@ -202,3 +204,26 @@ def test_the_drops_rerun_has_no_refused_clip() -> None:
     assert not any(r["field"].get("failure") for r in rerun)
     assert all(right(r) for r in rerun) and len(rerun) == 12
     assert all(right(r) for r in ROWS if r["scene"] == "drops")
+
+
+def test_on_seeds_the_tracker_was_not_tuned_on_bodies_of_two_pixels_or_more_are_mostly_right() -> (
+    None
+):
+    """Seeds 3 and 4, every effect, scene and engine with controls (180 clips, git d648fb7):
+    bodies of 2 px or more right in 131 of 134 (199 of 200 on seeds 0-2); one refused, a ball
+    of 2.1 px; no false alarm. The two wrong: a lens distortion 17.8 % off on two pucks, and a
+    bouncer whose restitution came with a sensor offset (its magnitude 26.6 % off)."""
+    rows = HELDOUT["rows"]
+    assert HELDOUT["seeds"] == [3, 4] and len(rows) == 180
+    big = [r for r in rows if r["body_px"] >= TINY]
+    assert (len(big), sum(right(r) for r in big)) == (134, 131)
+    refused = [r for r in big if "filmed_failure" in r]
+    assert [name(r) for r in refused] == ["clock_scale/projectile_kicked/box2d/4"]
+    assert refused[0]["body_px"] < 2.2
+    wrong = sorted(name(r) for r in big if not right(r) and "filmed_failure" not in r)
+    assert wrong == [
+        "lens_distortion/two_pucks/box2d/3",
+        "velocity_dependent_restitution/bouncer/pymunk/4",
+    ]
+    alarms = [r for r in rows if not r["effect"] and not right(r) and "filmed_failure" not in r]
+    assert alarms == [] and sum(not r["effect"] for r in rows) == 60
