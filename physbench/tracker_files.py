@@ -452,8 +452,8 @@ def project_video(
     """Where physbench can read the video of the Tracker project at ``path``: a file, or for an
     image sequence a folder holding its images alone (numbered in order). From a ``.trz`` the
     video is extracted into the folder ``into``; beside a ``.trk`` it is read where the project
-    names it (relative to the project's folder), a sequence's images linked or copied into
-    ``into``. Raises :class:`TrackerFileError` naming what is missing."""
+    names it (relative to the project's folder), a sequence's images copied into ``into``.
+    Raises :class:`TrackerFileError` naming what is missing."""
     p, into = Path(path), Path(into)
     project = project or read_tracker_project(p)
     if not project.video:
