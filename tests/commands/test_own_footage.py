@@ -18,6 +18,7 @@ from physbench.scene_toml import load_scene
 from physbench.simulators.pymunk_sim import PymunkSimulator
 from physbench.testing.field_camera import FieldCamera
 from physbench.tracker_files import read_tracker_project
+from physbench.trajectory import Trajectory
 from physbench.video.writer import write_clip
 
 #: Square-on, no lens distortion and steady light: Tracker's calibration is a scale and an angle.
@@ -27,7 +28,8 @@ SQUARE_ON = {"oblique": 0.0, "k1": 0.0, "k2": 0.0, "drift": 0.0, "roll": 0.0}
 FLAT = {"ambient": 1.0, "specular": 0.0}
 
 
-def test_the_walkthrough_from_a_clip_and_a_tracker_project(tmp_path, trk, capsys) -> None:  # type: ignore[no-untyped-def]
+def _toss() -> tuple[Scene, Trajectory, FieldCamera]:
+    """A ball tossed at 30 fps in a 1.6 x 1.2 m view, its motion, and the square-on camera."""
     truth = Scene(
         "toss",
         (Body("ball", Circle(0.04), (0.2, 0.3), velocity=(2.0, 3.0), mass=0.06),),
@@ -36,8 +38,11 @@ def test_the_walkthrough_from_a_clip_and_a_tracker_project(tmp_path, trk, capsys
         frames=18,
         substeps=20,
     )
-    traj = PymunkSimulator().simulate(truth)
-    cam = FieldCamera(seed=11, **SQUARE_ON, **FLAT)
+    return truth, PymunkSimulator().simulate(truth), FieldCamera(seed=11, **SQUARE_ON, **FLAT)
+
+
+def test_the_walkthrough_from_a_clip_and_a_tracker_project(tmp_path, trk, capsys) -> None:  # type: ignore[no-untyped-def]
+    truth, traj, cam = _toss()
     write_clip(cam, tmp_path / "clip.mp4", truth, traj)
     Image.fromarray(cam.plate(truth)).save(tmp_path / "plate.png")
     # The project a teacher saved: axes on the scene's origin, a scale, hand marks (Tracker's
@@ -99,16 +104,7 @@ def test_track_follows_a_tracker_projects_own_video_from_its_first_mark(  # type
     project's calibration, and the same centres as the hand marks."""
     import zipfile
 
-    truth = Scene(
-        "toss",
-        (Body("ball", Circle(0.04), (0.2, 0.3), velocity=(2.0, 3.0), mass=0.06),),
-        bounds=(0.0, 0.0, 1.6, 1.2),
-        fps=30.0,
-        frames=18,
-        substeps=20,
-    )
-    traj = PymunkSimulator().simulate(truth)
-    cam = FieldCamera(seed=11, **SQUARE_ON, **FLAT)
+    truth, traj, cam = _toss()
     cal = cam.calibration(truth)
     mpp = cal.metres_per_pixel(cal.to_image([0.8, 0.6]))
     true_px = cam.image_points(truth, traj.states[:, 0, :2])
