@@ -94,29 +94,9 @@ def not_found(
                 "px radius nor of its area: check the body's size in the scene and the "
                 f"calibration's scale{lit}"
             )
-    # A clear, solid blob at the start, of another size: the scene's radius (or the scale) is
-    # wrong. (A faint body's blob is a part of it, its pixels barely over the threshold.)
-    odd = [
-        b
-        for b, _, _, cover in blobs
-        if cover.max() >= 1.0
-        and b.area >= 0.6 * b.count
-        and float(np.hypot(b.u - u, b.v - v)) <= near
-    ]
-    if odd:
-        b = max(odd, key=lambda b: b.area)
-        seen = float(np.sqrt(b.area / np.pi))
-        size = ""
-        if body.metres is not None:
-            size = (
-                f" (if it is the body, its radius is about {seen * body.metres / body.radius:.3g} "
-                f"m, not {body.metres:.3g} m)"
-            )
-        return (
-            f"{head}; a blob there, at pixel (u={b.u:.0f}, v={b.v:.0f}), is about {seen:.1f} px "
-            f"in radius, where the scene's radius makes {body.radius:.1f} px{size}: correct the "
-            f"scene's radius (scene new --radius) or the calibration's scale{lit}"
-        )
+    other = _another_size(body, blobs, near)
+    if other:
+        return f"{head}; {other}{lit}"
     if sized:
         # With the clip's median as the background, a body that stays put is not there at all,
         # and the blob of its size may be another body.
@@ -159,4 +139,33 @@ def not_found(
         f"{head}; nothing there differs from the background (at most {peak:.0f} grey levels; "
         f"noise threshold {noise:.0f}): check the scene's initial position, --seed, --start and "
         f"the calibration, and that the background is a plate of this camera's view{lit}"
+    )
+
+
+def _another_size(body: Missing, blobs: list, near: float) -> str:
+    """What a clear, solid blob at ``body``'s start, of another size than the scene gives it,
+    says (the scene's radius or the calibration's scale is wrong); ``""`` without one. A faint
+    body's blob is only a part of it, its pixels barely over the threshold: not solid."""
+    u, v = body.uv
+    odd = [
+        b
+        for b, _, _, cover in blobs
+        if cover.max() >= 1.0
+        and b.area >= 0.6 * b.count
+        and float(np.hypot(b.u - u, b.v - v)) <= near
+    ]
+    if not odd:
+        return ""
+    b = max(odd, key=lambda b: b.area)
+    seen = float(np.sqrt(b.area / np.pi))
+    size = ""
+    if body.metres is not None:
+        size = (
+            f" (if it is the body, its radius is about {seen * body.metres / body.radius:.3g} m, "
+            f"not {body.metres:.3g} m)"
+        )
+    return (
+        f"a blob there, at pixel (u={b.u:.0f}, v={b.v:.0f}), is about {seen:.1f} px in radius, "
+        f"where the scene's radius makes {body.radius:.1f} px{size}: correct the scene's radius "
+        "(scene new --radius) or the calibration's scale"
     )
