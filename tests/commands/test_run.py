@@ -246,6 +246,7 @@ def test_estimator_options(capsys: pytest.CaptureFixture[str]) -> None:
         (["--observation", "x.npz", "--blur", "2"], "cannot apply to --observation frames"),
         (["--observation", "missing.npz"], "observation file 'missing.npz' does not exist"),
         (["--calibration", "c.toml"], "--calibration apply to a --video only"),
+        (["--capture-fps", "240"], "--capture-fps apply to a --video only"),
         (["--observer-option", "tilt=5"], "but no observer: name the camera renderer"),
         (["--video", "v.mp4", "--observation", "x.npz"], "give one source of the observation"),
         # Found by fuzzing (issue 14): each was a traceback.

@@ -52,6 +52,8 @@ def test_video_options_apply_to_a_video_only(tmp_path, slide):
     save_scene(slide(), tmp_path / "s.toml")
     with pytest.raises(DiscoverError, match=r"calibration, start apply to a video only"):
         load_runs(tmp_path / "r.csv", tmp_path / "s.toml", calibration="c.toml", start=1.0)
+    with pytest.raises(DiscoverError, match=r"capture_fps apply to a video only"):
+        load_runs(tmp_path / "r.csv", tmp_path / "s.toml", capture_fps=240.0)
 
 
 def test_unknown_inputs_name_every_accepted_format(tmp_path, slide):
