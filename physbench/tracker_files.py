@@ -424,8 +424,6 @@ def read_tracker_project(path: str | Path, *, member: str | None = None) -> Trac
 
 # --------------------------------------------------------------------------- the video
 
-#: Files Tracker shows as an image sequence (its ``ImageVideo``).
-SEQUENCE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff")
 _NUMBERED = re.compile(r"^(?P<stem>.*?)(?P<number>\d+)(?P<suffix>\.[A-Za-z]+)$")
 
 
@@ -454,12 +452,14 @@ def project_video(
     video is extracted into the folder ``into``; beside a ``.trk`` it is read where the project
     names it (relative to the project's folder), a sequence's images copied into ``into``.
     Raises :class:`TrackerFileError` naming what is missing."""
+    from physbench.video.reader import IMAGE_SUFFIXES
+
     p, into = Path(path), Path(into)
     project = project or read_tracker_project(p)
     if not project.video:
         raise TrackerFileError(f"{p}: the project names no video; give the video itself")
     name = project.video.replace("\\", "/")
-    sequence = posixpath.splitext(name)[1].lower() in SEQUENCE_SUFFIXES
+    sequence = posixpath.splitext(name)[1].lower() in IMAGE_SUFFIXES  # a folder's images
     if p.suffix.lower() == ".trk":
         target = Path(name) if Path(name).is_absolute() else p.parent / name
         if not target.is_file():
