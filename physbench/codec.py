@@ -1,7 +1,8 @@
 """Video codecs through PyAV (FFmpeg inside its wheel, ``pip install physbench[video]``): the one
 place that imports ``av``. The video package reads and writes files with it; a camera renderer
 passes its frames through an in-memory H.264 encode and decode (:func:`h264_round_trip`) so that
-they are what a video file would hold."""
+they are what a video file would hold. :data:`IMAGE_SUFFIXES` names the image files a folder of
+frames may hold (read by PIL), which a Tracker project's image sequence is checked against too."""
 
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ import numpy as np
 
 from physbench.errors import PhysbenchError
 
+#: Image files a folder may hold, as a video's frames.
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
 #: Threads every encoder runs with. x264's output depends on its thread count, which FFmpeg sets
 #: from the machine's cores by default: the same frames coded on one core and on two differ (a
 #: ball's highlight came out with a hole on one core only). A fixed count makes a clip the same

@@ -452,7 +452,7 @@ def project_video(
     video is extracted into the folder ``into``; beside a ``.trk`` it is read where the project
     names it (relative to the project's folder), a sequence's images copied into ``into``.
     Raises :class:`TrackerFileError` naming what is missing."""
-    from physbench.video.reader import IMAGE_SUFFIXES
+    from physbench.codec import IMAGE_SUFFIXES
 
     p, into = Path(path), Path(into)
     project = project or read_tracker_project(p)

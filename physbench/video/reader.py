@@ -25,12 +25,10 @@ from typing import Any
 
 import numpy as np
 
-from physbench.codec import load_av
+from physbench.codec import IMAGE_SUFFIXES, load_av
 from physbench.errors import PhysbenchError
 from physbench.video.transfer import from_tag
 
-#: Image files a folder may hold, as frames.
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
 #: Suffixes taken for video files where a command also accepts other inputs (any container FFmpeg
 #: reads opens in :class:`VideoReader`; these are the ones a command recognises by name).
 VIDEO_SUFFIXES = (".mp4", ".m4v", ".mov", ".avi", ".mkv", ".webm", ".gif", ".mpg", ".mpeg")
