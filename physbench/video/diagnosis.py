@@ -24,11 +24,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physbench.video.detect import find_blobs
+from physbench.video.detect import Blob, find_blobs
 from physbench.video.photometry import DEVIATIONS, Light
 
 #: How far (in radii) to look for a blob of the body's size.
 SEARCH_RADII = 8.0
+#: A blob rounder than this (:attr:`~physbench.video.detect.Blob.elongation`, the ratio of its
+#: second moments; 1.44 for an ellipse of axes 1.2 : 1) is taken for a disc.
+ROUND = 1.5
 
 
 @dataclass(frozen=True)
@@ -88,6 +91,10 @@ def not_found(
         best = min(sized, key=lambda b: float(np.hypot(b.u - u, b.v - v)))
         far = float(np.hypot(best.u - u, best.v - v))
         if far <= near:
+            # A solid round blob of another size is a wrong radius or scale, not "no disc".
+            (found,) = [f for f in blobs if f[0] is best]
+            if _solid(found) and best.elongation < ROUND and abs(best.area / body.area - 1) > 0.4:
+                return f"{head}; {_size(body, best)}{lit}"
             return (
                 f"{head}; a blob there, at pixel (u={best.u:.0f}, v={best.v:.0f}), covers "
                 f"{best.area / body.area:.0%} of its area but is not a disc's of {body.radius:.1f} "
@@ -147,16 +154,22 @@ def _another_size(body: Missing, blobs: list, near: float) -> str:
     says (the scene's radius or the calibration's scale is wrong); ``""`` without one. A faint
     body's blob is only a part of it, its pixels barely over the threshold: not solid."""
     u, v = body.uv
-    odd = [
-        b
-        for b, _, _, cover in blobs
-        if cover.max() >= 1.0
-        and b.area >= 0.6 * b.count
-        and float(np.hypot(b.u - u, b.v - v)) <= near
-    ]
+    odd = [f[0] for f in blobs if _solid(f) and float(np.hypot(f[0].u - u, f[0].v - v)) <= near]
     if not odd:
         return ""
-    b = max(odd, key=lambda b: b.area)
+    return _size(body, max(odd, key=lambda b: b.area))
+
+
+def _solid(found: tuple) -> bool:
+    """Whether a blob ``(blob, u, v, coverage)`` is solid: some of it fully over the background,
+    and most of its pixels near it (a faint body's blob is a part of it, barely over the
+    threshold)."""
+    blob, _, _, cover = found
+    return bool(cover.max() >= 1.0) and blob.area >= 0.6 * blob.count
+
+
+def _size(body: Missing, b: Blob) -> str:
+    """The radius blob ``b`` at ``body``'s start shows, against the scene's."""
     seen = float(np.sqrt(b.area / np.pi))
     size = ""
     if body.metres is not None:

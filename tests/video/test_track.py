@@ -669,7 +669,8 @@ def test_a_scene_radius_far_from_the_balls_is_named_not_a_bigger_blob_near_by() 
     """A ball of 4 px where the scene's radius makes 14 px, a larger blob 40 px off (a thrower's
     hand): the first frame is refused with the blob at the start and the radius it shows, not
     the hand taken for the ball; at 10 px, where no larger blob is near, the diagnosis names the
-    size too (it said "too little contrast"); at the right radius the ball is tracked."""
+    size too (it said "too little contrast"), and at 6 px, where the ball's blob is of a size
+    the tracker still looks at; at the right radius the ball is tracked."""
     from physbench.video.spheres import Sphere
 
     ball = Sphere(4.0, (0.95, 0.95, 0.95), ambient=1.0, specular=0.0)
@@ -685,5 +686,10 @@ def test_a_scene_radius_far_from_the_balls_is_named_not_a_bigger_blob_near_by() 
     with pytest.raises(TrackError, match=r"is about 4\.\d px in radius, where the scene's") as c2:
         track_frames(frames, scene, cal, plate)
     assert "not 0.1 m" in str(c2.value) and "too little contrast" not in str(c2.value)
+    # 1.5 times its radius: the ball's blob covers 47 % of the scene's disc (it said "covers 47 %
+    # of its area but is not a disc's", without the radius it measured)
+    scene, cal = _still("ball", (160.0, 120.0), 6.0)
+    with pytest.raises(TrackError, match=r"is about 4\.\d px in radius, where the scene's"):
+        track_frames(frames, scene, cal, plate)
     scene, cal = _still("ball", (160.0, 120.0), 4.0)
     assert track_frames(frames, scene, cal, plate).summary.detections == {"ball": 4}
