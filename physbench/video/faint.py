@@ -27,6 +27,12 @@ from physbench.video.photometry import Light
 
 #: How many robust deviations of the filtered response over the crop a detection must reach.
 SIGNIFICANCE = 8.0
+#: Gates up to this radius (px) take :data:`SIGNIFICANCE` as it is; a wider gate holds more
+#: places where noise could reach it, so its threshold grows as the root of the logarithm of
+#: the number of footprints the gate holds (a Gaussian's largest of n draws grows so): a ball
+#: lost for a few frames, whose gate had grown to 116 px, took a spot of brick texture 8.9
+#: deviations high, 120 px from it, while its own disc measured 30-40.
+WIDE_GATE = 30.0
 #: Half the side (px) of the smallest crop the response's spread is measured on.
 MIN_HALF = 24
 #: The share of the frame interval the exposure is taken to last (unknown: 0.15-0.7 seen):
@@ -72,6 +78,15 @@ def _significance(resp: np.ndarray) -> np.ndarray | None:
     return None if spread <= 1e-6 else (resp - centre) / spread
 
 
+def _widening(gate: float, radius: float) -> float:
+    """How much a gate of ``gate`` px raises the threshold for a disc of ``radius`` px (see
+    :data:`WIDE_GATE`)."""
+    if gate <= WIDE_GATE:
+        return 1.0
+    n, n0 = ((g / (radius + 1.0)) ** 2 for g in (gate, WIDE_GATE))
+    return math.sqrt(math.log(n) / math.log(max(n0, 2.0)))
+
+
 def find_faint(
     image: np.ndarray,
     background: np.ndarray,
@@ -83,6 +98,7 @@ def find_faint(
     taken: Sequence[np.ndarray] = (),
     last: np.ndarray | None = None,
     significance: float = SIGNIFICANCE,
+    rivals: Sequence[tuple[np.ndarray, float]] = (),
 ) -> Faint | None:
     """The disc of ``radius`` px nearest-by-significance to ``pred`` (px) within ``gate`` px in
     ``image`` against ``background`` (both ``(H, W, 3)`` uint8) in the frame's ``light``, smeared
@@ -90,7 +106,11 @@ def find_faint(
     other bodies found in this frame, whose footprints are not this body; ``last``: where this
     body was last seen (px), not it either where the prediction has moved away from it (a lossy
     codec's skipped blocks leave a faint ghost of the body where it was); ``significance``: the
-    robust deviations a detection must reach. ``None`` where nothing within the gate reaches it."""
+    robust deviations a detection must reach in a gate of up to :data:`WIDE_GATE` px;
+    ``rivals``: the predictions (px) and gates (px) of the other bodies not yet found in this
+    frame: a place nearer one of them, in gates, is theirs (two small balls after a collision:
+    the first searched took the other's disc, 26 px from its own prediction and 4 px from the
+    other's). ``None`` where nothing within the gate reaches it."""
     h, w = image.shape[:2]
     half = max(MIN_HALF, math.ceil(gate + radius + float(np.hypot(*smear)) + 3))
     u0, v0 = round(float(pred[0])), round(float(pred[1]))
@@ -112,6 +132,9 @@ def find_faint(
     reach = radius + 0.5 * float(np.hypot(*smear)) + 2.0
     for q in taken:
         allowed &= (uu - q[0]) ** 2 + (vv - q[1]) ** 2 > (2 * reach) ** 2
+    mine = np.sqrt((uu - pred[0]) ** 2 + (vv - pred[1]) ** 2) / gate
+    for q, other in rivals:
+        allowed &= mine <= np.sqrt((uu - q[0]) ** 2 + (vv - q[1]) ** 2) / other
     if last is not None and float(np.hypot(*(last - pred))) > 2 * radius + 2.0:
         allowed &= (uu - last[0]) ** 2 + (vv - last[1]) ** 2 > (radius + 1.5) ** 2
     if not allowed.any():
@@ -119,7 +142,7 @@ def find_faint(
     z = np.where(allowed, z, -np.inf)
     k = int(np.argmax(z))
     best = float(z.flat[k])
-    if best < significance:
+    if best < significance * _widening(gate, radius):
         return None
     uv = np.array([uu.flat[k], vv.flat[k]], dtype=np.float64)
     weight = np.maximum(diff, 0.0).astype(np.float64)
@@ -134,4 +157,7 @@ def find_faint(
         uv = new
         if moved < 0.02:
             break
+    mine = float(np.hypot(*(uv - pred))) / gate
+    if any(float(np.hypot(*(uv - q))) / other < mine for q, other in rivals):
+        return None  # centred on a rival's disc: the peak was the edge of it
     return Faint(uv, best)

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -54,6 +54,7 @@ from physbench.errors import PhysbenchError
 from physbench.scene import Box, Circle
 from physbench.video.accuracy import stated_accuracy, stated_angle_accuracy
 from physbench.video.appearance import (
+    COLOUR_PIXELS,
     HIDDEN,
     Appearance,
     Look,
@@ -509,9 +510,15 @@ class Tracker:
         if first:
             self._look_wider(image, gates, reach, t, visible, found)
             self._sizes_at_start(image, found)
+        self._one_each(found, gates)
         for i in range(len(self.states)):
             if visible[i] and i not in found:
-                faint = self._faint(i, image, gates[i], found)
+                rivals = [
+                    (self.pred_uv[j], float(gates[j]))
+                    for j in range(len(self.states))
+                    if j != i and visible[j] and j not in found
+                ]
+                faint = self._faint(i, image, gates[i], found, rivals)
                 if faint is not None:
                     found[i] = faint
         for i, s in enumerate(self.states):
@@ -533,6 +540,24 @@ class Tracker:
                 s.unseen.close()
         self.frames += 1
         self.t_last = t
+
+    def _one_each(self, found: dict[int, _Found], gates: np.ndarray) -> None:
+        """Of two bodies measured less than half their radii apart, the one whose prediction is
+        nearer (in gates) keeps the measurement: the other is unseen in this frame. Rigid bodies
+        do not overlap by that much, so it is one thing measured twice (two small balls flying
+        side by side, whose blob neither could be split along: each took it whole, and the
+        lighter's track went on along the heavier)."""
+        if len(found) < 2:
+            return
+        ids = sorted(found)
+        uv = np.array([found[i].uv for i in ids])
+        r = np.array([self.states[i].radius for i in ids])
+        close = np.hypot(*(uv[:, None] - uv[None]).transpose(2, 0, 1)) < 0.5 * (r[:, None] + r)
+        for a, b in zip(*np.nonzero(np.triu(close, 1)), strict=True):
+            i, j = ids[a], ids[b]
+            if i in found and j in found:
+                off = [float(np.hypot(*(found[k].uv - self.pred_uv[k]))) / gates[k] for k in (i, j)]
+                del found[j if off[0] <= off[1] else i]
 
     def _look_wider(
         self,
@@ -597,11 +622,17 @@ class Tracker:
                 )
 
     def _faint(
-        self, i: int, image: np.ndarray, gate: float, found: dict[int, _Found]
+        self,
+        i: int,
+        image: np.ndarray,
+        gate: float,
+        found: dict[int, _Found],
+        rivals: Sequence[tuple[np.ndarray, float]] = (),
     ) -> _Found | None:
         """A disc of a few pixels that no blob showed, found by a matched filter
         (:mod:`~physbench.video.faint`): its disc smeared along its predicted motion over the
-        exposure, searched within its gate, away from the bodies found in this frame. Measured
+        exposure, searched within its gate, away from the bodies found in this frame and
+        nearer its own prediction than those of ``rivals`` (the others not found yet). Measured
         by its centroid; its looks are not learnt from it (too few, too faint pixels)."""
         s = self.states[i]
         if not s.disc or s.radius >= SMALL_DISC:
@@ -610,7 +641,9 @@ class Tracker:
         ahead = self.pred_xy[i] + s.v * (SHUTTER / self.scene.fps)
         smear = self.cal.to_image(ahead[None])[0] - pred
         taken = [f.uv for f in found.values()]
-        got = find_faint(image, self.bg, self.light, pred, gate, s.radius, smear, taken, s.last_uv)
+        got = find_faint(
+            image, self.bg, self.light, pred, gate, s.radius, smear, taken, s.last_uv, rivals=rivals
+        )
         if got is None:
             return None
         xy = self.cal.to_scene(got.uv[None])[0]
@@ -945,13 +978,17 @@ class Tracker:
         body in a median background, or its neighbour, where the body itself is not found:
         it is unseen rather than measured there), and a body left out shares the nearest blob
         on its prediction that holds much of its colour (touching bodies whose blob is smaller
-        than two bodies, or a blob given to the neighbour alone)."""
+        than two bodies, or a blob given to the neighbour alone). A blob of fewer than
+        :data:`~physbench.video.appearance.COLOUR_PIXELS` has no colour to judge: its owners
+        stay as the distances gave them."""
 
         def held(c: int, i: int) -> float:
             mask = own[c].get(i)
             return 0.0 if mask is None else float(blobs[c][3][mask].sum()) / self.states[i].area
 
         for c, members in list(owner.items()):
+            if blobs[c][0].area < COLOUR_PIXELS:
+                continue
             others = [k for k in ids if k not in members and held(c, k) >= HIDDEN]
             for i in [i for i in members if i in own[c] and held(c, i) < 0.1] if others else []:
                 members.remove(i)
@@ -962,6 +999,8 @@ class Tracker:
                 continue
             for c in np.argsort(dist[j]):
                 _, u, v, _ = blobs[c]
+                if blobs[c][0].area < COLOUR_PIXELS:
+                    continue
                 d2 = (u - self.pred_uv[i, 0]) ** 2 + (v - self.pred_uv[i, 1]) ** 2
                 if d2.min() <= gates[i] ** 2 and held(int(c), i) >= HIDDEN:
                     owner.setdefault(int(c), []).append(i)

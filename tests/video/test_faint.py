@@ -89,3 +89,50 @@ def test_a_footprint_is_the_disc_smeared_along_its_motion() -> None:
     assert still.shape[0] == still.shape[1] and moving.shape[0] > still.shape[0]
     assert abs(still.sum() - np.pi * 1.5**2) < 1.0
     assert moving.sum() > still.sum() + 6 * 2  # the swept band adds about 6 x 3 px
+
+
+def _disc_on_wall(centre: tuple[float, float], contrast: float, radius: float = 1.5):
+    """A still disc ``contrast`` grey levels over the textured wall, noise of sigma 4: the image,
+    the plate and the frame's light."""
+    rng = np.random.default_rng(7)
+    plate = _wall(rng)
+    vv, uu = np.mgrid[0:H, 0:W].astype(float)
+    cover = np.clip(radius + 0.5 - np.hypot(uu - centre[0], vv - centre[1]), 0.0, 1.0)
+    image = plate + contrast * cover[:, :, None] + rng.normal(0, 4.0, (H, W, 3))
+    light = Light(np.ones(3), np.zeros(3), 4.0, 500)
+    return np.clip(np.rint(image), 0, 255).astype(np.uint8), plate, light
+
+
+def test_a_disc_nearer_another_bodys_prediction_is_left_to_it() -> None:
+    """Body A searches 20 px from a disc that lies 1 px from body B's prediction: without B as a
+    rival A takes it; with B as one, A finds nothing (the disc is B's)."""
+    image, plate, light = _disc_on_wall((330.0, 240.0), 40.0)
+    mine, other = np.array([310.0, 240.0]), np.array([331.0, 240.5])
+    args = (image, plate, light, mine, 25.0, 1.5, np.zeros(2))
+    got = find_faint(*args)
+    assert got is not None and np.hypot(*(got.uv - [330.0, 240.0])) < 0.5
+    assert find_faint(*args, rivals=[(other, 25.0)]) is None
+    # B itself finds it, A being its rival
+    got = find_faint(image, plate, light, other, 25.0, 1.5, np.zeros(2), rivals=[(mine, 25.0)])
+    assert got is not None and np.hypot(*(got.uv - [330.0, 240.0])) < 0.5
+
+
+def test_a_wider_gate_asks_for_a_more_significant_disc() -> None:
+    """A disc found in a gate of 20 px at significance ``z`` is not taken at a threshold just
+    under ``z`` from a gate of 120 px (which holds 36 times as many places where noise could
+    reach it); a threshold under ``z`` by the widening's factor takes it again."""
+    from physbench.video.faint import WIDE_GATE, _widening
+
+    image, plate, light = _disc_on_wall((330.0, 240.0), 30.0)
+    pred = np.array([325.0, 240.0])
+    near = find_faint(image, plate, light, pred, 20.0, 1.5, np.zeros(2))
+    assert near is not None
+    z = near.significance
+    assert _widening(WIDE_GATE, 1.5) == 1.0 and 1.15 < _widening(120.0, 1.5) < 1.5
+    assert (
+        find_faint(image, plate, light, pred, 120.0, 1.5, np.zeros(2), significance=0.95 * z)
+        is None
+    )
+    lowered = 0.95 * z / _widening(120.0, 1.5)
+    got = find_faint(image, plate, light, pred, 120.0, 1.5, np.zeros(2), significance=lowered)
+    assert got is not None and np.hypot(*(got.uv - near.uv)) < 0.1

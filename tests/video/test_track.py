@@ -693,3 +693,54 @@ def test_a_scene_radius_far_from_the_balls_is_named_not_a_bigger_blob_near_by() 
         track_frames(frames, scene, cal, plate)
     scene, cal = _still("ball", (160.0, 120.0), 4.0)
     assert track_frames(frames, scene, cal, plate).summary.detections == {"ball": 4}
+
+
+def _pair_fading(gap_px: float) -> tuple[list[Frame], np.ndarray, Scene, Calibration, dict]:
+    """30 frames (320x240, a textured wall, noise) of two balls thrown side by side ``gap_px``
+    apart: ``heavy`` (3.3 px) 70 grey levels over the wall, ``light`` (2 px) 60 over it in the
+    first three frames and 12 after (too faint to find); the plate, the scene, a 1 cm per pixel
+    calibration and each ball's true pixels."""
+    from physbench.video.spheres import wall
+
+    rng = np.random.default_rng(1)
+    plate = np.rint(255 * wall((240, 320), 1)).astype(np.uint8)
+    cal = Calibration.from_scale(0.01, (0.0, 239.0))
+    heavy = Body("heavy", Circle(0.033), (0.8, 1.6), velocity=(1.5, 2.0))
+    light = Body("light", Circle(0.02), (0.8 + 0.01 * gap_px, 1.6), velocity=(1.5, 2.0))
+    scene = Scene(
+        "pair", (light, heavy), bounds=(-1.0, -1.0, 4.2, 3.4), fps=30.0, frames=30
+    ).validate()
+    vv, uu = np.mgrid[0:240, 0:320].astype(float)
+    frames, truth = [], {"heavy": [], "light": []}
+    for k in range(scene.frames):
+        t = k / scene.fps
+        image = plate + rng.normal(0, 4.0, plate.shape)
+        for body, contrast in ((heavy, 70.0), (light, 60.0 if k < 3 else 12.0)):
+            fall = np.array([0.0, -4.905 * t * t])
+            p = np.add(body.position, np.multiply(body.velocity, t)) + fall
+            u, v = cal.to_image(p)
+            truth[body.name].append((u, v))
+            r = body.shape.extent() / 0.01
+            image += contrast * np.clip(r + 0.5 - np.hypot(uu - u, vv - v), 0, 1)[:, :, None]
+        frames.append(Frame(k, t, np.clip(np.rint(image), 0, 255).astype(np.uint8)))
+    return frames, plate, scene, cal, {n: np.array(p) for n, p in truth.items()}
+
+
+@pytest.mark.parametrize("gap_px", [5.5, 7.0])
+def test_a_ball_that_fades_beside_another_is_unseen_not_measured_on_the_others_disc(
+    gap_px: float,
+) -> None:
+    """Two balls thrown side by side, the smaller too faint to find after three frames: it is
+    unseen from then on. Before, both bodies took the blob of the brighter one whole, and the
+    faint ball's track ran along the other's, 5.5-7 px off its own, in every frame (the field
+    camera's two projectiles did so after they touched)."""
+    frames, plate, scene, cal, truth = _pair_fading(gap_px)
+    result = track_frames(frames, scene, cal, plate, allow_gaps=True)
+    for name in ("heavy", "light"):
+        tuv = result.pixels[name]
+        k = np.rint(tuv[:, 0] * scene.fps).astype(int)
+        errors = np.hypot(*(tuv[:, 1:] - truth[name][k]).T)
+        assert errors.max() < 1.0, (name, errors)
+    seen = result.summary.detections
+    assert seen["heavy"] == result.summary.in_view["heavy"] >= 20
+    assert seen["light"] <= 5  # found while it shows, then unseen
