@@ -101,8 +101,8 @@ def test_every_turning_arm_is_right_since_it_is_centred_between_its_ends() -> No
 
 def test_balls_under_two_pixels_are_mostly_lost() -> None:
     tiny = [r for r in ROWS if r["body_px"] < TINY]
-    assert (len(tiny), sum(right(r) for r in tiny)) == (70, 16)
-    assert sum("filmed_failure" in r for r in tiny) == 51
+    assert (len(tiny), sum(right(r) for r in tiny)) == (70, 17)
+    assert sum("filmed_failure" in r for r in tiny) == 50
 
 
 def test_no_control_raises_a_false_alarm() -> None:
@@ -121,33 +121,46 @@ def test_no_control_raises_a_false_alarm() -> None:
 def test_the_refused_tiny_balls_are_mostly_absent_from_the_coded_pixels() -> None:
     # benchmarks/field_visibility.py: no tracker, only whether the matched filter responds at a
     # refused small ball's true centre above what it gives at places without it. Measured on
-    # the earlier grid's 51 refused clips, which are this grid's 51 too (the same clips, each in
+    # the earlier grid's 51 refused clips; this grid refuses 50 of them (the same clips, each in
     # its own domain). In 46 a ball under 2 px radius is absent in more than a tenth of its
-    # frames, so the clip fails the lost-share rule whatever tracks it.
+    # frames, so the clip fails the lost-share rule whatever tracks it. The one no longer
+    # refused held its balls in every frame: its heavier ball had been lost after the two
+    # touched (the lighter measured on its disc), and it is right now.
     vis = json.loads((EARLIER / "visibility.json").read_text())
     refused = {name(r) for r in ROWS if r["field"].get("failure") and r["body_px"] < 2.5}
     before = {name(r) for r in EARLIER_ROWS if r["field"].get("failure") and r["body_px"] < 2.5}
     cases = {row["case"] for row in vis["rows"]}
-    assert cases == refused == before and len(cases) == 51
+    assert cases == before and len(cases) == 51
+    assert cases - refused == {"control/two_projectiles/pymunk/2"} and len(refused) == 50
+    assert right(next(r for r in ROWS if name(r) == "control/two_projectiles/pymunk/2"))
     worst: dict[str, float] = {}
     for row in vis["rows"]:
         assert row["radius_px"] < TINY and row["in_view"] == 41
         worst[row["case"]] = max(worst.get(row["case"], 0.0), row["absent"] / row["in_view"])
     assert sum(v > 0.10 for v in worst.values()) == vis["summary"]["clips_absent_over_10pct"] == 46
+    assert worst["control/two_projectiles/pymunk/2"] == 0.0
 
 
 def test_at_twice_the_resolution_half_the_refused_small_balls_are_right() -> None:
     # results/video_discover_field/hires_1280: the 70 clips of balls under 2 px radius, filmed
-    # at 1280x960 in the same domains (balls of 1.7-3.9 px): 37 right, 25 refused (51 at
+    # at 1280x960 in the same domains (balls of 1.7-3.9 px): 39 right, 25 refused (50 at
     # 640x480), no false alarm. In 22 of the 25 refused, a ball is absent from the coded pixels
-    # in more than a tenth of its frames; the other 3 are the tracker's misses.
+    # in more than a tenth of its frames; the other 3 are the tracker's misses. The 18 two-ball
+    # clips were rerun after two balls side by side stopped sharing one disc: 6 right (4 before);
+    # the heavier ball (3-3.7 px, in the coded pixels in 36-41 of 41 frames) is lost in over a
+    # tenth of its frames in 2 of them (6 before), the lighter one in all 10 refused.
     hires = json.loads((FOLDER / "hires_1280" / "results.json").read_text())
     rows = hires["rows"]
     assert hires["resolution"] == 1280
     assert {name(r) for r in rows} == {name(r) for r in ROWS if r["body_px"] < TINY}
     refused = {name(r) for r in rows if "filmed_failure" in r}
     alarms = [r for r in rows if not r["effect"] and not right(r) and "filmed_failure" not in r]
-    assert (sum(right(r) for r in rows), len(refused), len(alarms)) == (37, 25, 0)
+    assert (sum(right(r) for r in rows), len(refused), len(alarms)) == (39, 25, 0)
+    two = [r for r in rows if r["scene"] == "two_projectiles"]
+    assert sum(right(r) for r in two) == 6
+    failures = [r["filmed_failure"] for r in two if "filmed_failure" in r]
+    assert len(failures) == 10 and all("body 'light'" in f for f in failures)
+    assert sum("body 'heavy' was lost" in f for f in failures) == 2
     vis = json.loads((FOLDER / "hires_1280" / "visibility.json").read_text())
     assert vis["summary"]["resolution"] == 1280
     worst: dict[str, float] = {}
