@@ -27,7 +27,7 @@ import numpy as np
 
 from physbench.codec import IMAGE_SUFFIXES, load_av
 from physbench.errors import PhysbenchError
-from physbench.video.transfer import from_tag
+from physbench.video.transfer import from_tag, hdr_from_tag
 
 #: Suffixes taken for video files where a command also accepts other inputs (any container FFmpeg
 #: reads opens in :class:`VideoReader`; these are the ones a command recognises by name).
@@ -58,7 +58,8 @@ class Frame:
 class VideoInfo:
     """What the container says: size, the average frame rate, the frame count and duration when
     it knows them (``None`` otherwise), the codec, and the transfer function the stream is tagged
-    with (:mod:`~physbench.video.transfer`; ``None``: untagged, or a folder of images)."""
+    with (:mod:`~physbench.video.transfer`; ``None``: untagged, or a folder of images) or, for
+    HDR video, the HDR curve it is tagged with (``hdr``: ``"PQ"`` or ``"HLG"``)."""
 
     width: int
     height: int
@@ -67,6 +68,7 @@ class VideoInfo:
     duration: float | None
     codec: str
     transfer: str | None = None
+    hdr: str | None = None
 
 
 def _positive(name: str, value: float | None) -> float | None:
@@ -157,6 +159,7 @@ class VideoReader:
             elif container.duration is not None:
                 duration = container.duration / 1_000_000  # microseconds
             w, h = stream.codec_context.width, stream.codec_context.height
+            trc = getattr(stream.codec_context, "color_trc", None)
             return VideoInfo(
                 h if turns % 2 else w,
                 w if turns % 2 else h,
@@ -164,7 +167,8 @@ class VideoReader:
                 frames,
                 duration,
                 stream.codec_context.name,
-                from_tag(getattr(stream.codec_context, "color_trc", None)),
+                from_tag(trc),
+                hdr_from_tag(trc),
             )
 
     # ----------------------------------------------------------------- frames

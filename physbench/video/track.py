@@ -1511,7 +1511,9 @@ def track_video(
         reader = VideoReader(path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps)
         info = reader.info()
         _check_rate(path, scene, info.rate, reader.images, capture_fps)
-        curve, _ = resolve(transfer, info.transfer)
+        curve, source = resolve(transfer, info.transfer)
+        if info.hdr and source == "default":
+            _warn_hdr(path, info.hdr)
         if calibration is None:
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
@@ -1564,6 +1566,25 @@ def _check_rate(
             f"{scene.fps:g}: physbench takes the frames' times from the file; if it is slow "
             f"motion filmed at {scene.fps:g} frames/s, give that rate (--capture-fps "
             f"{scene.fps:g}, capture_fps=...)"
+        ),
+        stacklevel=3,
+    )
+
+
+def _warn_hdr(path: str | Path, curve: str) -> None:
+    """Warn that an HDR video (tagged with the ``curve`` PQ or HLG) is read with no HDR curve."""
+    import warnings
+
+    from physbench.errors import PhysbenchWarning
+
+    nearest = " (--transfer gamma2.2 is nearest HLG's lower half, a square root)"
+    warnings.warn(
+        PhysbenchWarning(
+            f"{str(path)!r} is HDR video ({curve}): physbench has no {curve} curve and reads its "
+            "pixel values as linear light where it unmixes a turning body's blurred pixels"
+            f"{nearest if curve == 'HLG' else ''}; discs are tracked on their outlines, which "
+            "do not need the curve. For measurements, film with HDR video off (phones record "
+            "HDR by default) or give --transfer"
         ),
         stacklevel=3,
     )

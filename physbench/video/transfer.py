@@ -43,6 +43,9 @@ TAGS = {
     8: "linear",
     13: "srgb",
 }
+#: ITU-T H.273 codes of the HDR curves a phone records with (HDR video is on by default on
+#: recent phones): physbench reads their pixel values as they are, with no HDR curve.
+HDR = {16: "PQ", 18: "HLG"}
 #: The code each transfer is tagged with when written.
 CODES = {"bt709": 1, "gamma2.2": 4, "gamma2.8": 5, "linear": 8, "srgb": 13}
 #: The transfer of a video with no tag. A wrong guess costs alike both ways (an arm's centre: a
@@ -71,6 +74,15 @@ def from_tag(code: object) -> str | None:
     or a curve physbench does not read)."""
     try:
         return TAGS.get(int(code))  # type: ignore[call-overload]
+    except (TypeError, ValueError):
+        return None
+
+
+def hdr_from_tag(code: object) -> str | None:
+    """The HDR curve (``"PQ"``, ``"HLG"``) a stream's ``transfer_characteristics`` code names, or
+    ``None``."""
+    try:
+        return HDR.get(int(code))  # type: ignore[call-overload]
     except (TypeError, ValueError):
         return None
 
