@@ -115,6 +115,10 @@ SMEAR = 0.2
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
 SMALL_DISC = 5.0
+#: Two bodies measured closer than this share of the sum of their radii are one thing measured
+#: twice (rigid bodies touch at the sum; this leaves room for a pixel or so of noise on balls
+#: of a few pixels).
+OVERLAP = 0.75
 #: A disc (of :data:`SMALL_DISC` px or more) whose median contrast in the first frame is under
 #: this multiple of the noise threshold loses a share of its pixels to it (a mid-grey puck on
 #: bricks): the threshold then comes down to what the background's difference measured
@@ -266,6 +270,7 @@ class _Found:
     look: Look
     radius: float | None = None  # m, a disc's radius fitted freely to its outline
     centroid: bool = False  # a disc measured by its centroid, without an outline
+    split: bool = False  # a small disc measured on a blob it shares: its velocity is not learnt
 
 
 @dataclass(frozen=True)
@@ -510,7 +515,7 @@ class Tracker:
         if first:
             self._look_wider(image, gates, reach, t, visible, found)
             self._sizes_at_start(image, found)
-        self._one_each(found, gates)
+        self._one_each(found)
         for i in range(len(self.states)):
             if visible[i] and i not in found:
                 rivals = [
@@ -541,22 +546,22 @@ class Tracker:
         self.frames += 1
         self.t_last = t
 
-    def _one_each(self, found: dict[int, _Found], gates: np.ndarray) -> None:
-        """Of two bodies measured less than half their radii apart, the one whose prediction is
-        nearer (in gates) keeps the measurement: the other is unseen in this frame. Rigid bodies
-        do not overlap by that much, so it is one thing measured twice (two small balls flying
-        side by side, whose blob neither could be split along: each took it whole, and the
-        lighter's track went on along the heavier)."""
-        if len(found) < 2:
+    def _one_each(self, found: dict[int, _Found]) -> None:
+        """Of two discs measured closer than :data:`OVERLAP` of the sum of their radii, the one
+        whose prediction is nearer keeps the measurement: the other is unseen in this frame.
+        Discs do not overlap so, so it is one thing measured twice (two small balls flying side
+        by side, whose blob neither could be split along: each took it whole, and the lighter's
+        track went on along the heavier). Other bodies may: arms joined at an elbow."""
+        ids = sorted(i for i in found if self.states[i].disc)
+        if len(ids) < 2:
             return
-        ids = sorted(found)
         uv = np.array([found[i].uv for i in ids])
         r = np.array([self.states[i].radius for i in ids])
-        close = np.hypot(*(uv[:, None] - uv[None]).transpose(2, 0, 1)) < 0.5 * (r[:, None] + r)
-        for a, b in zip(*np.nonzero(np.triu(close, 1)), strict=True):
+        apart = np.hypot(*(uv[:, None] - uv[None]).transpose(2, 0, 1))
+        for a, b in zip(*np.nonzero(np.triu(apart < OVERLAP * (r[:, None] + r), 1)), strict=True):
             i, j = ids[a], ids[b]
             if i in found and j in found:
-                off = [float(np.hypot(*(found[k].uv - self.pred_uv[k]))) / gates[k] for k in (i, j)]
+                off = [float(np.hypot(*(found[k].uv - self.pred_uv[k]))) for k in (i, j)]
                 del found[j if off[0] <= off[1] else i]
 
     def _look_wider(
@@ -686,7 +691,9 @@ class Tracker:
         if s.seen and dt > 0:
             kick = self.motion.kick(s.body.name, s.t, dt)
             hit = float(s.v @ s.contact) if s.contact is not None else 0.0
-            s.v = (xy - s.xy) / dt + kick.dv - kick.dx / dt
+            # A split measurement's position leans towards its neighbour: the velocity goes on
+            # as predicted.
+            s.v = s.v + kick.dv if found.split else (xy - s.xy) / dt + kick.dv - kick.dx / dt
             s.bounce = 0.0
             if s.contact is not None:
                 s.v, s.bounce = _off_surface(s.v, s.contact, hit)
@@ -1100,6 +1107,11 @@ class Tracker:
             if s.look and s.look.mismatch(got.look, hidden=hidden) is not None:
                 s.rejected += 1
                 continue
+            if shared and s.disc and s.radius < SMALL_DISC:
+                # A blob of a few pixels holds no outline to split along: the split centres
+                # lean towards each other (a ball of 1 px came out 2.5 px towards the one it
+                # touched, and the velocity from that carried its prediction onto the other).
+                got = replace(got, split=True)
             out[i] = got
         return out
 
