@@ -1595,8 +1595,8 @@ def _warn_hdr(path: str | Path, curve: str) -> None:
             f"{str(path)!r} is HDR video ({curve}): physbench has no {curve} curve and reads its "
             "pixel values as linear light where it unmixes a turning body's blurred pixels"
             f"{nearest if curve == 'HLG' else ''}; discs are tracked on their outlines, which "
-            "do not need the curve. For measurements, film with HDR video off (phones record "
-            "HDR by default) or give --transfer"
+            "do not need the curve. For measurements, film with HDR video off (many phones "
+            "record HDR by default) or give --transfer"
         ),
         stacklevel=3,
     )

@@ -44,7 +44,7 @@ TAGS = {
     13: "srgb",
 }
 #: ITU-T H.273 codes of the HDR curves a phone records with (HDR video is on by default on
-#: recent phones): physbench reads their pixel values as they are, with no HDR curve.
+#: many recent phones): physbench reads their pixel values as they are, with no HDR curve.
 HDR = {16: "PQ", 18: "HLG"}
 #: The code each transfer is tagged with when written.
 CODES = {"bt709": 1, "gamma2.2": 4, "gamma2.8": 5, "linear": 8, "srgb": 13}
