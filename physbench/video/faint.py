@@ -132,9 +132,10 @@ def find_faint(
     reach = radius + 0.5 * float(np.hypot(*smear)) + 2.0
     for q in taken:
         allowed &= (uu - q[0]) ** 2 + (vv - q[1]) ** 2 > (2 * reach) ** 2
-    mine = np.sqrt((uu - pred[0]) ** 2 + (vv - pred[1]) ** 2) / gate
-    for q, other in rivals:
-        allowed &= mine <= np.sqrt((uu - q[0]) ** 2 + (vv - q[1]) ** 2) / other
+    if rivals:
+        mine = np.sqrt((uu - pred[0]) ** 2 + (vv - pred[1]) ** 2) / gate
+        for q, other in rivals:
+            allowed &= mine <= np.sqrt((uu - q[0]) ** 2 + (vv - q[1]) ** 2) / other
     if last is not None and float(np.hypot(*(last - pred))) > 2 * radius + 2.0:
         allowed &= (uu - last[0]) ** 2 + (vv - last[1]) ** 2 > (radius + 1.5) ** 2
     if not allowed.any():
@@ -157,7 +158,7 @@ def find_faint(
         uv = new
         if moved < 0.02:
             break
-    mine = float(np.hypot(*(uv - pred))) / gate
-    if any(float(np.hypot(*(uv - q))) / other < mine for q, other in rivals):
+    off = float(np.hypot(*(uv - pred))) / gate
+    if any(float(np.hypot(*(uv - q))) / other < off for q, other in rivals):
         return None  # centred on a rival's disc: the peak was the edge of it
     return Faint(uv, best)
