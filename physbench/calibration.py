@@ -414,15 +414,16 @@ def loads_calibration_csv(text: str, *, source: str = "") -> Calibration:
 def load_calibration(path: str | Path) -> Calibration:
     """Read a calibration file (TOML, CSV of point pairs, or a Tracker project: see the module
     docstring); errors name the file and the key."""
-    p = Path(path)
+    from physbench.tracker_files import is_tracker_file, read_tracker_project, tracker_path
+
+    tracker = is_tracker_file(path)
+    p = tracker_path(path)[0] if tracker else Path(path)
     if not p.is_file():
         raise CalibrationError(f"calibration file {str(p)!r} does not exist")
-    suffix = p.suffix.lower()
-    if suffix in (".trz", ".trk"):
-        from physbench.tracker_files import read_tracker_project
-
-        project = read_tracker_project(p)
+    if tracker:
+        project = read_tracker_project(path)
         return Calibration(project.homography(), None, 0.0, project.source)
+    suffix = p.suffix.lower()
     try:
         text = p.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:

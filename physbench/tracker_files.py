@@ -21,9 +21,13 @@ files and usually the video. :func:`read_tracker_project` reads:
 - **the clock**: frame ``n`` is at ``starttime + (n - startframe) delta_t`` (ms; ``startframe``
   and ``starttime`` from the ``VideoClip``, ``delta_t`` from the clip control), as Tracker itself
   times it. physbench's recording time 0 is the first marked frame (recordings start at 0).
-- **hand-marked points**: every ``PointMass`` track (not model particles, centres of mass or
-  other tracks), one body per track name, its marks ``framedata[n]`` (Tracker image pixels in
-  frame ``n``) and its ``mass`` (with ``mass_unit``: kg, g or mg).
+- **hand-marked points**: every ``PointMass`` track (not model particles or other tracks), one
+  body per track name, its marks ``framedata[n]`` (Tracker image pixels in frame ``n``) and its
+  ``mass`` (with ``mass_unit``: kg, g or mg; Tracker's 1 where none is stated).
+- **centres of mass**: a ``CenterOfMass`` track (the point a teacher follows on a spinning or
+  jointed body whose ends were marked: a diabolo, a thrown bat) is computed as Tracker computes
+  it: the mass-weighted mean of the point masses it names, in the frames where all of them are
+  marked, with their total mass. Its file stores no points of its own.
 
 Video filters that move pixels (perspective, radial distortion, rotation, resize) put Tracker's
 image coordinates in the filtered picture: such a project still gives a recording, but
@@ -81,6 +85,9 @@ GEOMETRIC_FILTERS = (
 MAX_TRK_BYTES = 64 * 1024 * 1024
 TRACKER_SUFFIXES = (".trz", ".trk")
 _POINT_MASS = "org.opensourcephysics.cabrillo.tracker.PointMass"
+_CENTRE_OF_MASS = "org.opensourcephysics.cabrillo.tracker.CenterOfMass"
+#: Tracker's mass of a point mass whose file states none.
+DEFAULT_MASS = 1.0
 
 
 class TrackerFileError(PhysbenchError, ValueError):
@@ -334,7 +341,52 @@ def _marks(x: _Xml, root: ElementTree.Element, kg_per_unit: float) -> dict[str, 
         ys = np.array([x.number(steps[n], "y") for n in frames])
         mass = x.number(obj, "mass", math.nan)
         out[name] = Marks(frames, xs, ys, None if math.isnan(mass) else mass * kg_per_unit)
+    for item in tracks.findall("property"):
+        obj = item.find("object")
+        if obj is not None and obj.get("class") == _CENTRE_OF_MASS:
+            name, centre = _centre_of_mass(x, obj, out, kg_per_unit)
+            if centre is not None:
+                out[name] = centre
     return out
+
+
+def _centre_of_mass(
+    x: _Xml, obj: ElementTree.Element, points: Mapping[str, Marks], kg_per_unit: float
+) -> tuple[str, Marks | None]:
+    """A ``CenterOfMass`` track's name and :class:`Marks` (``None`` where its point masses share
+    no marked frame): the mass-weighted mean of the point masses it names, in the frames
+    where all are marked. Raises naming a point mass that is not in the file."""
+    name = (x.text(obj, "name") or "").strip()
+    if not name:
+        raise x.fail("a centre-of-mass track has no name; name it in Tracker")
+    if name in points:
+        raise x.fail(f"two tracks are named {name!r}; rename one in Tracker")
+    listed = x.props(obj).get("masses")
+    members = [] if listed is None else [(p.text or "").strip() for p in listed.findall("property")]
+    if not members:
+        raise x.fail(f"centre of mass {name!r} names no point masses; add them in Tracker")
+    missing = [m for m in members if m not in points]
+    if missing:
+        raise x.fail(
+            f"centre of mass {name!r} names {', '.join(map(repr, missing))}, which is no "
+            f"point-mass track of the file (it has {', '.join(map(repr, points)) or 'none'})"
+        )
+    frames = points[members[0]].frames
+    for m in members[1:]:
+        frames = np.intersect1d(frames, points[m].frames)
+    if not len(frames):
+        return name, None
+    unstated = DEFAULT_MASS * kg_per_unit
+    weights = [unstated if points[m].mass is None else points[m].mass for m in members]
+    total = float(sum(weights))
+    if not total > 0:
+        raise x.fail(f"centre of mass {name!r}: its point masses weigh {total:g} in all")
+    xs, ys = np.zeros(len(frames)), np.zeros(len(frames))
+    for m, w in zip(members, weights, strict=True):
+        at = np.searchsorted(points[m].frames, frames)
+        xs += w * points[m].x[at]
+        ys += w * points[m].y[at]
+    return name, Marks(frames, xs / total, ys / total, total)
 
 
 def _unit(x: _Xml, root: ElementTree.Element, key: str, table: Mapping[str, float]) -> tuple:
@@ -384,14 +436,27 @@ def parse_tracker_xml(text: str | bytes, *, source: str = "<trk>") -> TrackerPro
     )
 
 
+def tracker_path(path: str | Path) -> tuple[Path, str | None]:
+    """The file of a Tracker project path and the project it names inside an archive:
+    ``ARCHIVE.trz:INNER.trk`` (as physbench names a project's source) is ``(ARCHIVE.trz,
+    INNER.trk)``; any other path is itself, with no member."""
+    text = str(path)
+    at = text.lower().rfind(".trz:")
+    if at < 0:
+        return Path(text), None
+    return Path(text[: at + 4]), text[at + 5 :] or None
+
+
 def is_tracker_file(path: str | Path) -> bool:
-    return Path(path).suffix.lower() in TRACKER_SUFFIXES
+    return tracker_path(path)[0].suffix.lower() in TRACKER_SUFFIXES
 
 
 def read_tracker_project(path: str | Path, *, member: str | None = None) -> TrackerProject:
-    """Read a ``.trk`` file, or the ``.trk`` inside a ``.trz`` archive (``member`` names it when
-    the archive holds several)."""
-    p = Path(path)
+    """Read a ``.trk`` file, or the ``.trk`` inside a ``.trz`` archive: ``member`` (or a path
+    ``ARCHIVE.trz:MEMBER``) names it, by its path in the archive or its file name, when the
+    archive holds several."""
+    p, named = tracker_path(path)
+    member = member or named
     if not p.is_file():
         raise TrackerFileError(f"Tracker project {str(p)!r} does not exist")
     if p.suffix.lower() == ".trk":
@@ -402,15 +467,10 @@ def read_tracker_project(path: str | Path, *, member: str | None = None) -> Trac
         raise TrackerFileError(f"{p}: expected a Tracker project (.trz or .trk)")
     try:
         with zipfile.ZipFile(p) as z:
-            projects = [i for i in z.infolist() if i.filename.lower().endswith(".trk")]
-            if member is not None:
-                projects = [i for i in projects if i.filename == member]
+            every = [i for i in z.infolist() if i.filename.lower().endswith(".trk")]
+            projects = every if member is None else _named(every, member)
             if len(projects) != 1:
-                names = ", ".join(i.filename for i in projects) or "none"
-                raise TrackerFileError(
-                    f"{p}: holds {len(projects)} Tracker projects (.trk: {names}); "
-                    + ("name one" if projects else "expected one")
-                )
+                raise _which(p, every, member)
             info = projects[0]
             if info.file_size > MAX_TRK_BYTES:
                 raise TrackerFileError(f"{p}: {info.filename} is over {MAX_TRK_BYTES >> 20} MiB")
@@ -420,6 +480,26 @@ def read_tracker_project(path: str | Path, *, member: str | None = None) -> Trac
             f"{p}: not a zip archive; a .trz is a zipped Tracker project"
         ) from None
     return parse_tracker_xml(data, source=f"{p}:{info.filename}")
+
+
+def _named(projects: list[zipfile.ZipInfo], member: str) -> list[zipfile.ZipInfo]:
+    """The archive's projects ``member`` names: by its path in the archive, else its file name."""
+    exact = [i for i in projects if i.filename == member]
+    return exact or [i for i in projects if posixpath.basename(i.filename) == member]
+
+
+def _which(p: Path, projects: list[zipfile.ZipInfo], member: str | None) -> TrackerFileError:
+    """The error for an archive whose project is not named, or not found, by ``member``."""
+    names = ", ".join(repr(i.filename) for i in projects) or "none"
+    if not projects:
+        return TrackerFileError(f"{p}: holds no Tracker project (.trk); expected one")
+    if member is not None:
+        return TrackerFileError(f"{p}: no project {member!r} in it; it holds {names}")
+    example = posixpath.basename(projects[0].filename)
+    return TrackerFileError(
+        f"{p}: holds {len(projects)} Tracker projects ({names}); name one after a colon, "
+        f"as in '{p}:{example}'"
+    )
 
 
 # --------------------------------------------------------------------------- the video
@@ -454,8 +534,8 @@ def project_video(
     Raises :class:`TrackerFileError` naming what is missing."""
     from physbench.codec import IMAGE_SUFFIXES
 
-    p, into = Path(path), Path(into)
-    project = project or read_tracker_project(p)
+    project = project or read_tracker_project(path)
+    p, into = tracker_path(path)[0], Path(into)
     if not project.video:
         raise TrackerFileError(f"{p}: the project names no video; give the video itself")
     name = project.video.replace("\\", "/")

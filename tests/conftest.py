@@ -386,12 +386,16 @@ def tracker_xml(
     coords_frames: dict[int, tuple[float, float, float, float, float]] | None = None,
     filters: tuple[str, ...] = (),
     video: str = "videos/clip.mp4",
+    masses: dict[str, float | None] | None = None,
+    centres: dict[str, list[str]] | None = None,
 ) -> str:
     """A Tracker project (.trk XML) laid out as Tracker 6 saves one: the panel's image size and
     units, the video clip and its clip control, the fixed coordinate system (``angle`` in
     degrees, ``scale`` in px per unit), an axes track, a tape measure, a model particle (which is
     not a measurement) and one point-mass track per entry of ``marks`` (frame -> Tracker image
-    point); ``video``: the path the clip names (a file, or an image sequence's first image)."""
+    point); ``video``: the path the clip names (a file, or an image sequence's first image);
+    ``masses``: a track's own mass (``None``: no mass stated), else ``mass``; ``centres``: centre
+    of mass tracks (name -> the point masses it names), which store no points of their own."""
     media, tracker = "org.opensourcephysics.media.core", "org.opensourcephysics.cabrillo.tracker"
     frames = coords_frames or {0: (*origin, angle, *scale)}
     coords = _obj(
@@ -456,14 +460,26 @@ def tracker_xml(
             + "</property>"
             for n, (x, y) in sorted(points.items())
         )
+        own = (masses or {}).get(name, mass)
         items.append(
             _obj(
                 f"{tracker}.PointMass",
-                _prop("mass", "double", mass),
+                *([_prop("mass", "double", own)] if own is not None else []),
                 _prop("name", "string", name),
                 f'<property name="framedata" type="array" class="[L{tracker}.PointMass$FrameData;">'
                 + steps
                 + "</property>",
+            )
+        )
+    for name, members in (centres or {}).items():
+        items.append(
+            _obj(
+                f"{tracker}.CenterOfMass",
+                '<property name="masses" type="collection" class="java.util.ArrayList">'
+                + "".join(_prop("item", "string", m) for m in members)
+                + "</property>",
+                _prop("mass", "double", 0.0),
+                _prop("name", "string", name),
             )
         )
     return (

@@ -18,6 +18,7 @@ from physbench.tracker_files import (
     TrackerFileError,
     parse_tracker_xml,
     read_tracker_project,
+    tracker_path,
 )
 
 ORIGIN, ANGLE, SCALE = (212.5, 301.25), 30.0, (150.0, 150.0)  # px, degrees, px per cm
@@ -111,11 +112,22 @@ def test_a_trz_archive_holds_the_project(trk, trk_image, tmp_path) -> None:  # t
     from_trk = read_tracker_project(trk_path).recording().track("ball")
     assert np.array_equal(from_trz.x, from_trk.x) and np.array_equal(from_trz.t, from_trk.t)
     assert np.allclose(load_calibration(trz).homography, load_calibration(trk_path).homography)
+    later = project(trk, trk_image, tmp_path, "later.trk", start_frame=0)
     with zipfile.ZipFile(trz, "a") as z:
-        z.write(trk_path, "second.trk")
-    with pytest.raises(TrackerFileError, match=r"holds 2 Tracker projects.*second\.trk"):
+        z.write(later, "runs/second.trk")
+    with pytest.raises(TrackerFileError, match=r"holds 2 Tracker projects.*runs/second\.trk.*"
+                       r"name one after a colon, as in '.*toss\.trz:toss_toss\.trk'"):  # fmt: skip
         read_tracker_project(trz)
-    assert read_tracker_project(trz, member="second.trk").marks["ball"].frames[0] == 3
+    assert read_tracker_project(trz, member="runs/second.trk").start_frame == 0
+    # ARCHIVE.trz:PROJECT names one, by its path in the archive or its file name, wherever a
+    # project is read (the calibration too); a wrong name lists what the archive holds
+    assert read_tracker_project(f"{trz}:second.trk").start_frame == 0
+    assert read_tracker_project(f"{trz}:toss_toss.trk").start_frame == 2
+    assert load_calibration(f"{trz}:second.trk").source == f"{trz}:runs/second.trk"
+    with pytest.raises(TrackerFileError, match=r"no project 'third\.trk' in it; it holds"):
+        read_tracker_project(f"{trz}:third.trk")
+    assert tracker_path(f"{trz}:runs/second.trk") == (trz, "runs/second.trk")
+    assert tracker_path(trk_path) == (trk_path, None)
 
 
 def test_units_masses_and_a_missing_unit(trk, trk_image, tmp_path) -> None:  # type: ignore[no-untyped-def]
@@ -154,3 +166,47 @@ def test_what_cannot_be_read_is_named(trk, trk_image, tmp_path) -> None:  # type
     with pytest.raises(TrackerFileError, match="does not exist"):
         read_tracker_project(tmp_path / "none.trk")
     assert math.isfinite(read_tracker_project(project(trk, trk_image, tmp_path)).t0)
+
+
+def test_a_centre_of_mass_track_is_the_mass_weighted_mean_of_its_points(  # type: ignore[no-untyped-def]
+    trk, trk_image, tmp_path
+) -> None:
+    """Both ends of a spinning bar marked (1 g and 3 g, the light end from frame 3, the heavy
+    from frame 5), and Tracker's centre of mass of the two: read as a track of its own, where
+    both ends are marked, at the bar's balance point, weighing 4 g."""
+    spin = {n: (0.0 + 5 * math.cos(n), 50.0 + 5 * math.sin(n)) for n in range(3, 12)}
+    light = {n: (WORLD[n][0] + 3 * dx, WORLD[n][1] + 3 * dy) for n, (dx, dy) in spin.items()}
+    heavy = {n: (WORLD[n][0] - dx, WORLD[n][1] - dy) for n, (dx, dy) in spin.items() if n >= 5}
+    marks = {
+        name: {n: trk_image(xy, ORIGIN, ANGLE, SCALE) for n, xy in pts.items()}
+        for name, pts in (("light end", light), ("heavy end", heavy))
+    }
+    options = {"marks": marks, "mass_unit": "g", "masses": {"light end": 1.0, "heavy end": 3.0}}
+    p = read_tracker_project(
+        project(trk, trk_image, tmp_path, centres={"cm": ["light end", "heavy end"]}, **options)
+    )
+    assert list(p.marks["cm"].frames) == list(range(5, 12))
+    assert p.marks["cm"].mass == pytest.approx(0.004)
+    cm = p.recording().track("cm")
+    want = np.array([WORLD[n] for n in range(5, 12)]) / 100  # cm -> m: the bar's middle
+    assert np.allclose(np.column_stack([cm.x, cm.y]), want, atol=1e-9)
+    assert cm.t[0] == pytest.approx(0.2)  # frame 5, two frames after the first mark (frame 3)
+    # An end with no mass stated weighs Tracker's default, 1 (here 1 g): the plain mean.
+    p = read_tracker_project(
+        project(
+            trk,
+            trk_image,
+            tmp_path,
+            centres={"cm": ["light end", "heavy end"]},
+            **{**options, "masses": {"light end": 1.0, "heavy end": None}},
+        )
+    )
+    plain = (np.array([light[n] for n in range(5, 12)]) + [heavy[n] for n in range(5, 12)]) / 2
+    cm = p.recording().track("cm")
+    assert np.allclose(np.column_stack([cm.x, cm.y]), plain / 100, atol=1e-9)
+    with pytest.raises(TrackerFileError, match=r"'cm' names 'tip'.*'light end', 'heavy end'"):
+        read_tracker_project(project(trk, trk_image, tmp_path, centres={"cm": ["tip"]}, **options))
+    with pytest.raises(TrackerFileError, match="two tracks are named 'light end'"):
+        read_tracker_project(
+            project(trk, trk_image, tmp_path, centres={"light end": ["heavy end"]}, **options)
+        )

@@ -111,16 +111,19 @@ def load_runs(
     slow-motion file was filmed at; :func:`~physbench.video.track.track_video`);
     ``track_out`` writes its tracks as a recording CSV."""
     from physbench.scene_toml import load_scene
+    from physbench.tracker_files import is_tracker_file, tracker_path
     from physbench.video.reader import VIDEO_SUFFIXES, is_video
 
     sc = scene if not isinstance(scene, str | Path) else load_scene(scene)
     sc.validate()
     path = Path(recording)
     video = is_video(path)
-    if not path.exists() or (not video and not path.is_file()):
+    file = tracker_path(path)[0] if is_tracker_file(path) else path  # ARCHIVE.trz:PROJECT.trk
+    if not file.exists() or (not video and not file.is_file()):
         raise DiscoverError(
-            f"recording file {str(path)!r} does not exist; expected a .csv recording, .npz frames "
-            f"or a video ({', '.join(VIDEO_SUFFIXES)}, or a folder of images)"
+            f"recording file {str(file)!r} does not exist; expected a .csv recording, .npz "
+            "frames, a Tracker project (.trz, .trk) or a video "
+            f"({', '.join(VIDEO_SUFFIXES)}, or a folder of images)"
         )
     stray = {
         "calibration": calibration,
@@ -154,9 +157,9 @@ def load_runs(
                 capture_fps=capture_fps,
             )
         ]
-    suffix = path.suffix.lower()
-    if suffix in (".trz", ".trk"):
+    if is_tracker_file(path):
         return [_tracker_run(path, sc)]
+    suffix = path.suffix.lower()
     if suffix == ".csv":
         from physbench.recording import read_recordings
 

@@ -177,7 +177,8 @@ def _clock(answers: Answers, rec: Recording | None) -> tuple[float, int]:
         steps = np.concatenate([np.diff(tr.t) for tr in rec.tracks.values()])
         steps = steps[steps > 0]
         if steps.size:
-            fps = 1.0 / float(np.median(steps))
+            # Times are sums of float steps: 80.00000000000028 is 80 frames/s.
+            fps = float(f"{1.0 / float(np.median(steps)):.9g}")
     if fps is None or not (math.isfinite(fps) and fps > 0):
         raise SetupError("the frame rate is unknown: give --fps, --video or a recording")
     if frames is None and rec is not None:

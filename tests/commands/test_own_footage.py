@@ -99,7 +99,8 @@ def test_the_walkthrough_from_a_clip_and_a_tracker_project(tmp_path, trk, capsys
 def test_track_follows_a_tracker_projects_own_video_from_its_first_mark(  # type: ignore[no-untyped-def]
     tmp_path, trk, capsys, kind
 ) -> None:
-    """``track PROJECT``: the clip inside a .trz (or the image sequence a .trk names), from the
+    """``track PROJECT``: the clip inside a .trz (one of the two projects it holds, named after a
+    colon), or the image sequence a .trk names, from the
     frame the teacher's marks start at (where ``scene new --from`` starts the scene), with the
     project's calibration, and the same centres as the hand marks."""
     import zipfile
@@ -117,7 +118,9 @@ def test_track_follows_a_tracker_projects_own_video_from_its_first_mark(  # type
         project = tmp_path / "toss.trz"
         with zipfile.ZipFile(project, "w") as z:
             z.writestr("toss.trk", trk(**options, delta_t=1000 / 30))
+            z.writestr("toss_other.trk", trk(**{**options, "marks": {"ball": {0: (1, 1)}}}))
             z.write(tmp_path / "clip.mp4", "videos/clip.mp4")
+        project = tmp_path / "toss.trz:toss.trk"  # the archive holds two projects: name one
     else:
         (tmp_path / "videos").mkdir()
         for k, image in enumerate(cam.exposure(truth, traj)):
