@@ -45,6 +45,10 @@ G = 9.81
 FIRST_SECONDS = 0.3
 #: Fewest samples an estimate uses (more if the first seconds hold more).
 FIRST_SAMPLES = 4
+#: A fit's scatter over this many times the recording's accuracy is not free motion.
+SCATTER = 4.0
+#: An acceleration past gravity's along the motion over this share of g is not free motion.
+PUSH = 0.05
 #: Physics steps per second at least (substeps = this / fps, rounded up, at least 4).
 STEPS_PER_SECOND = 600.0
 
@@ -81,6 +85,9 @@ class Estimate:
     pivot: tuple[float, float] | None
     samples: int
     rms: float  # m, the fit's residual over those samples
+    #: A flight's or puck's fitted acceleration (m/s²) over those samples, and its standard error.
+    acceleration: tuple[float, float] | None = None
+    acceleration_se: float = 0.0
 
 
 def _first(track: Track, seconds: float = FIRST_SECONDS) -> np.ndarray:
@@ -97,9 +104,19 @@ def _first(track: Track, seconds: float = FIRST_SECONDS) -> np.ndarray:
 
 def _fit(t: np.ndarray, y: np.ndarray, degree: int) -> tuple[np.ndarray, float]:
     """Polynomial coefficients (constant first) and RMS residual."""
+    c, rms, _ = _fit_se(t, y, degree)
+    return c, rms
+
+
+def _fit_se(t: np.ndarray, y: np.ndarray, degree: int) -> tuple[np.ndarray, float, np.ndarray]:
+    """:func:`_fit`, and the coefficients' standard errors (from the residual; 0 where the
+    samples leave no degree of freedom)."""
     a = np.vander(t, degree + 1, increasing=True)
     c, *_ = np.linalg.lstsq(a, y, rcond=None)
-    return c, float(np.sqrt(np.mean((a @ c - y) ** 2)))
+    rss = float(np.sum((a @ c - y) ** 2))
+    free = len(t) - degree - 1
+    cov = np.linalg.pinv(a.T @ a) * (rss / free if free > 0 else 0.0)
+    return c, math.sqrt(rss / len(t)), np.sqrt(np.maximum(np.diag(cov), 0.0))
 
 
 def fit_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
@@ -126,9 +143,11 @@ def estimate(
     if kind in ("flight", "puck"):
         # Quadratic in both: the drag or friction being looked for slows the body within 0.3 s,
         # and a fit without it would give the window's mean velocity, not the first sample's.
-        cx, rx = _fit(t, x, 2)
-        cy, ry = _fit(t, y, 2)
-        return Estimate((cx[0], cy[0]), (cx[1], cy[1]), None, len(idx), math.hypot(rx, ry))
+        cx, rx, ex = _fit_se(t, x, 2)
+        cy, ry, ey = _fit_se(t, y, 2)
+        acc = (2 * float(cx[2]), 2 * float(cy[2]))
+        se = 2 * math.hypot(ex[2], ey[2])
+        return Estimate((cx[0], cy[0]), (cx[1], cy[1]), None, len(idx), math.hypot(rx, ry), acc, se)
     if kind == "surface":
         a = math.radians(angle)
         along = x * math.cos(a) + y * math.sin(a)
@@ -228,6 +247,7 @@ def build_setup(answers: Answers, recording: Recording | None = None) -> tuple[S
                 f"{', '.join(what)} of {name!r} fitted to its first {est.samples} samples "
                 f"(residual {est.rms * 1000:.1f} mm RMS); recording time 0 is simulation time 0"
             )
+            _say_if_not_free(kind, name, est, recording.accuracy)
     if pos is None:
         raise SetupError("the initial position is unknown: give --position (or --pixel) or --from")
     vel = (0.0, 0.0) if vel is None else vel
@@ -271,6 +291,46 @@ def build_setup(answers: Answers, recording: Recording | None = None) -> tuple[S
         description=f"{kind} setup made by physbench scene new",
     )
     return scene.validate(), notes
+
+
+def _say_if_not_free(kind: str, name: str, est: Estimate, accuracy: float) -> None:
+    """Warn where a flight's or puck's first samples are not free motion, from which its start
+    was fitted: they scatter about the fit by over :data:`SCATTER` times the recording's
+    ``accuracy`` (m), or they speed up beyond gravity (drag and friction only slow a free
+    body: an acceleration past gravity's along the velocity, by over 3 standard errors and
+    :data:`PUSH` g, is a hand or a string still acting)."""
+    import warnings
+
+    from physbench.errors import PhysbenchWarning
+
+    if kind not in ("flight", "puck") or est.acceleration is None:
+        return
+    said = []
+    if accuracy > 0 and est.rms > SCATTER * accuracy:
+        said.append(
+            f"they scatter {est.rms * 1000:.1f} mm RMS about the fit, {est.rms / accuracy:.0f} "
+            f"times the recording's accuracy ({accuracy * 1000:.1f} mm)"
+        )
+    free = np.array([0.0, 0.0 if kind == "puck" else -G])
+    extra = np.asarray(est.acceleration) - free
+    speed = math.hypot(*est.velocity)
+    push = float(extra @ est.velocity) / speed if speed > 0 else 0.0
+    if push > 3 * est.acceleration_se + PUSH * G:
+        ax, ay = est.acceleration
+        said.append(
+            f"they accelerate at ({ax:.2f}, {ay:.2f}) m/s², {push:.2f} m/s² along the motion "
+            f"beyond {'gravity' if kind == 'flight' else 'none'} (drag and friction only slow "
+            "a free body)"
+        )
+    if said:
+        warnings.warn(
+            f"the first {est.samples} samples of {name!r}, which its start is fitted to, are not "
+            f"a free {kind}: {'; '.join(said)}. Is it still held or pulled there? Start the "
+            "recording after the release (in Tracker: mark from the release on), or give "
+            "--position and --velocity",
+            PhysbenchWarning,
+            stacklevel=3,
+        )
 
 
 def _vec(v: Sequence[float]) -> tuple[float, float]:

@@ -5,10 +5,12 @@ missing answers named."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 
+from physbench.errors import PhysbenchWarning
 from physbench.recording import Recording, Track
 from physbench.scene_toml import loads_scene
 from physbench.scenes.setups import (
@@ -47,6 +49,28 @@ def test_a_flight_is_fitted_and_its_scene_replays_the_recording() -> None:
     traj = PymunkSimulator().simulate(scene)
     assert np.abs(traj.states[:, 0, 1] - track.y).max() < 0.01  # the scene replays the throw
     assert loads_scene(format_setup(scene, notes)) == scene
+
+
+def test_first_samples_that_are_not_a_free_flight_are_said() -> None:
+    """A start fitted to samples where the ball is still held or pulled is said: a ball pulled up
+    a string (speeding up along its motion past gravity), and marks that scatter about the fit
+    by several times the recording's accuracy. A falling paper cup, which drag holds to a fifth
+    of g, and a clean throw are free flights and say nothing."""
+    t = np.arange(25) / 30
+    pulled = noisy(Recording({"ball": Track(t, 0.2 + t, 1.0 + t + 2.0 * t * t)}), 0.0005)
+    with pytest.warns(PhysbenchWarning, match=r"not a free flight: they accelerate at \(-?0\.\d+, "
+                      r"4\.\d+\) m/s², 9\.\d+ m/s² along the motion beyond gravity"):  # fmt: skip
+        build_setup(Answers("flight", 0.03), pulled)
+    throw = Track(t, 0.2 + 1.7 * t, 1.1 + 2.6 * t - 4.905 * t * t)
+    jumpy = noisy(Recording({"ball": throw}), 0.02)
+    jumpy = Recording(jumpy.tracks, fields=("x", "y"), accuracy=0.002)
+    with pytest.warns(PhysbenchWarning, match=r"scatter \d+\.\d mm RMS about the fit, \d+ times"):
+        build_setup(Answers("flight", 0.03), jumpy)
+    cup = Recording({"cup": Track(t, 0.4 + 0.0 * t, 1.5 - 0.5 * t - 1.0 * t * t)}, accuracy=0.002)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        build_setup(Answers("flight", 0.05), cup)
+        build_setup(Answers("flight", 0.03), Recording({"ball": throw}, accuracy=0.002))
 
 
 def test_a_puck_and_a_ball_on_a_ramp() -> None:
