@@ -67,6 +67,20 @@ class TrackSummary:
     #: Per disc, the frames measured by their centroid (no outline could be fitted).
     centroids: dict[str, int] = field(default_factory=dict)
     angle_accuracy: dict[str, float] = field(default_factory=dict)
+    #: The spans ``(first, last)`` (s) of frames whose picture lay half a pixel or more off the
+    #: background's (:mod:`~physbench.video.steadiness`), and the largest such shift (px).
+    camera_moved: list[tuple[float, float]] = field(default_factory=list)
+    camera_shift_px: float = 0.0
+
+    def camera_words(self) -> str:
+        """``the camera moved by up to 2.5 px against the background, from 0.20 to 0.90 s``, or
+        ``""`` where it stayed put."""
+        if not self.camera_moved:
+            return ""
+        return (
+            f"the camera moved by up to {self.camera_shift_px:.1f} px against the background, "
+            f"{lost_words(self.camera_moved)}"
+        )
 
     def unseen(self, body: str) -> int:
         """Frames where ``body`` was in view but not found."""
@@ -126,6 +140,8 @@ class TrackSummary:
             if name in self.angle_accuracy:
                 parts.append(f"angles to {1e3 * self.angle_accuracy[name]:.1f} mrad")
             lines.append(f"  {name:>8}: " + "; ".join(parts))
+        if self.camera_moved:
+            lines.append(f"  {self.camera_words()}")
         return "\n".join(lines)
 
 

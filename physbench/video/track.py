@@ -50,7 +50,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import ndimage
 
-from physbench.errors import PhysbenchError
+from physbench.errors import PhysbenchError, PhysbenchWarning
 from physbench.scene import Box, Circle
 from physbench.video.accuracy import stated_accuracy, stated_angle_accuracy
 from physbench.video.appearance import (
@@ -83,6 +83,7 @@ from physbench.video.silhouette import (
     fit_discs,
     window_edges,
 )
+from physbench.video.steadiness import MOVED_PX, ShiftMeter
 from physbench.video.transfer import Decoder
 
 if TYPE_CHECKING:
@@ -324,6 +325,9 @@ class Tracker:
         self.motion = Motion(scene)
         self.meter = LightMeter(background)
         self.light = Light.unchanged()
+        self.steady = ShiftMeter(background)
+        self.moved = Spans()  # frames whose picture lies MOVED_PX or more off the background's
+        self.largest_shift = 0.0  # px
         self.median = median
         self.states: list[_State] = []
         for body in scene.bodies:
@@ -506,6 +510,7 @@ class Tracker:
         gates, reach = self._gates(t, first)
         avoid = [(u, v, r) for (u, v), r in zip(self.pred_uv, reach, strict=True)]
         self.light = self.meter.measure(image, avoid)
+        self._steadiness(image, t)
         if first:
             if not any(visible):
                 raise BodyNotFoundError(self._none_in_view())
@@ -545,6 +550,16 @@ class Tracker:
                 s.unseen.close()
         self.frames += 1
         self.t_last = t
+
+    def _steadiness(self, image: np.ndarray, t: float) -> None:
+        """Whether the camera stayed put in this frame (:mod:`~physbench.video.steadiness`):
+        the tracker does not follow a moving camera, but says that it moved."""
+        shift = self.steady.measure(image, self.light)
+        if shift is None or shift.size < MOVED_PX:
+            self.moved.close()
+            return
+        self.moved.mark(t)
+        self.largest_shift = max(self.largest_shift, shift.size)
 
     def _one_each(self, found: dict[int, _Found]) -> None:
         """Of two discs measured closer than :data:`OVERLAP` of the sum of their radii, the one
@@ -664,7 +679,7 @@ class Tracker:
         missing = Missing(
             s.body.name, self.pred_uv[i], s.radius, s.area, s.body.position, metres=metres
         )
-        return not_found(
+        said = not_found(
             missing,
             image,
             self.bg,
@@ -672,6 +687,14 @@ class Tracker:
             self.low,
             median=self.median,
             deviations=self.deviations,
+        )
+        if not self.moved.open:
+            return said
+        where = "the clip's median" if self.median else "the background you gave"
+        return (
+            f"the first frame's picture lies {self.largest_shift:.1f} px off {where}: the camera "
+            f"moved, or was moved, during the clip, and {MOVING}. What else the first frame "
+            f"shows: {said}"
         )
 
     def _none_in_view(self) -> str:
@@ -1400,6 +1423,8 @@ class Tracker:
             {n: round(accuracy_px[n], 3) for n in names},
             {s.body.name: s.centroids for s in self.states if s.centroids},
             {n: round(a, 5) for n, a in angle_accuracy.items()},
+            list(self.moved.spans),
+            round(self.largest_shift, 2),
         )
         return TrackResult(recording, summary, pixels, replace(recording, tracks=measured))
 
@@ -1478,14 +1503,33 @@ def track_frames(
             if median
             else ""
         )
+        camera = result.summary.camera_words()
         raise TrackLostError(
-            "; ".join(failures) + ". A track with such gaps is not the motion; find why in a "
+            "; ".join(failures)
+            + (f". {camera[0].upper()}{camera[1:]}: {MOVING}" if camera else "")
+            + ". A track with such gaps is not the motion; find why in a "
             "--preview (an occluder, too little contrast, a body leaving the view), or pass "
             f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{held}"
             f"{_tiny(tracker, result.summary.lost_bodies())}",
             result,
         )
+    if result.summary.camera_moved:
+        import warnings
+
+        warnings.warn(
+            f"{result.summary.camera_words()}: the positions carry its motion; {MOVING}",
+            PhysbenchWarning,
+            stacklevel=2,
+        )
     return result
+
+
+#: What a moving camera means, and the fix.
+MOVING = (
+    "the tracker finds bodies against a fixed background, and every textured edge of the "
+    "background differs from it when the picture moves; film from a tripod, with the phone's "
+    "image stabilisation off"
+)
 
 
 def track_video(

@@ -1,0 +1,217 @@
+"""Whether the camera stayed put: each frame's shift against the background.
+
+The tracker finds bodies as what differs from a background, so it needs a fixed camera. A phone
+held in the hand, a tripod knocked during the clip, or a phone's image stabilisation moves the
+whole picture by a pixel or more; every textured edge of the wall then differs from the
+background, the bodies' blobs drown in that, and a lost body would be blamed on contrast or an
+occluder (measured: a toss filmed with a 0.3 px-per-frame random walk of the camera, 2.5 px at
+most, was refused as lost in 21 % of its frames, with no word of the camera).
+
+:class:`ShiftMeter` measures the shift instead: on the background's most textured pixels (the
+steepest of each cell of a grid, where a shift shows most), it compares each frame with the
+background moved by whole pixels around no shift, in the frame's light
+(:class:`~physbench.video.photometry.Light`), and takes the shift where they agree best, to a
+tenth of a pixel by a parabola through the neighbours. It walks downhill from no shift, 3 x 3
+shifts at a time (one step a frame while the camera stays put), and searches every shift up to
+:data:`SEARCH` px only where the best it walked to agrees worse than the clip's frames did before
+(a wall's periodic texture, bricks, can hold the walk in a false dip). A background with no
+texture shows no shift, and none is needed: moving a plain wall changes no pixel.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from physbench.video.photometry import Light
+
+#: Side (px) of the box a sample averages.
+BOX = 3
+#: Grid cell (px) from which the steepest background pixel is sampled.
+CELL = 24
+#: The background's gradient (grey levels per px) below which a pixel shows no shift.
+MIN_GRADIENT = 6.0
+#: The largest shift searched everywhere (px, each axis); the walk downhill may go further.
+SEARCH = 4
+#: Steps the walk downhill takes at most.
+STEPS = 12
+#: The walk steps only where a neighbour agrees better by this factor: against a blurred
+#: background (the median of a clip whose camera shook) agreement is flat, and a walk without it
+#: drifts on the noise (measured: 11 px for a 2.5 px shake).
+STEEP = 0.97
+#: A camera that moved less than this (px) stayed put, as far as the tracker is concerned.
+MOVED_PX = 0.5
+#: Residuals over this many of the frame's noise are clipped in the agreement (bodies, a hand).
+CLIP = 3.0
+#: The walk's best is trusted while it agrees within this factor of the best agreement so far
+#: (a shift between whole pixels agrees worse than the best frames: up to half a pixel of
+#: every edge's contrast).
+WORSE = 2.0
+#: A shift the search found far from the walk's replaces it where it agrees better by this
+#: factor (a periodic wall agrees in part at a period's shift).
+BETTER = 0.7
+#: Fewest textured samples a shift is measured on.
+MIN_SAMPLES = 20
+
+
+@dataclass(frozen=True)
+class Shift:
+    """How far a frame's picture lies from the background's: ``(du, dv)`` px (``u`` right, ``v``
+    down)."""
+
+    du: float
+    dv: float
+
+    @property
+    def size(self) -> float:
+        return float(np.hypot(self.du, self.dv))
+
+
+class ShiftMeter:
+    """Measures each frame's :class:`Shift` against ``background`` (``(H, W, 3)`` uint8)."""
+
+    def __init__(self, background: np.ndarray) -> None:
+        from scipy import ndimage
+
+        # Compared over 3 x 3 boxes: grain a pixel wide agrees at no shift but its own, so it
+        # narrows the dip a walk must find; edges of tiles, bricks or planks widen it.
+        smooth = ndimage.uniform_filter(background.astype(np.float32), size=(BOX, BOX, 1))
+        grey = smooth.mean(axis=2)
+        gv, gu = np.gradient(grey)
+        self.gu, self.gv = gu.ravel(), gv.ravel()
+        steep = np.hypot(gu, gv)
+        h, w = grey.shape
+        rows, cols = [], []
+        for r0 in range(BOX, h - BOX, CELL):
+            for c0 in range(BOX, w - BOX, CELL):
+                cell = steep[r0 : min(r0 + CELL, h - BOX), c0 : min(c0 + CELL, w - BOX)]
+                r, c = divmod(int(np.argmax(cell)), cell.shape[1])
+                if cell[r, c] >= MIN_GRADIENT:
+                    rows.append(r0 + r)
+                    cols.append(c0 + c)
+        self.rows, self.cols = np.array(rows, dtype=np.intp), np.array(cols, dtype=np.intp)
+        self.h, self.w = h, w
+        self.flat = self.rows * w + self.cols
+        # A channel's plane each: gathering from one is several times faster than gathering
+        # pixels of three channels.
+        self.planes = [np.ascontiguousarray(smooth[..., k]).ravel() for k in range(3)]
+        box = np.arange(BOX) - BOX // 2
+        box = (box[:, None] * w + box[None, :]).ravel()
+        self.at = 3 * (self.flat[:, None] + box[None]).ravel()  # each box's pixels' red bytes
+        self.best = np.inf  # the best agreement of a frame so far
+        self.last = (0, 0)  # the last frame's whole-pixel shift: the walk starts there
+
+    @property
+    def usable(self) -> bool:
+        """Whether the background has texture enough to show a shift."""
+        return len(self.rows) >= MIN_SAMPLES
+
+    def measure(self, image: np.ndarray, light: Light) -> Shift | None:
+        """Called by the tracker once per frame, after the frame's light is measured: the shift
+        of ``image`` against the background (``None`` where the background has too little
+        texture to tell). Bodies need not be left out: their few samples are clipped, and
+        clipped alike at every shift."""
+        if not self.usable:
+            return None
+        flat = image.reshape(-1)
+        seen = sum(flat.take(self.at + k).astype(np.float32) for k in range(3))
+        seen = seen.reshape(len(self.flat), -1).mean(axis=1) / np.float32(3.0)
+        weights = (light.gain / 3.0).astype(np.float32)
+        level = np.float32(np.mean(light.offset))
+        clip2 = np.float32(CLIP * max(light.sigma, 2.0)) ** 2
+
+        def residuals(shifts: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
+            """Per whole-pixel shift, the background's samples there in this light less the
+            frame's (a picture moved by +du shows at u what was at u - du), and where they
+            are read."""
+            du = np.array([s[0] for s in shifts])[:, None]
+            dv = np.array([s[1] for s in shifts])[:, None]
+            where = (self.rows[None] - dv) * self.w + (self.cols[None] - du)
+            if np.abs(du).max() >= BOX or np.abs(dv).max() >= BOX:  # may leave the picture
+                r = np.minimum(np.maximum(self.rows[None] - dv, 0), self.h - 1)
+                c = np.minimum(np.maximum(self.cols[None] - du, 0), self.w - 1)
+                where = r * self.w + c
+            expected = sum(
+                plane.take(where) * g for plane, g in zip(self.planes, weights, strict=True)
+            )
+            return expected + level - seen, where
+
+        def cost(shifts: list[tuple[int, int]]) -> np.ndarray:
+            """The clipped mean squared disagreement at each shift."""
+            d = residuals(shifts)[0]
+            return np.minimum(d * d, clip2).mean(axis=1)
+
+        centre = self.last
+        at_last = residuals([centre])
+        here = float(np.minimum(at_last[0] ** 2, clip2).mean())
+        if not np.isfinite(self.best) or here > WORSE * self.best:  # off the last frame's shift
+            centre, here = self._walk(centre, cost)
+        if np.isfinite(self.best) and here > WORSE * self.best:
+            side = 2 * SEARCH + 1
+            every = cost(_around((0, 0), SEARCH))
+            k = int(np.argmin(every))
+            if every[k] < BETTER * here:
+                centre, here = self._walk((k % side - SEARCH, k // side - SEARCH), cost)
+        self.best = min(self.best, here)
+        step = (0.0, 0.0)
+        for _ in range(3):
+            at = at_last if centre == self.last else residuals([centre])
+            got = _between(*at, self.gu, self.gv, light, clip2)
+            if got is None:
+                break
+            step = got
+            if abs(step[0]) <= 0.5 and abs(step[1]) <= 0.5:
+                break
+            centre, step = (centre[0] + round(step[0]), centre[1] + round(step[1])), (0.0, 0.0)
+        self.last = centre
+        return Shift(centre[0] + step[0], centre[1] + step[1])
+
+    @staticmethod
+    def _walk(centre: tuple[int, int], cost) -> tuple[tuple[int, int], float]:  # type: ignore[no-untyped-def]
+        """Downhill from ``centre`` over whole-pixel shifts, a 3 x 3 neighbourhood at a time, to
+        where no neighbour agrees better by :data:`STEEP`; that shift and its cost."""
+        costs = np.zeros(9)
+        for _ in range(STEPS):
+            costs = cost(_around(centre, 1))
+            k = int(np.argmin(costs))
+            if k == 4 or costs[k] > STEEP * costs[4]:
+                break
+            centre = (centre[0] + k % 3 - 1, centre[1] + k // 3 - 1)
+        else:
+            costs = cost(_around(centre, 1))
+        return centre, float(costs[4])
+
+
+def _around(centre: tuple[int, int], radius: int) -> list[tuple[int, int]]:
+    """The whole-pixel shifts within ``radius`` of ``centre``, row-major over (dv, du)."""
+    return [
+        (centre[0] + du, centre[1] + dv)
+        for dv in range(-radius, radius + 1)
+        for du in range(-radius, radius + 1)
+    ]
+
+
+def _between(
+    d: np.ndarray,
+    where: np.ndarray,
+    gu: np.ndarray,
+    gv: np.ndarray,
+    light: Light,
+    clip2: np.float32,
+) -> tuple[float, float] | None:
+    """The shift between whole pixels from the residuals ``d`` ``(1, n)`` at a whole-pixel
+    shift, read at ``where``: a Lucas-Kanade step (frame = background(u - s) ~ background(u) -
+    gradient . s), on the samples that agree (clipped ones left out), each axis within a pixel;
+    ``None`` where the samples' edges run one way only."""
+    d, where = d[0], where[0]
+    ok = d * d < clip2
+    g = np.float32(np.mean(light.gain))
+    su, sv = gu.take(where)[ok] * g, gv.take(where)[ok] * g
+    uu, uv, vv = float(su @ su), float(su @ sv), float(sv @ sv)
+    det = uu * vv - uv * uv
+    if ok.sum() < MIN_SAMPLES or not det > 1e-6 * (uu + vv) ** 2:
+        return None
+    bu, bv = float(su @ d[ok]), float(sv @ d[ok])
+    du, dv = (vv * bu - uv * bv) / det, (uu * bv - uv * bu) / det
+    return min(max(du, -1.0), 1.0), min(max(dv, -1.0), 1.0)
