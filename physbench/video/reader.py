@@ -59,7 +59,8 @@ class VideoInfo:
     """What the container says: size, the average frame rate, the frame count and duration when
     it knows them (``None`` otherwise), the codec, and the transfer function the stream is tagged
     with (:mod:`~physbench.video.transfer`; ``None``: untagged, or a folder of images) or, for
-    HDR video, the HDR curve it is tagged with (``hdr``: ``"PQ"`` or ``"HLG"``)."""
+    HDR video, the HDR curve it is tagged with (``hdr``: ``"PQ"`` or ``"HLG"``), and whether it
+    is ``interlaced`` (each frame two fields filmed half a frame apart)."""
 
     width: int
     height: int
@@ -69,6 +70,7 @@ class VideoInfo:
     codec: str
     transfer: str | None = None
     hdr: str | None = None
+    interlaced: bool = False
 
 
 def _positive(name: str, value: float | None) -> float | None:
@@ -150,7 +152,8 @@ class VideoReader:
             return VideoInfo(w, h, rate, n, n / rate, "images")
         with self._open() as container:
             stream = self._stream(container)
-            turns = _quarter_turns(self.path, _first_rotation(container, stream))
+            rotation, interlaced = _first_frame(container, stream)
+            turns = _quarter_turns(self.path, rotation)
             rate = float(stream.average_rate or stream.guessed_rate or 0.0)
             frames = int(stream.frames) or None
             duration = None
@@ -169,6 +172,7 @@ class VideoReader:
                 stream.codec_context.name,
                 from_tag(trc),
                 hdr_from_tag(trc),
+                interlaced,
             )
 
     # ----------------------------------------------------------------- frames
@@ -295,13 +299,23 @@ def _upright(frame: Any, path: Path) -> np.ndarray:
     return np.ascontiguousarray(np.rot90(image, turns)) if turns else image
 
 
-def _first_rotation(container: Any, stream: Any) -> float:
-    """The display rotation of the stream's first frame (degrees counter-clockwise; 0 when the
-    file cannot be decoded here: :meth:`VideoReader.frames` says why)."""
+#: FFmpeg's field orders of interlaced video (``AVFieldOrder``: top or bottom field first,
+#: coded and shown either way); 0 is unknown and 1 progressive.
+INTERLACED_ORDERS = (2, 3, 4, 5)
+
+
+def _first_frame(container: Any, stream: Any) -> tuple[float, bool]:
+    """The display rotation of the stream's first frame (degrees counter-clockwise) and whether
+    it is interlaced (flagged so, or the stream's field order says so); ``(0, False)`` as far as
+    the file cannot be decoded here (:meth:`VideoReader.frames` says why)."""
     av = load_av()
+    order = getattr(stream.codec_context, "field_order", 0)
     try:
         for frame in container.decode(stream):
-            return float(getattr(frame, "rotation", 0) or 0)
+            interlaced = bool(getattr(frame, "interlaced_frame", False))
+            return float(
+                getattr(frame, "rotation", 0) or 0
+            ), interlaced or order in INTERLACED_ORDERS
     except av.error.FFmpegError:
         pass
-    return 0.0
+    return 0.0, order in INTERLACED_ORDERS

@@ -1570,6 +1570,8 @@ def track_video(
         curve, source = resolve(transfer, info.transfer)
         if info.hdr and source == "default":
             _warn_hdr(path, info.hdr)
+        if info.interlaced:
+            _warn_interlaced(path, info.rate)
         if calibration is None:
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
@@ -1641,6 +1643,22 @@ def _warn_hdr(path: str | Path, curve: str) -> None:
             f"{nearest if curve == 'HLG' else ''}; discs are tracked on their outlines, which "
             "do not need the curve. For measurements, film with HDR video off (many phones "
             "record HDR by default) or give --transfer"
+        ),
+        stacklevel=3,
+    )
+
+
+def _warn_interlaced(path: str | Path, rate: float) -> None:
+    """Warn that ``path`` is interlaced video, which the tracker reads a frame at a time."""
+    import warnings
+
+    twice = f" ({2 * rate:g} frames/s)" if rate > 0 else ""
+    warnings.warn(
+        PhysbenchWarning(
+            f"{str(path)!r} is interlaced video: each frame holds two fields filmed half a frame "
+            "apart, so a moving body shows as a comb of both and is measured at their mean, and "
+            "a disc's outline does not fit it. Deinterlace it into a frame per field"
+            f"{twice}: ffmpeg -i IN -vf yadif=1 OUT.mp4 (or film progressive video, as phones do)"
         ),
         stacklevel=3,
     )
