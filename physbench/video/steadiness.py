@@ -84,12 +84,22 @@ class ShiftMeter:
 
         # Compared over 3 x 3 boxes: grain a pixel wide agrees at no shift but its own, so it
         # narrows the dip a walk must find; edges of tiles, bricks or planks widen it.
-        smooth = ndimage.uniform_filter(background.astype(np.float32), size=(BOX, BOX, 1))
-        grey = smooth.mean(axis=2)
+        # A channel's plane each (gathering from one is several times faster than gathering
+        # pixels of three channels), in float16 (a tenth of a grey level at worst): with the
+        # gradients, 10 bytes a pixel in all.
+        h, w = background.shape[:2]
+        self.planes = [
+            ndimage.uniform_filter(background[..., k].astype(np.float32), BOX)
+            .astype(np.float16)
+            .ravel()
+            for k in range(3)
+        ]
+        grey = sum(p.astype(np.float32) for p in self.planes).reshape(h, w) / np.float32(3.0)
         gv, gu = np.gradient(grey)
-        self.gu, self.gv = gu.ravel(), gv.ravel()
+        del grey
+        self.gu, self.gv = gu.astype(np.float16).ravel(), gv.astype(np.float16).ravel()
         steep = np.hypot(gu, gv)
-        h, w = grey.shape
+        del gu, gv
         rows, cols = [], []
         for r0 in range(BOX, h - BOX, CELL):
             for c0 in range(BOX, w - BOX, CELL):
@@ -101,9 +111,6 @@ class ShiftMeter:
         self.rows, self.cols = np.array(rows, dtype=np.intp), np.array(cols, dtype=np.intp)
         self.h, self.w = h, w
         self.flat = self.rows * w + self.cols
-        # A channel's plane each: gathering from one is several times faster than gathering
-        # pixels of three channels.
-        self.planes = [np.ascontiguousarray(smooth[..., k]).ravel() for k in range(3)]
         box = np.arange(BOX) - BOX // 2
         box = (box[:, None] * w + box[None, :]).ravel()
         self.at = 3 * (self.flat[:, None] + box[None]).ravel()  # each box's pixels' red bytes
@@ -147,7 +154,8 @@ class ShiftMeter:
                 c = np.minimum(np.maximum(self.cols[None] - du, 0), self.w - 1)
                 where = r * self.w + c
             expected = sum(
-                plane.take(where) * g for plane, g in zip(self.planes, weights, strict=True)
+                plane.take(where).astype(np.float32) * g
+                for plane, g in zip(self.planes, weights, strict=True)
             )
             return expected + level - seen, where
 
@@ -222,7 +230,8 @@ def _between(
     spread = 1.4826 * float(np.median(np.abs(d)))  # what is left of the noise, and any body
     ok = d * d < min(float(clip2), (CLIP * max(spread, 1.0)) ** 2)
     g = np.float32(np.mean(light.gain))
-    su, sv = gu.take(where)[ok] * g, gv.take(where)[ok] * g
+    su = gu.take(where)[ok].astype(np.float32) * g
+    sv = gv.take(where)[ok].astype(np.float32) * g
     uu, uv, vv = float(su @ su), float(su @ sv), float(sv @ sv)
     det = uu * vv - uv * uv
     if ok.sum() < MIN_SAMPLES or not det > 1e-6 * (uu + vv) ** 2:
