@@ -319,11 +319,15 @@ def _filters(root: ElementTree.Element) -> tuple[str, ...]:
     return tuple(sorted(found))
 
 
-def _marks(x: _Xml, root: ElementTree.Element, kg_per_unit: float) -> dict[str, Marks]:
+def _marks(
+    x: _Xml, root: ElementTree.Element, kg_per_unit: float
+) -> tuple[dict[str, Marks], list[str]]:
+    """The point-mass tracks and centres of mass, and a note for each centre left out."""
     tracks = x.props(root).get("tracks")
     out: dict[str, Marks] = {}
+    left: list[str] = []
     if tracks is None:
-        return out
+        return out, left
     for item in tracks.findall("property"):
         obj = item.find("object")
         if obj is None or obj.get("class") != _POINT_MASS:
@@ -345,17 +349,19 @@ def _marks(x: _Xml, root: ElementTree.Element, kg_per_unit: float) -> dict[str, 
         obj = item.find("object")
         if obj is not None and obj.get("class") == _CENTRE_OF_MASS:
             name, centre = _centre_of_mass(x, obj, out, kg_per_unit)
-            if centre is not None:
+            if isinstance(centre, Marks):
                 out[name] = centre
-    return out
+            else:
+                left.append(f"centre of mass {name!r} left out: {centre}")
+    return out, left
 
 
 def _centre_of_mass(
     x: _Xml, obj: ElementTree.Element, points: Mapping[str, Marks], kg_per_unit: float
-) -> tuple[str, Marks | None]:
-    """A ``CenterOfMass`` track's name and :class:`Marks` (``None`` where its point masses share
-    no marked frame): the mass-weighted mean of the point masses it names, in the frames
-    where all are marked. Raises naming a point mass that is not in the file."""
+) -> tuple[str, Marks | str]:
+    """A ``CenterOfMass`` track's name and :class:`Marks`: the mass-weighted mean of the point
+    masses it names, in the frames where all are marked; or, as Tracker shows no point for it,
+    why not (it names no point mass of the file, or they share no marked frame)."""
     name = (x.text(obj, "name") or "").strip()
     if not name:
         raise x.fail("a centre-of-mass track has no name; name it in Tracker")
@@ -363,19 +369,15 @@ def _centre_of_mass(
         raise x.fail(f"two tracks are named {name!r}; rename one in Tracker")
     listed = x.props(obj).get("masses")
     members = [] if listed is None else [(p.text or "").strip() for p in listed.findall("property")]
-    if not members:
-        raise x.fail(f"centre of mass {name!r} names no point masses; add them in Tracker")
     missing = [m for m in members if m not in points]
-    if missing:
-        raise x.fail(
-            f"centre of mass {name!r} names {', '.join(map(repr, missing))}, which is no "
-            f"point-mass track of the file (it has {', '.join(map(repr, points)) or 'none'})"
-        )
+    if not members or missing:
+        named = ", ".join(map(repr, missing)) if missing else "no point mass"
+        return name, f"it names {named}, not a marked point mass of the file"
     frames = points[members[0]].frames
     for m in members[1:]:
         frames = np.intersect1d(frames, points[m].frames)
     if not len(frames):
-        return name, None
+        return name, f"its point masses {', '.join(map(repr, members))} share no marked frame"
     unstated = DEFAULT_MASS * kg_per_unit
     weights = [unstated if points[m].mass is None else points[m].mass for m in members]
     total = float(sum(weights))
@@ -417,6 +419,7 @@ def parse_tracker_xml(text: str | bytes, *, source: str = "<trk>") -> TrackerPro
     unit, metres, note = _unit(x, root, "length_unit", LENGTH_UNITS)
     _, kg, mass_note = _unit(x, root, "mass_unit", MASS_UNITS)
     start, t0, dt, video = _clock(x, root)
+    marks, left = _marks(x, root, kg)
     w, h = x.number(root, "width", 0.0), x.number(root, "height", 0.0)
     return TrackerProject(
         source=source,
@@ -430,9 +433,9 @@ def parse_tracker_xml(text: str | bytes, *, source: str = "<trk>") -> TrackerPro
         frame_ms=dt,
         image_size=(round(w), round(h)) if w > 0 and h > 0 else None,
         video=video,
-        marks=_marks(x, root, kg),
+        marks=marks,
         filters=_filters(root),
-        notes=tuple(n for n in (note, mass_note) if n),
+        notes=tuple(n for n in (note, mass_note, *left) if n),
     )
 
 
@@ -462,7 +465,7 @@ def read_tracker_project(path: str | Path, *, member: str | None = None) -> Trac
     if p.suffix.lower() == ".trk":
         if p.stat().st_size > MAX_TRK_BYTES:
             raise TrackerFileError(f"{p}: over {MAX_TRK_BYTES >> 20} MiB; not a Tracker project?")
-        return parse_tracker_xml(p.read_bytes(), source=str(p))
+        return _said(parse_tracker_xml(p.read_bytes(), source=str(p)))
     if p.suffix.lower() != ".trz":
         raise TrackerFileError(f"{p}: expected a Tracker project (.trz or .trk)")
     try:
@@ -479,7 +482,18 @@ def read_tracker_project(path: str | Path, *, member: str | None = None) -> Trac
         raise TrackerFileError(
             f"{p}: not a zip archive; a .trz is a zipped Tracker project"
         ) from None
-    return parse_tracker_xml(data, source=f"{p}:{info.filename}")
+    return _said(parse_tracker_xml(data, source=f"{p}:{info.filename}"))
+
+
+def _said(project: TrackerProject) -> TrackerProject:
+    """``project``, its notes (a unit taken as SI, a centre of mass left out) each warned of."""
+    import warnings
+
+    from physbench.errors import PhysbenchWarning
+
+    for note in project.notes:
+        warnings.warn(PhysbenchWarning(f"{project.source}: {note}"), stacklevel=3)
+    return project
 
 
 def _named(projects: list[zipfile.ZipInfo], member: str) -> list[zipfile.ZipInfo]:

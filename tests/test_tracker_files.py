@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from physbench.calibration import load_calibration
+from physbench.errors import PhysbenchWarning
 from physbench.tracker_files import (
     MARK_ACCURACY_PX,
     PIXEL_OFFSET,
@@ -135,7 +136,8 @@ def test_units_masses_and_a_missing_unit(trk, trk_image, tmp_path) -> None:  # t
         project(trk, trk_image, tmp_path, unit="ft", mass=250.0, mass_unit="g")
     )
     assert p.metres_per_unit == 0.3048 and p.marks["ball"].mass == pytest.approx(0.25)
-    p = read_tracker_project(project(trk, trk_image, tmp_path, unit=None))
+    with pytest.warns(PhysbenchWarning, match=r"toss\.trk: length_unit not stated: taken as m"):
+        p = read_tracker_project(project(trk, trk_image, tmp_path, unit=None))
     assert p.metres_per_unit == 1.0 and any("taken as m" in n for n in p.notes)
     with pytest.raises(TrackerFileError, match="length_unit = 'furlong'"):
         read_tracker_project(project(trk, trk_image, tmp_path, unit="furlong"))
@@ -204,8 +206,13 @@ def test_a_centre_of_mass_track_is_the_mass_weighted_mean_of_its_points(  # type
     plain = (np.array([light[n] for n in range(5, 12)]) + [heavy[n] for n in range(5, 12)]) / 2
     cm = p.recording().track("cm")
     assert np.allclose(np.column_stack([cm.x, cm.y]), plain / 100, atol=1e-9)
-    with pytest.raises(TrackerFileError, match=r"'cm' names 'tip'.*'light end', 'heavy end'"):
-        read_tracker_project(project(trk, trk_image, tmp_path, centres={"cm": ["tip"]}, **options))
+    # One that names no marked point mass shows no point in Tracker: left out, and said.
+    with pytest.warns(PhysbenchWarning, match="'cm' left out"):
+        p = read_tracker_project(
+            project(trk, trk_image, tmp_path, centres={"cm": ["tip"]}, **options)
+        )
+    assert "cm" not in p.marks and "light end" in p.marks
+    assert any("'cm' left out: it names 'tip', not a marked point mass" in n for n in p.notes)
     with pytest.raises(TrackerFileError, match="two tracks are named 'light end'"):
         read_tracker_project(
             project(trk, trk_image, tmp_path, centres={"light end": ["heavy end"]}, **options)
