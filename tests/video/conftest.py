@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from physbench.calibration import Calibration
 from physbench.components import create
 from physbench.render.camera import CameraRenderer
 from physbench.scene import Scene
@@ -45,3 +46,47 @@ def film(tmp_path: Path) -> Callable[..., Clip]:
         return Clip(path, scene, traj, camera)
 
     return make
+
+
+@dataclass
+class StillDisc:
+    """A still dark disc on a lighter wall, 128x96 px at 10 fps for 2 s: its scene, calibration
+    and plate, and :meth:`clip` to write it as a video."""
+
+    scene: Scene
+    calibration: Calibration
+    plate: np.ndarray
+
+    def clip(self, path: Path, *, trc: int | None = None, interlaced: bool = False) -> Path:
+        """The clip, H.264 written with PyAV: its stream tagged with transfer characteristics
+        ``trc`` (physbench's writer tags only the curves it reads), or coded ``interlaced`` (top
+        field first)."""
+        import av
+
+        frame = self.plate.copy()
+        vv, uu = np.mgrid[0:96, 0:128]
+        frame[(uu - 64) ** 2 + (vv - 48) ** 2 <= 8**2] = 60
+        with av.open(str(path), "w") as container:
+            stream = container.add_stream("libx264", rate=10)
+            stream.width, stream.height, stream.pix_fmt = 128, 96, "yuv420p"
+            if trc is not None:
+                stream.codec_context.color_trc = trc
+            if interlaced:
+                stream.options = {"x264-params": "tff=1"}
+            for i in range(20):
+                f = av.VideoFrame.from_ndarray(frame, format="rgb24")
+                f.pts = i
+                container.mux(stream.encode(f))
+            container.mux(stream.encode(None))
+        return path
+
+
+@pytest.fixture
+def still_disc() -> StillDisc:
+    """:class:`StillDisc`."""
+    from physbench.scene import Body, Circle
+
+    cal = Calibration.from_scale(0.01, (0.0, 95.0))
+    ball = Body("ball", Circle(0.08), tuple(cal.to_scene((64.0, 48.0))))
+    scene = Scene("s", (ball,), bounds=(0.0, 0.0, 1.28, 0.96), gravity=(0.0, 0.0), fps=10.0)
+    return StillDisc(scene.validate(), cal, np.full((96, 128, 3), 180, np.uint8))

@@ -148,51 +148,25 @@ def test_a_phone_clip_with_a_display_rotation_is_read_upright(tmp_path: Path) ->
         list(VideoReader(tmp_path / "tilted.mp4").frames())
 
 
-def _disc_clip(path: Path, *, interlaced: bool) -> Path:
-    """A 2 s clip at 10 fps of a still dark disc on a lighter wall, H.264 coded interlaced (top
-    field first) or progressive."""
-    import av
-
-    frame = np.full((96, 128, 3), 180, np.uint8)
-    vv, uu = np.mgrid[0:96, 0:128]
-    frame[(uu - 64) ** 2 + (vv - 48) ** 2 <= 8**2] = 60
-    with av.open(str(path), "w") as container:
-        stream = container.add_stream("libx264", rate=10)
-        stream.width, stream.height, stream.pix_fmt = 128, 96, "yuv420p"
-        if interlaced:
-            stream.options = {"x264-params": "tff=1"}
-        for i in range(20):
-            f = av.VideoFrame.from_ndarray(frame, format="rgb24")
-            f.pts = i
-            container.mux(stream.encode(f))
-        container.mux(stream.encode(None))
-    return path
-
-
-def test_interlaced_video_is_named_and_warned_of(tmp_path: Path) -> None:
+def test_interlaced_video_is_named_and_warned_of(tmp_path: Path, still_disc) -> None:  # type: ignore[no-untyped-def]
     """An interlaced clip (as camcorders and older teaching clips are) says so in its info, and
     tracking it warns with the fix (a frame per field, at twice the rate); a progressive clip
     says nothing."""
     import warnings
 
-    from physbench.calibration import Calibration
     from physbench.errors import PhysbenchWarning
-    from physbench.scene import Body, Circle, Scene
     from physbench.video.track import track_video
 
-    cal = Calibration.from_scale(0.01, (0.0, 95.0))
-    ball = Body("ball", Circle(0.08), tuple(cal.to_scene((64.0, 48.0))))
-    scene = Scene("s", (ball,), bounds=(0.0, 0.0, 1.28, 0.96), gravity=(0.0, 0.0), fps=10.0)
-    plate = np.full((96, 128, 3), 180, np.uint8)
-    combed = _disc_clip(tmp_path / "interlaced.mp4", interlaced=True)
+    scene, cal, plate = still_disc.scene, still_disc.calibration, still_disc.plate
+    combed = still_disc.clip(tmp_path / "interlaced.mp4", interlaced=True)
     assert VideoReader(combed).info().interlaced
     with pytest.warns(
         PhysbenchWarning, match=r"is interlaced video.*\(20 frames/s\): ffmpeg -i IN -vf yadif=1"
     ):
-        got = track_video(combed, scene.validate(), cal, background=plate)
+        got = track_video(combed, scene, cal, background=plate)
     assert got.summary.detections["ball"] == 20
-    plain = _disc_clip(tmp_path / "progressive.mp4", interlaced=False)
+    plain = still_disc.clip(tmp_path / "progressive.mp4")
     assert not VideoReader(plain).info().interlaced
     with warnings.catch_warnings():
         warnings.simplefilter("error", PhysbenchWarning)
-        track_video(plain, scene.validate(), cal, background=plate)
+        track_video(plain, scene, cal, background=plate)

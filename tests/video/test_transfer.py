@@ -116,54 +116,30 @@ def test_a_gamma_camera_is_tracked_in_linear_light(tmp_path: Path, monkeypatch) 
         assert errors[True, transfer]["median"] < 0.3 and errors[True, transfer]["p95"] < 0.6
 
 
-def _tagged(path: Path, code: int) -> Path:
-    """A 2 s clip of a still grey disc on a lighter wall, its stream tagged with transfer
-    characteristics ``code`` (written with PyAV: physbench's writer tags only the curves it
-    reads)."""
-    import av
-
-    frame = np.full((96, 128, 3), 180, np.uint8)
-    vv, uu = np.mgrid[0:96, 0:128]
-    frame[(uu - 64) ** 2 + (vv - 48) ** 2 <= 8**2] = 60
-    with av.open(str(path), "w") as container:
-        stream = container.add_stream("libx264", rate=10)
-        stream.width, stream.height, stream.pix_fmt = 128, 96, "yuv420p"
-        stream.codec_context.color_trc = code
-        for i in range(20):
-            f = av.VideoFrame.from_ndarray(frame, format="rgb24")
-            f.pts = i
-            container.mux(stream.encode(f))
-        container.mux(stream.encode(None))
-    return path
-
-
-def test_hdr_video_is_named_and_warned_of_where_no_curve_is_given(tmp_path: Path) -> None:
+def test_hdr_video_is_named_and_warned_of_where_no_curve_is_given(
+    tmp_path: Path, still_disc
+) -> None:  # type: ignore[no-untyped-def]
     """A phone's HDR clip (HLG, or PQ) is tagged with a curve physbench does not read: its info
     says which, and tracking it without --transfer warns, naming the curve; with a transfer
     given, or for an SDR clip, nothing is said."""
     import warnings
 
-    from physbench.calibration import Calibration
     from physbench.errors import PhysbenchWarning
-    from physbench.scene import Body, Circle, Scene
     from physbench.video.track import track_video
 
-    cal = Calibration.from_scale(0.01, (0.0, 95.0))
-    ball = Body("ball", Circle(0.08), tuple(cal.to_scene((64.0, 48.0))))
-    scene = Scene("s", (ball,), bounds=(0.0, 0.0, 1.28, 0.96), gravity=(0.0, 0.0), fps=10.0)
-    plate = np.full((96, 128, 3), 180, np.uint8)
+    scene, cal, plate = still_disc.scene, still_disc.calibration, still_disc.plate
     for code, curve in ((18, "HLG"), (16, "PQ")):
-        path = _tagged(tmp_path / f"{curve}.mp4", code)
+        path = still_disc.clip(tmp_path / f"{curve}.mp4", trc=code)
         info = VideoReader(path).info()
         assert (info.hdr, info.transfer) == (curve, None)
         with pytest.warns(PhysbenchWarning, match=rf"is HDR video \({curve}\)"):
-            got = track_video(path, scene.validate(), cal, background=plate)
+            got = track_video(path, scene, cal, background=plate)
         assert got.summary.detections["ball"] == 20
         with warnings.catch_warnings():
             warnings.simplefilter("error", PhysbenchWarning)
-            track_video(path, scene.validate(), cal, background=plate, transfer="gamma2.2")
-    sdr = _tagged(tmp_path / "sdr.mp4", 1)
+            track_video(path, scene, cal, background=plate, transfer="gamma2.2")
+    sdr = still_disc.clip(tmp_path / "sdr.mp4", trc=1)
     assert VideoReader(sdr).info().hdr is None
     with warnings.catch_warnings():
         warnings.simplefilter("error", PhysbenchWarning)
-        track_video(sdr, scene.validate(), cal, background=plate)
+        track_video(sdr, scene, cal, background=plate)
