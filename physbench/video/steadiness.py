@@ -28,6 +28,7 @@ only one more was tracked in full.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -190,7 +191,9 @@ class ShiftMeter:
         return Shift(centre[0] + step[0], centre[1] + step[1])
 
     @staticmethod
-    def _walk(centre: tuple[int, int], cost) -> tuple[tuple[int, int], float]:  # type: ignore[no-untyped-def]
+    def _walk(
+        centre: tuple[int, int], cost: Callable[[list[tuple[int, int]]], np.ndarray]
+    ) -> tuple[tuple[int, int], float]:
         """Downhill from ``centre`` over whole-pixel shifts, a 3 x 3 neighbourhood at a time, to
         where no neighbour agrees better by :data:`STEEP`; that shift and its cost."""
         costs = np.zeros(9)
