@@ -312,10 +312,9 @@ def _first_frame(container: Any, stream: Any) -> tuple[float, bool]:
     order = getattr(stream.codec_context, "field_order", 0)
     try:
         for frame in container.decode(stream):
-            interlaced = bool(getattr(frame, "interlaced_frame", False))
-            return float(
-                getattr(frame, "rotation", 0) or 0
-            ), interlaced or order in INTERLACED_ORDERS
+            rotation = float(getattr(frame, "rotation", 0) or 0)
+            flagged = bool(getattr(frame, "interlaced_frame", False))
+            return rotation, flagged or order in INTERLACED_ORDERS
     except av.error.FFmpegError:
         pass
     return 0.0, order in INTERLACED_ORDERS
