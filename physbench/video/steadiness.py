@@ -7,19 +7,22 @@ background, the bodies' blobs drown in that, and a lost body would be blamed on 
 occluder (measured: a toss filmed with a 0.3 px-per-frame random walk of the camera, 2.5 px at
 most, was refused as lost in 21 % of its frames, with no word of the camera).
 
-:class:`ShiftMeter` measures the shift instead, on the background's most textured pixels (the
-steepest of each cell of a grid, each a 3 x 3 box, where a shift shows most), in the frame's light
-(:class:`~physbench.video.photometry.Light`): the whole-pixel shift where frame and background
-agree best (the last frame's, while it agrees as well as the clip's frames did; else a walk
-downhill over 3 x 3 shifts, and a search of every shift up to :data:`SEARCH` px where the walk
-ends in a false dip of a periodic wall, bricks), then a Lucas-Kanade step between pixels. It
-costs about 0.1 ms a 640x480 frame. Measured on tiled walls: within 0.06 px of shifts under
-1.5 px, 0.6 px of larger ones. A background with no texture shows no shift, and none is needed:
-moving a plain wall changes no pixel.
+:class:`ShiftMeter` measures the shift instead, in grey, on the background's most textured pixels
+(the steepest of each cell of a grid, each a 3 x 3 box, where a shift shows most), in the light
+that fits each shift best (a gain and an offset: the light meter's, fitted at no shift, is off
+where the picture moved): the whole-pixel shift where frame and background agree best (the last
+frame's, while it agrees as well as the clip's frames did; else a walk downhill over 3 x 3
+shifts, and a search of every shift up to :data:`SEARCH` px where the walk ends in a false dip of
+a periodic wall, bricks), then a Lucas-Kanade step between pixels with the light fitted with it.
+It costs about 0.15 ms a 640x480 frame. Measured on tiled walls in another light: within
+0.08 px of shifts up to 4 px; on a toss whose camera shook 0.3 px a frame (2.5 px at most),
+within 0.15 px. A background with no texture shows no shift, and none is needed: moving a plain
+wall changes no pixel.
 
 The tracker does not follow the camera; it says that it moved, and when. Moving each frame back
-onto the background was tried on a toss before a brick wall at 320x240, knocked by 0.6-4 px a
-third of the way through: alone, a shift measured a pixel off now and then made a false detection
+onto the background was tried (with the shifts of an earlier meter, which took the light
+meter's light and was a pixel off now and then) on a toss before a brick wall at 320x240,
+knocked by 0.6-4 px a third of the way through: alone, a shift measured a pixel off now and then made a false detection
 20 px from the ball where the tracker without it refused the clip; kept only where the moved frame
 then agreed with the background as steady frames do (and with the median taken over frames moved
 onto the first), it made no false detection, but of 8 knocked runs (4 knocks, plate and median)
@@ -28,6 +31,7 @@ only one more was tracked in full.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -83,19 +87,15 @@ class ShiftMeter:
     def __init__(self, background: np.ndarray) -> None:
         from scipy import ndimage
 
-        # Compared over 3 x 3 boxes: grain a pixel wide agrees at no shift but its own, so it
-        # narrows the dip a walk must find; edges of tiles, bricks or planks widen it.
-        # A channel's plane each (gathering from one is several times faster than gathering
-        # pixels of three channels), in float16 (a tenth of a grey level at worst): with the
-        # gradients, 10 bytes a pixel in all.
+        # Compared in grey over 3 x 3 boxes: grain a pixel wide agrees at no shift but its own,
+        # so it narrows the dip a walk must find; edges of tiles, bricks or planks widen it.
+        # Kept in float16 (a tenth of a grey level at worst) with its gradients: 6 bytes a pixel.
         h, w = background.shape[:2]
-        self.planes = [
-            ndimage.uniform_filter(background[..., k].astype(np.float32), BOX)
-            .astype(np.float16)
-            .ravel()
-            for k in range(3)
-        ]
-        grey = sum(p.astype(np.float32) for p in self.planes).reshape(h, w) / np.float32(3.0)
+        grey = np.zeros((h, w), np.float32)
+        for k in range(3):
+            grey += ndimage.uniform_filter(background[..., k].astype(np.float32), BOX)
+        grey /= np.float32(3.0)
+        self.grey = grey.ravel().astype(np.float16)
         gv, gu = np.gradient(grey)
         del grey
         self.gu, self.gv = gu.astype(np.float16).ravel(), gv.astype(np.float16).ravel()
@@ -134,8 +134,6 @@ class ShiftMeter:
         flat = image.reshape(-1)
         seen = sum(flat.take(self.at + k).astype(np.float32) for k in range(3))
         seen = seen.reshape(len(self.flat), -1).mean(axis=1) / np.float32(3.0)
-        weights = (light.gain / 3.0).astype(np.float32)
-        level = np.float32(np.mean(light.offset))
         # The frame's noise as the light meter measured it is inflated where the picture moved
         # (every edge disagrees): the least of the clip's frames is its noise.
         if light.samples:
@@ -144,9 +142,10 @@ class ShiftMeter:
         clip2 = np.float32(CLIP * max(noise, 2.0)) ** 2
 
         def residuals(shifts: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
-            """Per whole-pixel shift, the background's samples there in this light less the
-            frame's (a picture moved by +du shows at u what was at u - du), and where they
-            are read."""
+            """Per whole-pixel shift, the background's samples there in the frame's light (a
+            gain and an offset fitted at that shift: the light meter's, fitted at none, is off
+            where the picture moved) less the frame's (a picture moved by +du shows at u what
+            was at u - du), and where they are read."""
             du = np.array([s[0] for s in shifts])[:, None]
             dv = np.array([s[1] for s in shifts])[:, None]
             where = (self.rows[None] - dv) * self.w + (self.cols[None] - du)
@@ -154,11 +153,8 @@ class ShiftMeter:
                 r = np.minimum(np.maximum(self.rows[None] - dv, 0), self.h - 1)
                 c = np.minimum(np.maximum(self.cols[None] - du, 0), self.w - 1)
                 where = r * self.w + c
-            expected = sum(
-                plane.take(where).astype(np.float32) * g
-                for plane, g in zip(self.planes, weights, strict=True)
-            )
-            return expected + level - seen, where
+            e = self.grey.take(where).astype(np.float32)
+            return _in_light(e, seen) - seen, where
 
         def cost(shifts: list[tuple[int, int]]) -> np.ndarray:
             """The clipped mean squared disagreement at each shift."""
@@ -177,18 +173,47 @@ class ShiftMeter:
             if every[k] < BETTER * here:
                 centre, here = self._walk((k % side - SEARCH, k // side - SEARCH), cost)
         self.best = min(self.best, here)
-        step = (0.0, 0.0)
-        for _ in range(3):
-            at = at_last if centre == self.last else residuals([centre])
-            got = _between(*at, self.gu, self.gv, light, clip2)
-            if got is None:
+        # A step of over half a pixel moves to the next whole pixel and steps again from there;
+        # back at a pixel already stepped from, it ends at the shortest step taken.
+        steps: dict[tuple[int, int], tuple[float, float]] = {}
+        while centre not in steps and len(steps) < 3:
+            d, where = at_last if centre == self.last else residuals([centre])
+            got = self._between(d[0], where[0], seen, clip2)
+            steps[centre] = (0.0, 0.0) if got is None else got
+            if got is None or (abs(got[0]) <= 0.5 and abs(got[1]) <= 0.5):
                 break
-            step = got
-            if abs(step[0]) <= 0.5 and abs(step[1]) <= 0.5:
-                break
-            centre, step = (centre[0] + round(step[0]), centre[1] + round(step[1])), (0.0, 0.0)
+            centre = (centre[0] + round(got[0]), centre[1] + round(got[1]))
+        centre = min(steps, key=lambda c: math.hypot(*steps[c]))
         self.last = centre
-        return Shift(centre[0] + step[0], centre[1] + step[1])
+        return Shift(centre[0] + steps[centre][0], centre[1] + steps[centre][1])
+
+    def _between(
+        self, d: np.ndarray, where: np.ndarray, seen: np.ndarray, clip2: np.float32
+    ) -> tuple[float, float] | None:
+        """The shift between whole pixels from the residuals ``d`` at a whole-pixel shift, read
+        at ``where``: a Lucas-Kanade step with the light fitted with it (frame = gain
+        background(u - s) + offset, linear in the gain, the offset and gain times s), on the
+        samples that agree (clipped ones left out), each axis within a pixel; ``None`` where
+        the samples' edges run one way only."""
+        spread = 1.4826 * float(np.median(np.abs(d)))  # what is left of the noise, and any body
+        ok = d * d < min(float(clip2), (CLIP * max(spread, 1.0)) ** 2)
+        if ok.sum() < MIN_SAMPLES:
+            return None
+        where = where[ok]
+        e = self.grey.take(where).astype(np.float64)
+        gu = self.gu.take(where).astype(np.float64)
+        gv = self.gv.take(where).astype(np.float64)
+        uu, uv, vv = float(gu @ gu), float(gu @ gv), float(gv @ gv)
+        if not uu * vv - uv * uv > 1e-6 * (uu + vv) ** 2:
+            return None  # edges of one direction only
+        a = np.column_stack([e, np.ones_like(e), -gu, -gv])
+        try:
+            gain, _, pu, pv = np.linalg.solve(a.T @ a, a.T @ seen[ok].astype(np.float64))
+        except np.linalg.LinAlgError:
+            return None
+        if not gain > 0.1:
+            return None
+        return min(max(pu / gain, -1.0), 1.0), min(max(pv / gain, -1.0), 1.0)
 
     @staticmethod
     def _walk(
@@ -217,28 +242,12 @@ def _around(centre: tuple[int, int], radius: int) -> list[tuple[int, int]]:
     ]
 
 
-def _between(
-    d: np.ndarray,
-    where: np.ndarray,
-    gu: np.ndarray,
-    gv: np.ndarray,
-    light: Light,
-    clip2: np.float32,
-) -> tuple[float, float] | None:
-    """The shift between whole pixels from the residuals ``d`` ``(1, n)`` at a whole-pixel
-    shift, read at ``where``: a Lucas-Kanade step (frame = background(u - s) ~ background(u) -
-    gradient . s), on the samples that agree (clipped ones left out), each axis within a pixel;
-    ``None`` where the samples' edges run one way only."""
-    d, where = d[0], where[0]
-    spread = 1.4826 * float(np.median(np.abs(d)))  # what is left of the noise, and any body
-    ok = d * d < min(float(clip2), (CLIP * max(spread, 1.0)) ** 2)
-    g = np.float32(np.mean(light.gain))
-    su = gu.take(where)[ok].astype(np.float32) * g
-    sv = gv.take(where)[ok].astype(np.float32) * g
-    uu, uv, vv = float(su @ su), float(su @ sv), float(sv @ sv)
-    det = uu * vv - uv * uv
-    if ok.sum() < MIN_SAMPLES or not det > 1e-6 * (uu + vv) ** 2:
-        return None
-    bu, bv = float(su @ d[ok]), float(sv @ d[ok])
-    du, dv = (vv * bu - uv * bv) / det, (uu * bv - uv * bu) / det
-    return min(max(du, -1.0), 1.0), min(max(dv, -1.0), 1.0)
+def _in_light(e: np.ndarray, seen: np.ndarray) -> np.ndarray:
+    """Each row of background samples ``e`` ``(K, n)`` in the light that fits ``seen`` ``(n,)``
+    best: ``gain e + offset`` by least squares, per row."""
+    em, sm = e.mean(axis=1, keepdims=True), seen.mean()
+    de = e - em
+    gain = (de * (seen - sm)).sum(axis=1, keepdims=True) / np.maximum(
+        (de * de).sum(axis=1, keepdims=True), 1e-6
+    )
+    return gain * de + sm
