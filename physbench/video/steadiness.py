@@ -11,11 +11,12 @@ most, was refused as lost in 21 % of its frames, with no word of the camera).
 (the steepest of each cell of a grid, each a 3 x 3 box, where a shift shows most), in the light
 that fits each shift best (a gain and an offset: the light meter's, fitted at no shift, is off
 where the picture moved): the whole-pixel shift where frame and background agree best (the last
-frame's, while it agrees as well as the clip's frames did; else a walk downhill over 3 x 3
-shifts, and a search of every shift up to :data:`SEARCH` px where the walk ends in a false dip of
-a periodic wall, bricks), then a Lucas-Kanade step between pixels with the light fitted with it.
-It costs about 0.15 ms a 640x480 frame. Measured on tiled walls in another light: within
-0.08 px of shifts up to 4 px; on a toss whose camera shook 0.3 px a frame (2.5 px at most),
+frame's, while it agrees as well as the clip's frames did; else a walk downhill over 3 x 3 shifts,
+and a search of every shift up to :data:`SEARCH` px where the walk ends in a false dip of a
+periodic wall, bricks), then a Lucas-Kanade step between pixels with the light fitted with it. It
+costs 0.15-0.3 ms a 640x480 frame (0.29 on the noisy, flickering rack of the tracking speed
+benchmark, where the search runs in half the frames). Measured on tiled walls in another light:
+within 0.08 px of shifts up to 4 px; on a toss whose camera shook 0.3 px a frame (2.5 px at most),
 within 0.15 px. A background with no texture shows no shift, and none is needed: moving a plain
 wall changes no pixel.
 
