@@ -241,3 +241,31 @@ def test_on_seeds_the_tracker_was_not_tuned_on_bodies_of_two_pixels_or_more_are_
     ]
     alarms = [r for r in rows if not r["effect"] and not right(r) and "filmed_failure" not in r]
     assert alarms == [] and sum(not r["effect"] for r in rows) == 60
+
+
+def test_the_near_search_tracks_two_refused_small_balls_at_twice_the_resolution() -> None:
+    # benchmarks/faint_near.py on the 25 refused clips of hires_1280 (3 refused in their first
+    # frame either way): a small disc looked for near its prediction before its whole gate.
+    # Two of the three clips whose ball is in the coded pixels in over nine tenths of its frames
+    # (the tracker's misses above) are no longer refused; the frames it adds lie 0.1-3.5 px
+    # from the truth, and it loses 2 frames elsewhere.
+    near = json.loads((FOLDER / "hires_1280" / "near_search.json").read_text())
+    s = near["summary"]
+    assert (s["resolution"], s["clips"], s["refused_in_first_frame"]) == (1280, 25, 3)
+    assert (s["refused_without"], s["refused_with"]) == (22, 20)
+    assert s["frames_gained"] == 21 and s["frames_dropped"] == 2
+    assert s["gained_error_max_px"] < 4.0 and s["gained_error_median_px"] < 1.5
+    now = {r["case"] for r in near["rows"] if "bodies" in r and not r["refused_with"]}
+    assert now == {"axis_rotation/projectile_kicked/box2d/1", "control/projectile/box2d/2"}
+    for row in near["rows"]:
+        for body in row.get("bodies", {}).values():
+            assert body["seen_with"] >= body["seen_without"] - 2
+    # Discovered again (near_rerun/, the three clips of the tracker's misses): the control is
+    # right, the rotated axis is named first but 10.7 % off (the line is 10 %), the third is
+    # still refused.
+    rerun = json.loads((FOLDER / "hires_1280" / "near_rerun" / "results.json").read_text())
+    got = {name(r): r for r in rerun["rows"]}
+    assert right(got["control/projectile/box2d/2"])
+    axis = got["axis_rotation/projectile_kicked/box2d/1"]["filmed"]
+    assert axis["causes"][:1] == ["axis_rotation"] and 0.10 < axis["error"] < 0.11
+    assert "filmed_failure" in got["control/projectile_kicked/box2d/1"]
