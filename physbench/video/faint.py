@@ -78,13 +78,18 @@ def _significance(resp: np.ndarray) -> np.ndarray | None:
     return None if spread <= 1e-6 else (resp - centre) / spread
 
 
+def look_elsewhere(gate: float, radius: float) -> float:
+    """The significance a search within ``gate`` px needs for a disc of ``radius`` px, as a share
+    of what one within :data:`WIDE_GATE` px needs: the root of the ratio of the logarithms of the
+    number of footprints each holds (a Gaussian's largest of n draws grows so)."""
+    n, n0 = ((g / (radius + 1.0)) ** 2 for g in (gate, WIDE_GATE))
+    return math.sqrt(math.log(max(n, 2.0)) / math.log(max(n0, 2.0)))
+
+
 def _widening(gate: float, radius: float) -> float:
     """How much a gate of ``gate`` px raises the threshold for a disc of ``radius`` px (see
     :data:`WIDE_GATE`)."""
-    if gate <= WIDE_GATE:
-        return 1.0
-    n, n0 = ((g / (radius + 1.0)) ** 2 for g in (gate, WIDE_GATE))
-    return math.sqrt(math.log(n) / math.log(max(n0, 2.0)))
+    return 1.0 if gate <= WIDE_GATE else look_elsewhere(gate, radius)
 
 
 def find_faint(

@@ -72,7 +72,7 @@ from physbench.video.detect import (
     plane_pose,
     split_pixels,
 )
-from physbench.video.faint import SHUTTER, SIGNIFICANCE, WIDE_GATE, find_faint
+from physbench.video.faint import SHUTTER, SIGNIFICANCE, Faint, find_faint, look_elsewhere
 from physbench.video.medians import median
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
@@ -682,37 +682,23 @@ class Tracker:
         ahead = self.pred_xy[i] + s.v * (SHUTTER / self.scene.fps)
         smear = self.cal.to_image(ahead[None])[0] - pred
         taken = [f.uv for f in found.values()]
+
+        def search(within: float, level: float) -> Faint | None:
+            return find_faint(
+                image, self.bg, self.light, pred, within, s.radius, smear, taken, s.last_uv,
+                significance=level, rivals=rivals,
+            )  # fmt: skip
+
         got = None
         near = math.inf if s.error2 is None else NEAR * math.sqrt(s.error2) * (s.missed + 1) + 1.0
         others = [q for q, _ in rivals] + taken
         alone = all(float(np.hypot(*(q - pred))) > gate for q in others)
         if alone and s.missed <= NEAR_MISSED and near <= min(gate, NEAR_RADII * s.radius + 2.0):
-            got = find_faint(
-                image,
-                self.bg,
-                self.light,
-                pred,
-                near,
-                s.radius,
-                smear,
-                taken,
-                s.last_uv,
-                significance=max(NEAR_SIGNIFICANCE, SIGNIFICANCE * _fewer(near, s.radius)),
-                rivals=rivals,
+            got = search(
+                near, max(NEAR_SIGNIFICANCE, SIGNIFICANCE * look_elsewhere(near, s.radius))
             )
         if got is None:
-            got = find_faint(
-                image,
-                self.bg,
-                self.light,
-                pred,
-                gate,
-                s.radius,
-                smear,
-                taken,
-                s.last_uv,
-                rivals=rivals,
-            )
+            got = search(gate, SIGNIFICANCE)
         if got is None:
             return None
         xy = self.cal.to_scene(got.uv[None])[0]
@@ -1790,15 +1776,6 @@ def _colours_of(found_blob: tuple, own: Mapping[int, np.ndarray], states: list[_
     """How many bodies' colours a blob holds much of (a fifth of a body's area or more)."""
     w = found_blob[3]
     return sum(float(w[mask].sum()) >= 0.2 * states[i].area for i, mask in own.items())
-
-
-def _fewer(near: float, radius: float) -> float:
-    """How much less significance a search within ``near`` px of a prediction needs than one
-    within :data:`~physbench.video.faint.WIDE_GATE` px, for a disc of ``radius`` px: the root
-    of the ratio of the logarithms of the number of footprints each holds (a Gaussian's largest
-    of n draws grows so)."""
-    n, n0 = ((g / (radius + 1.0)) ** 2 for g in (near, WIDE_GATE))
-    return min(1.0, math.sqrt(math.log(max(n, 2.0)) / math.log(max(n0, 2.0))))
 
 
 class _Lazy:
