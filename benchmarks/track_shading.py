@@ -183,7 +183,7 @@ def table(rows: list[dict]) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results/track/shading.json")
-    ap.add_argument("--walls", type=int, default=1, help="wall seeds per case")
+    ap.add_argument("--walls", type=int, default=3, help="wall seeds per case")
     args = ap.parse_args()
     cases = []
     grid = itertools.product(

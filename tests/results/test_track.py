@@ -1,6 +1,6 @@
-"""The committed tracking benchmarks (``results/track``, ``benchmarks/track_accuracy.py``,
-``benchmarks/track_shading.py`` and ``benchmarks/track_speed.py``): the figures the docs quote,
-held against the issues' bars."""
+"""The committed tracking benchmarks (``results/track``; ``benchmarks/track_accuracy.py``,
+``track_shading.py``, ``track_edges.py`` and ``track_speed.py``): the figures the docs quote, held
+against the issues' bars."""
 
 from __future__ import annotations
 
@@ -27,22 +27,47 @@ def test_accuracy_over_20_seeds_of_2_to_6_balls_on_both_engines() -> None:
         assert sum(c["swaps"] for c in mine) == 0
 
 
-def test_lit_spheres_are_centred_within_a_fifth_of_a_pixel() -> None:
+def test_lit_spheres_are_centred_within_a_fifth_of_a_pixel_in_raw_frames() -> None:
     # Issue 26: a weighted centroid leans 0.7-1.1 px away from a sphere's highlight at 13-22 px
-    # radius (here: up to 3.6 px). The outline fit keeps the bias within a fifth of a pixel in
-    # raw frames; H.264's halved colour resolution moves a saturated ball's coloured rim, and a
-    # white ball's lit limb can be as bright as the wall, so coded frames keep nineteen cases in
-    # twenty within 0.3 px, the worst 0.44 px (0.49 px at 6 px radius).
+    # radius (here: up to 3.6 px). Over three walls the outline fit keeps raw frames' bias within
+    # 0.14 px in nineteen cases in twenty (the worst 0.23 px); in H.264-coded frames the halved
+    # colour resolution moves a coloured rim outwards, most on the lit side (edges.json), and a
+    # white ball's lit limb can be as bright as the wall: 0.27-0.33 px at the 95th percentile,
+    # the worst 0.48 px (0.85 px at 6 px radius). The issue's 0.2 px is not met in coded frames.
     data = json.loads((RESULTS / "shading.json").read_text())
     rows = {r["radius"]: r for r in data["summary"]}
     assert set(rows) == {6, 13, 17, 22}
+    assert {c["wall"] for c in data["cases"]} == {0, 1, 2}
     for radius in (13, 17, 22):
         r = rows[radius]
-        assert r["cases"] == 128 and r["missed_frames"] == 0
+        assert r["cases"] == 384 and r["missed_frames"] == 0
         assert r["bias_median_px"] <= 0.05 and r["bias_p95_px"] <= 0.3 and r["bias_max_px"] <= 0.5
-        assert r["centroid_bias_p95_px"] >= 1.5  # what it was: six to twelve times as much
+        assert r["centroid_bias_p95_px"] >= 1.5  # what it was: six to ten times as much
     raw = [abs(c["bias_px"]) for c in data["cases"] if c["radius"] >= 13 and not c["coded"]]
-    assert len(raw) == 192 and np.percentile(raw, 95) <= 0.15 and max(raw) <= 0.21
+    assert len(raw) == 576 and np.percentile(raw, 95) <= 0.15 and max(raw) <= 0.25
+    coded = [abs(c["bias_px"]) for c in data["cases"] if c["radius"] >= 13 and c["coded"]]
+    assert np.percentile(coded, 95) > 0.2  # said in the docs: not met there
+
+
+def test_coded_frames_move_a_coloured_rim_outwards_and_the_luma_difference_is_no_cure() -> None:
+    # Why coded frames' centres lean (benchmarks/track_edges.py): edge points found from the
+    # true centre sit on the rim in raw frames (within 0.04 px, each side's median), and outside
+    # it in coded ones, most on the lit side, so a circle through them leans towards the
+    # highlight. Edges on the luma difference do not bleed, but a lit limb darker than the
+    # sphere further in puts them inside the rim there: their circles lean 1.5 to 7 times as
+    # far at the 95th percentile.
+    data = json.loads((RESULTS / "edges.json").read_text())
+    rows = {(r["radius"], r["coded"], r["difference"]): r for r in data["summary"]}
+    assert len(rows) == 8 and all(r["cases"] == 96 for r in rows.values())
+    raw = rows[13, False, "colour"]
+    assert all(abs(raw[f"{side}_median_px"]) <= 0.04 for side in ("toward", "sides", "away"))
+    for radius in (6, 13):
+        coded = rows[radius, True, "colour"]
+        assert coded["toward_median_px"] >= 0.25 and coded["sides_median_px"] >= 0.15
+        assert coded["toward_median_px"] >= coded["away_median_px"] + 0.2
+        for is_coded in (False, True):
+            luma, colour = rows[radius, is_coded, "luma"], rows[radius, is_coded, "colour"]
+            assert luma["toward_median_px"] < 0 and luma["bias_p95_px"] > colour["bias_p95_px"]
 
 
 def test_speed_with_either_background_and_flat_memory() -> None:
