@@ -38,6 +38,9 @@ def test_lit_spheres_are_centred_within_a_fifth_of_a_pixel_in_raw_frames() -> No
     rows = {r["radius"]: r for r in data["summary"]}
     assert set(rows) == {6, 13, 17, 22}
     assert {c["wall"] for c in data["cases"]} == {0, 1, 2}
+    # A black 6 px ball on a warm wall was rejected as another colour in 21 coded frames (its
+    # hue is noise): appearance.SAME_COLOUR.
+    assert rows[6]["missed_frames"] == 0
     for radius in (13, 17, 22):
         r = rows[radius]
         assert r["cases"] == 384 and r["missed_frames"] == 0
