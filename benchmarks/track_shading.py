@@ -119,6 +119,7 @@ def run_case(radius, colour, light, seed, *, blur, coded) -> dict:
         cal,
         plate,
         allow_gaps=True,
+        subsampled=coded,  # H.264 at 4:2:0, as track_video reads from the file
     )
     px = result.pixels["ball"]
     k = np.rint(px[:, 0] * FPS).astype(int)

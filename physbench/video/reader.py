@@ -60,7 +60,8 @@ class VideoInfo:
     it knows them (``None`` otherwise), the codec, and the transfer function the stream is tagged
     with (:mod:`~physbench.video.transfer`; ``None``: untagged, or a folder of images) or, for
     HDR video, the HDR curve it is tagged with (``hdr``: ``"PQ"`` or ``"HLG"``), and whether it
-    is ``interlaced`` (each frame two fields filmed half a frame apart)."""
+    is ``interlaced`` (each frame two fields filmed half a frame apart), and whether its colour is
+    ``subsampled`` (stored at a lower resolution than brightness: 4:2:0, 4:2:2)."""
 
     width: int
     height: int
@@ -71,6 +72,15 @@ class VideoInfo:
     transfer: str | None = None
     hdr: str | None = None
     interlaced: bool = False
+    subsampled: bool = False
+
+
+def _subsampled(fmt: Any, width: int, height: int) -> bool:
+    """Whether the pixel format ``fmt`` (an ``av.VideoFormat`` or ``None``) stores colour at a
+    lower resolution than brightness."""
+    if fmt is None or fmt.is_rgb or not width or not height:
+        return False
+    return fmt.chroma_width(width) < width or fmt.chroma_height(height) < height
 
 
 def _positive(name: str, value: float | None) -> float | None:
@@ -173,6 +183,7 @@ class VideoReader:
                 from_tag(trc),
                 hdr_from_tag(trc),
                 interlaced,
+                _subsampled(stream.codec_context.format, w, h),
             )
 
     # ----------------------------------------------------------------- frames

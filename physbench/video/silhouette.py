@@ -15,7 +15,9 @@ a touching ball, an occluder), that leaves the image, or whose edge is far off t
 nothing, so the fit holds where part of the outline is hidden. Motion blur stretches a fast disc
 into a stadium, symmetric about the disc's pose at mid-exposure: where the circle does not fit
 its edges, a stadium along the disc's motion is fitted instead (a fast ball's centre errors: 95 %
-within 0.24 px, 0.59 px with the circle).
+within 0.24 px, 0.59 px with the circle). In video that stores colour at a lower resolution than
+brightness, a coloured rim bleeds outwards: a still disc's edges that look like such a halo
+(:data:`HALO`) are left out where the disc fits without them.
 """
 
 from __future__ import annotations
@@ -52,6 +54,12 @@ MAX_ARC_GAP = math.radians(150.0)
 #: With the disc's radius known from earlier frames, this much of its outline (rad) fixes its
 #: centre.
 MIN_ARC = math.radians(120.0)
+#: In video whose colour is stored at a lower resolution than its brightness (4:2:0, 4:2:2), an
+#: edge whose contrast is under this share of the difference's peak just inside it may be a
+#: halo: colour bled past the rim, where the outermost run of foreground ends (on lit spheres
+#: coded as H.264, a tenth of the edges lay a median 2 px further out than in the same frames
+#: uncoded).
+HALO = 0.75
 
 
 @dataclass(frozen=True)
@@ -103,8 +111,8 @@ class Edges:
     """Edge points found along rays: ``uv`` ``(n, 2)`` (frame px), the rays' angles ``theta``,
     each edge's ``contrast`` (grey levels, its inner level over the outside) and ``width`` (px
     from where it rises out of the noise to its half-way point: a sharp edge's is about a
-    pixel), its distance from the rays' origin (``reach``, px), and the index of the disc each
-    belongs to (``owner``)."""
+    pixel), its distance from the rays' origin (``reach``, px), the index of the disc each
+    belongs to (``owner``), and whether each may be a :data:`HALO` (``halo``)."""
 
     uv: np.ndarray
     theta: np.ndarray
@@ -112,6 +120,7 @@ class Edges:
     width: np.ndarray
     reach: np.ndarray
     owner: np.ndarray
+    halo: np.ndarray | None = None
 
     def select(self, keep: np.ndarray) -> Edges:
         """The edges where ``keep`` (a mask or indices)."""
@@ -122,6 +131,7 @@ class Edges:
             self.width[keep],
             self.reach[keep],
             self.owner[keep],
+            None if self.halo is None else self.halo[keep],
         )
 
     def of(self, disc: int) -> Edges:
@@ -192,18 +202,18 @@ def window_edges(
         for mine, got in parts:
             for out, part in zip(found, got, strict=True):
                 out[mine] = part
-    good, dist, contrast, width = found
+    good, dist, contrast, width, halo = found
     ok &= good
     uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
-    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok])
+    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok], halo[ok])
 
 
 def _edges_on(
     p: np.ndarray, s: np.ndarray, steps: np.ndarray, k: int, low: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Each ray's edge on its profile ``p`` ``(n, m)`` sampled at distances ``s`` (``steps`` of
     them its own), its inner level searched ``k`` samples inside: whether it has one, its
-    distance, contrast and width (see :class:`Edges`)."""
+    distance, contrast, width and whether it may be a halo (see :class:`Edges`)."""
     m = p.shape[1]
     above = (p >= low) & (np.arange(m)[None] < steps[:, None])
     # The outermost run of foreground at least RUN samples long ends at the edge: a speck of the
@@ -240,7 +250,8 @@ def _edges_on(
     frac = np.minimum(np.maximum((pj - level) / np.maximum(pj - pn, 1e-6), 0.0), 1.0)
     dist = s[rows, idx[rows, j]] + STEP * frac
     width = s[rows, last] + 0.5 * STEP - dist
-    return ok, dist, contrast, width
+    halo = contrast < HALO * (near.max(axis=1) - outside)
+    return ok, dist, contrast, width, halo
 
 
 @dataclass(frozen=True)
@@ -396,6 +407,8 @@ def fit_discs(
     mpp: Sequence[float],
     known: Sequence[float | None],
     along: Sequence[np.ndarray | None] | None = None,
+    *,
+    halos: bool = False,
 ) -> list[DiscFit | None]:
     """Each disc's centre from its :class:`Edges` (``owner``: the index into ``radii``), fitted
     by a circle on the plane (see the module docstring), all discs at once; ``mpp``: metres per
@@ -413,7 +426,38 @@ def fit_discs(
     one that rises out of the noise slowly (a lit limb shows only where the sphere brightens
     inwards, inside the true outline), counts for less than a sharp one. The fit is robust: from
     the circle of the three quarters of a disc's edges that fit it best, edges further than 3
-    robust standard deviations (at least 0.75 px) off it are dropped and the circle refitted."""
+    robust standard deviations (at least 0.75 px) off it are dropped and the circle refitted.
+
+    ``halos``: the video stores colour at a lower resolution than brightness (4:2:0, 4:2:2), so
+    a coloured rim may bleed outwards: a still disc (no ``along``) is fitted without its
+    :data:`HALO` edges where it still fits without them (still lit spheres of 13 px, coded as
+    H.264: the centre's bias 0.33 px at the 95th percentile with them, 0.22 px without), else
+    with them (a side whose rim is faint throughout, a lit limb as bright as the wall, is all
+    halos by that rule)."""
+    if not halos or edges.halo is None or not edges.halo.any():
+        return _fit_discs(edges, radii, calibration, mpp, known, along)
+    # A smear's edges fade out over its length, which is not a halo: they all count.
+    smeared = np.array([a is not None for a in along or [None] * len(radii)], dtype=bool)
+    fits = _fit_discs(
+        edges.select(~(edges.halo & ~smeared[edges.owner])), radii, calibration, mpp, known, along
+    )
+    failed = [d for d, fit in enumerate(fits) if fit is None]
+    if failed:
+        again = _fit_discs(edges, radii, calibration, mpp, known, along)
+        for d in failed:
+            fits[d] = again[d]
+    return fits
+
+
+def _fit_discs(
+    edges: Edges,
+    radii: Sequence[float],
+    calibration: Calibration,
+    mpp: Sequence[float],
+    known: Sequence[float | None],
+    along: Sequence[np.ndarray | None] | None,
+) -> list[DiscFit | None]:
+    """:func:`fit_discs` on all of ``edges``."""
     count = len(radii)
     radius = np.asarray(radii, dtype=float)
     mpp_ = np.asarray(mpp, dtype=float)
@@ -488,5 +532,5 @@ def fit_disc(
 ) -> DiscFit | None:
     """:func:`fit_discs` for the edges of one disc."""
     one = Edges(edges.uv, edges.theta, edges.contrast, edges.width, edges.reach,
-                np.zeros(len(edges.uv), dtype=np.intp))  # fmt: skip
+                np.zeros(len(edges.uv), dtype=np.intp), edges.halo)  # fmt: skip
     return fit_discs(one, [radius], calibration, [mpp], [known])[0]

@@ -334,8 +334,10 @@ class Tracker:
         *,
         median: bool = False,
         transfer: str = "linear",
+        subsampled: bool = False,
     ) -> None:
         self.scene, self.cal, self.bg = scene, calibration, background
+        self.subsampled = subsampled  # colour at a lower resolution: discs fitted without halos
         self.linear = Decoder(transfer)  # pixel values to linear light, for the unmixing
         self.bg_index = plate_index(background)  # once: each window's difference reads it
         self.h, self.w = background.shape[:2]
@@ -1294,6 +1296,7 @@ class Tracker:
             [p.mpp for p in plans],
             [p.known for p in plans],
             along,
+            halos=self.subsampled,
         )
 
     def _disc(
@@ -1512,15 +1515,20 @@ def track_frames(
     allow_gaps: bool = False,
     progress: bool = False,
     transfer: str = "linear",
+    subsampled: bool = False,
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
     the clip's median), whose pixel values encode light by ``transfer``
-    (:mod:`~physbench.video.transfer`). A body lost in more than
-    :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view raises
+    (:mod:`~physbench.video.transfer`); ``subsampled``: the frames were stored with colour at a
+    lower resolution than brightness (4:2:0 or 4:2:2 video, as nearly every camera's), whose
+    coloured rims bleed outwards (:data:`~physbench.video.silhouette.HALO`). A body lost in more
+    than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view raises
     :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
-    tracker = Tracker(scene, calibration, background, median=median, transfer=transfer)
+    tracker = Tracker(
+        scene, calibration, background, median=median, transfer=transfer, subsampled=subsampled
+    )
     tic = _time.perf_counter()
     for fr in frames:
         tracker.update(fr.image, fr.time)
@@ -1637,6 +1645,7 @@ def track_video(
             allow_gaps=allow_gaps,
             progress=progress,
             transfer=curve,
+            subsampled=info.subsampled,
         )
     except VideoError as exc:
         raise TrackError(str(exc)) from None

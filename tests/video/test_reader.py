@@ -39,6 +39,7 @@ def test_a_variable_frame_rate_clip_reads_back_with_its_own_times(tmp_path: Path
     )
     info = VideoReader(clip).info()
     assert (info.width, info.height, info.codec) == (64, 48, "h264")
+    assert info.subsampled  # 4:2:0: colour at half the resolution, as a camera's
 
 
 def test_trimming_keeps_the_file_times_and_streams(tmp_path: Path) -> None:
@@ -69,6 +70,8 @@ def test_gifs_and_folders_of_images(tmp_path: Path) -> None:
     seq = list(VideoReader(folder, fps=20).frames())
     assert [f.time for f in seq] == [0.0, 0.05, 0.1, 0.15]
     assert np.array_equal(seq[2].image, frame(2))
+    assert not VideoReader(folder, fps=20).info().subsampled  # every pixel its own colour
+    assert not VideoReader(tmp_path / "a.gif").info().subsampled
     with pytest.raises(VideoError, match="give its frame rate"):
         VideoReader(folder)
     (tmp_path / "empty_dir").mkdir()

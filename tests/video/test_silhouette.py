@@ -129,3 +129,53 @@ def test_a_smear_turned_by_a_bounce_is_fitted_along_its_own_direction() -> None:
     assert abs(fit.radius - radius) < 0.5  # 11.9 (18.2 along the old direction)
     assert fit.rms_px < 0.5  # 0.39 (3.8)
     assert np.hypot(*(fit.uv - centre)) < 0.1  # 0.07 px (0.18)
+
+
+def test_a_coloured_rim_bled_by_coding_is_left_out_of_the_fit() -> None:
+    # A yellow ball of 13 px lit from above, H.264 at 4:2:0 (as benchmarks/track_shading.py's
+    # wall 2): its colour, stored at half the resolution, bleeds past the rim, most on the lit
+    # side, and the centre leaned 0.34 px towards the highlight; with the halo left out, 0.14.
+    rng = np.random.default_rng(2)
+    plate = wall((240, 320), 2)
+    sphere = Sphere(13.0, (0.90, 0.80, 0.10), (0.0, -0.80, 0.60), ambient=0.2, specular=0.7)
+    truth = np.array([110.6, 110.2]) + np.outer(np.arange(16), [0.37, 0.21])
+    frames = []
+    for c in truth:
+        img = plate.astype(np.float64)
+        paint(img, sphere, [c])
+        frames.append(expose(img, rng))
+    clean = expose(plate.astype(np.float64), rng, noise=0.0)
+    coded = h264_round_trip(np.stack([clean, *frames]), 30.0, 0, 23)
+    x, y = CAL.to_scene(truth[0])
+    ball = Body("ball", Circle(0.13), (float(x), float(y)), velocity=(0.111, -0.063))
+    scene = Scene("s", (ball,), bounds=(0.0, 0.0, 3.2, 2.4), gravity=(0.0, 0.0), frames=16)
+    toward = sphere.highlight()
+    bias = {}
+    for subsampled in (False, True):
+        result = track_frames(
+            [Frame(k, k / 30, f) for k, f in enumerate(coded[1:])],
+            scene.validate(),
+            CAL,
+            coded[0],
+            subsampled=subsampled,
+        )
+        px = result.pixels["ball"]
+        assert len(px) == 16
+        bias[subsampled] = float(np.mean((px[:, 1:] - truth) @ toward))
+    assert bias[False] > 0.3 and abs(bias[True]) < 0.2
+
+
+def test_halo_edges_are_kept_where_the_disc_does_not_fit_without_them() -> None:
+    from physbench.video.silhouette import Edges, fit_discs
+
+    # Half of a disc's outline is faint (against a wall of its brightness) and taken for a
+    # halo: without it too little of the outline is left to fit, so it counts.
+    theta = np.arange(24) * (2 * np.pi / 24)
+    uv = np.column_stack([50.3 + 15 * np.cos(theta), 49.6 + 15 * np.sin(theta)])
+    halo = np.cos(theta) > 0.05
+    edges = Edges(uv, theta, np.full(24, 80.0), np.ones(24), np.full(24, 15.0),
+                  np.zeros(24, dtype=np.intp), halo)  # fmt: skip
+    cal = Calibration.from_scale(1.0, (0.0, 0.0))
+    assert fit_discs(edges.select(~halo), [15.0], cal, [1.0], [None])[0] is None
+    fit = fit_discs(edges, [15.0], cal, [1.0], [None], halos=True)[0]
+    assert fit is not None and np.hypot(*(fit.uv - [50.3, 49.6])) < 0.01
