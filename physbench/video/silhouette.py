@@ -408,7 +408,7 @@ def fit_discs(
     known: Sequence[float | None],
     along: Sequence[np.ndarray | None] | None = None,
     *,
-    halos: bool = False,
+    halos: bool | Sequence[bool] = False,
 ) -> list[DiscFit | None]:
     """Each disc's centre from its :class:`Edges` (``owner``: the index into ``radii``), fitted
     by a circle on the plane (see the module docstring), all discs at once; ``mpp``: metres per
@@ -428,18 +428,17 @@ def fit_discs(
     the circle of the three quarters of a disc's edges that fit it best, edges further than 3
     robust standard deviations (at least 0.75 px) off it are dropped and the circle refitted.
 
-    ``halos``: the video stores colour at a lower resolution than brightness (4:2:0, 4:2:2), so
-    a coloured rim may bleed outwards: a still disc (no ``along``) is fitted without its
-    :data:`HALO` edges where it still fits without them (still lit spheres of 13 px, coded as
-    H.264: the centre's bias 0.33 px at the 95th percentile with them, 0.22 px without), else
-    with them (a side whose rim is faint throughout, a lit limb as bright as the wall, is all
-    halos by that rule)."""
-    if not halos or edges.halo is None or not edges.halo.any():
+    ``halos`` (for all discs or each): the video stores colour at a lower resolution than
+    brightness (4:2:0, 4:2:2), so a coloured rim may bleed outwards: such a disc is fitted
+    without its :data:`HALO` edges where it still fits without them (lit spheres of 13 px coded
+    as H.264: the centre's bias 0.33 px at the 95th percentile with them, 0.23 px without),
+    else with them (a side whose rim is faint throughout, a lit limb as bright as the wall, is
+    all halos by that rule). Not for a long smear, whose ends fade out over its length."""
+    per = np.broadcast_to(np.asarray(halos, dtype=bool), (len(radii),))
+    if edges.halo is None or not (edges.halo & per[edges.owner]).any():
         return _fit_discs(edges, radii, calibration, mpp, known, along)
-    # A smear's edges fade out over its length, which is not a halo: they all count.
-    smeared = np.array([a is not None for a in along or [None] * len(radii)], dtype=bool)
     fits = _fit_discs(
-        edges.select(~(edges.halo & ~smeared[edges.owner])), radii, calibration, mpp, known, along
+        edges.select(~(edges.halo & per[edges.owner])), radii, calibration, mpp, known, along
     )
     failed = [d for d, fit in enumerate(fits) if fit is None]
     if failed:
