@@ -16,8 +16,9 @@ nothing, so the fit holds where part of the outline is hidden. Motion blur stret
 into a stadium, symmetric about the disc's pose at mid-exposure: where the circle does not fit
 its edges, a stadium along the disc's motion is fitted instead (a fast ball's centre errors: 95 %
 within 0.24 px, 0.59 px with the circle). In video that stores colour at a lower resolution than
-brightness, a coloured rim bleeds outwards: a still disc's edges that look like such a halo
-(:data:`HALO`) are left out where the disc fits without them.
+brightness, a coloured rim bleeds outwards: a disc's edges that look like such a halo
+(:data:`HALO`) are left out where the disc fits without them (the tracker keeps them for a disc
+whose smear is long: its ends fade out over its length).
 """
 
 from __future__ import annotations
@@ -441,8 +442,9 @@ def fit_discs(
         edges.select(~(edges.halo & per[edges.owner])), radii, calibration, mpp, known, along
     )
     failed = [d for d, fit in enumerate(fits) if fit is None]
-    if failed:
-        again = _fit_discs(edges, radii, calibration, mpp, known, along)
+    if failed:  # each disc is fitted on its own edges: refit only those
+        mine = edges.select(np.isin(edges.owner, failed))
+        again = _fit_discs(mine, radii, calibration, mpp, known, along)
         for d in failed:
             fits[d] = again[d]
     return fits

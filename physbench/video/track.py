@@ -116,7 +116,7 @@ SMEAR = 0.2
 #: A disc that moves more than this many radii in a frame interval keeps the edges that look like
 #: a halo of bled colour in its fit: a long smear's ends fade out over its length (a thrown ball
 #: moving 3 radii a frame was measured 0.13 px further from the truth without them; lit
-#: spheres moving 0.2-0.7 radii a frame nearer: 0.33 to 0.28 px at the 95th percentile at 13 px).
+#: spheres moving 0.2-0.7 radii a frame nearer: 0.32 to 0.28 px at the 95th percentile at 13 px).
 HALO_MOTION = 1.0
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
