@@ -107,6 +107,7 @@ def run_case(
     camera: str,
     clean: dict | None,
     resolution: int = 640,
+    allow_gaps: bool = False,
 ) -> dict:
     sim = ENGINES[engine]()
     case = make_case(effect, scene, seed, sim)
@@ -130,7 +131,7 @@ def run_case(
     from physbench.testing.field_footage import camera_seed, film_case
 
     name = f"{effect or 'control'}/{scene}/{engine}/{seed}"
-    film = film_case(case, camera_seed(name), resolution)
+    film = film_case(case, camera_seed(name), resolution, allow_gaps=allow_gaps)
     row["body_px"] = film.body_px
     row["field"] = film.info()
     filmed = film.run
@@ -159,6 +160,17 @@ def main(argv: list[str] | None = None) -> int:
         type=int,
         default=640,
         help="--camera field: the clips' width in pixels (4:3; default 640, the grid's)",
+    )
+    p.add_argument(
+        "--allow-gaps",
+        action="store_true",
+        help="--camera field: keep tracks lost in over a tenth of their frames (track "
+        "--allow-gaps) instead of refusing the clip",
+    )
+    p.add_argument(
+        "--refused-in",
+        metavar="RESULTS.json",
+        help="run only the cases whose clip this results file's filmed column refused",
     )
     p.add_argument(
         "--clean-from",
@@ -192,6 +204,8 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     if args.resolution != 640 and args.camera != "field":
         p.error(f"--resolution {args.resolution}: only --camera field films at another width")
+    if args.allow_gaps and args.camera != "field":
+        p.error("--allow-gaps: only --camera field tracks with gaps allowed")
     tolerance = args.tolerance or (TOLERANCE if args.camera == "camera" else FIELD_TOLERANCE)
     out = Path(
         args.out or ("results/video_discover" + ("_field" if args.camera == "field" else ""))
@@ -222,6 +236,10 @@ def main(argv: list[str] | None = None) -> int:
             for c in todo
             if any(o in f"{c[0] or 'control'}/{c[1]}/{c[2]}/{c[3]}" for o in args.only)
         ]
+    if args.refused_in:
+        refused = json.loads(Path(args.refused_in).read_text())["rows"]
+        picked = {key(r) for r in refused if "filmed_failure" in r}
+        todo = [c for c in todo if c in picked]
     partial = out / "partial.jsonl"  # one row per finished case: --resume goes on from there
     rows = []
     if args.resume and partial.exists():
@@ -234,7 +252,7 @@ def main(argv: list[str] | None = None) -> int:
     for i, c in enumerate(todo):
         if c in done:
             continue
-        row = run_case(*c, args.camera, clean.get(c), args.resolution)
+        row = run_case(*c, args.camera, clean.get(c), args.resolution, args.allow_gaps)
         rows.append(row)
         with partial.open("a") as fh:
             fh.write(json.dumps(row) + "\n")
@@ -258,6 +276,8 @@ def main(argv: list[str] | None = None) -> int:
     }
     if args.camera == "field" and args.resolution != 640:
         payload["resolution"] = args.resolution
+    if args.allow_gaps:
+        payload["allow_gaps"] = True
     write(out, payload, other)
     partial.unlink()
     return 0
@@ -291,6 +311,11 @@ def write(out: Path, payload: dict, other: list[dict] | None) -> None:
         w = payload["resolution"]
         text = (
             f"Clips {w}x{w * 3 // 4} px (the grid's: 640x480). Code: {payload['code']}.\n\n" + text
+        )
+    if payload.get("allow_gaps"):
+        text = (
+            "Tracked with gaps allowed (track --allow-gaps): a track lost in over a tenth "
+            "of its frames is kept, not refused.\n\n" + text
         )
     (out / "table.md").write_text(text)
     print(text)

@@ -57,9 +57,13 @@ def camera_seed(name: str) -> int:
     return zlib.crc32(name.encode())
 
 
-def film_case(case: SyntheticRun, cam_seed: int, resolution: int = 640) -> Filmed:
+def film_case(
+    case: SyntheticRun, cam_seed: int, resolution: int = 640, *, allow_gaps: bool = False
+) -> Filmed:
     """Film ``case``'s true motion with the field camera of ``cam_seed``, ``resolution`` pixels
-    wide (4:3), and track it (see the module docstring)."""
+    wide (4:3), and track it (see the module docstring); ``allow_gaps``: keep a track lost in
+    more than :data:`~physbench.video.track.LOST_SHARE` of its frames (``track --allow-gaps``)
+    instead of refusing the clip."""
     from physbench.calibration import Calibration
     from physbench.testing.field_camera import FieldCamera
     from physbench.video.footage import frame_trajectory, motion_view
@@ -87,7 +91,7 @@ def film_case(case: SyntheticRun, cam_seed: int, resolution: int = 640) -> Filme
         clip = Path(tmp) / "run.mp4"
         write_clip(cam, clip, sc, traj)
         try:
-            result = track_video(clip, sc, cal, background=cam.plate(sc))
+            result = track_video(clip, sc, cal, background=cam.plate(sc), allow_gaps=allow_gaps)
         except Exception as exc:  # a refused clip is a result to report
             out.failure = f"{type(exc).__name__}: {exc}"
             return out

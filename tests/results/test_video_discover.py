@@ -78,7 +78,7 @@ def test_the_arm_clips_rerun_with_rods_centred_between_their_ends_are_all_right(
     assert all(r["filmed"]["ok"] and "filmed_failure" not in r for r in rerun["rows"])
 
 
-def test_only_the_field_camera_films_at_another_resolution(capsys) -> None:
+def test_only_the_field_camera_films_at_another_resolution_or_keeps_gaps(capsys) -> None:
     spec = importlib.util.spec_from_file_location(
         "video_discover", ROOT / "benchmarks" / "video_discover.py"
     )
@@ -88,3 +88,6 @@ def test_only_the_field_camera_films_at_another_resolution(capsys) -> None:
     with pytest.raises(SystemExit):
         bench.main(["--camera", "camera", "--resolution", "1280", "--out", "unused"])
     assert "--resolution 1280: only --camera field" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        bench.main(["--camera", "camera", "--allow-gaps", "--out", "unused"])
+    assert "--allow-gaps: only --camera field" in capsys.readouterr().err
