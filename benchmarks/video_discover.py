@@ -16,7 +16,9 @@ from the case (light drift of 3-10 %, shaded spheres with a highlight, bricks, p
 rows also hold the drawn domain and what the tracker made of the clip (frames seen, centre errors
 in px against the camera's projection of the true motion). ``--clean-from`` takes the clean
 discoveries from an earlier results file (they do not depend on the camera), and ``--compare``
-adds another camera's filmed column to the table.
+adds another camera's filmed column to the table. ``--refused-in RESULTS.json --allow-gaps``
+tracks the clips that file refused again, keeping tracks lost in over a tenth of their frames
+(what ``track --allow-gaps`` keeps): what refusing them costs.
 
     python benchmarks/video_discover.py --seeds 0 1 2 --out results/video_discover
     python benchmarks/video_discover.py --camera field --seeds 0 1 2 \\
