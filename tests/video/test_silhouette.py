@@ -179,3 +179,59 @@ def test_halo_edges_are_kept_where_the_disc_does_not_fit_without_them() -> None:
     assert fit_discs(edges.select(~halo), [15.0], cal, [1.0], [None])[0] is None
     fit = fit_discs(edges, [15.0], cal, [1.0], [None], halos=True)[0]
     assert fit is not None and np.hypot(*(fit.uv - [50.3, 49.6])) < 0.01
+
+
+def test_an_outline_inside_the_rim_on_one_side_is_refitted_at_the_radius(monkeypatch) -> None:
+    import physbench.video.silhouette as silhouette
+    from physbench.video.silhouette import Edges, fit_discs
+
+    # A 6 px disc whose lit side's edges lie 1.8 px inside the rim (the highlight's border,
+    # where the lit limb is as bright as the wall): its free circle shrinks to 5.3 px and leans
+    # 0.7 px away; at its radius, on the edges that lie on that circle, it is centred.
+    theta = np.arange(16) * (2 * np.pi / 16)
+    lit = np.cos(theta) > 0.3
+    reach = np.where(lit, 6.0 - 1.8, 6.0)
+    uv = np.column_stack([40.2 + reach * np.cos(theta), 30.7 + reach * np.sin(theta)])
+    edges = Edges(uv, theta, np.full(16, 90.0), np.ones(16), reach,
+                  np.zeros(16, dtype=np.intp))  # fmt: skip
+    cal = Calibration.from_scale(1.0, (0.0, 0.0))
+    off = {}
+    for shrunk in (0.0, silhouette.SHRUNK):
+        monkeypatch.setattr(silhouette, "SHRUNK", shrunk)
+        fit = fit_discs(edges, [6.0], cal, [1.0], [None])[0]
+        assert fit is not None
+        off[shrunk] = (float(np.hypot(*(fit.uv - [40.2, 30.7]))), fit.radius, fit.fixed)
+    assert off[0.0][0] > 0.4 and off[0.0][1] < 0.96 * 6.0 and not off[0.0][2]
+    assert off[silhouette.SHRUNK][0] < 0.05 and off[silhouette.SHRUNK][1:] == (6.0, True)
+
+
+def test_a_small_light_ball_lit_from_the_side_is_not_pulled_to_its_dark_side(monkeypatch) -> None:
+    import physbench.video.silhouette as silhouette
+
+    # benchmarks/track_shading.py's worst case: a light grey ball of 6 px lit from the upper
+    # right, still, on wall 1, coded as H.264: its free circles were 5.1-5.7 px and it leaned
+    # 0.86 px away from the highlight; refitted at its radius, 0.23 px.
+    rng = np.random.default_rng(1)
+    plate = wall((240, 320), 1)
+    light = (0.60, -0.30, 0.74)
+    sphere = Sphere(6.0, (0.65, 0.65, 0.65), light, ambient=0.2, specular=0.7, shininess=25.0)
+    truth = np.array([110.0, 110.0]) + rng.uniform(0, 1, 2) + np.outer(np.arange(16), [0.37, 0.21])
+    frames = []
+    for c in truth:
+        img = plate.astype(np.float64)
+        paint(img, sphere, [c])
+        frames.append(expose(img, rng))
+    clean = expose(plate.astype(np.float64), rng, noise=0.0)
+    coded = h264_round_trip(np.stack([clean, *frames]), 30.0, 0, 23)
+    x, y = CAL.to_scene(truth[0])
+    ball = Body("ball", Circle(0.06), (float(x), float(y)), velocity=(0.111, -0.063))
+    scene = Scene("s", (ball,), bounds=(0.0, 0.0, 3.2, 2.4), gravity=(0.0, 0.0), frames=16)
+    bias = {}
+    for shrunk in (0.0, silhouette.SHRUNK):
+        monkeypatch.setattr(silhouette, "SHRUNK", shrunk)
+        frames_in = [Frame(k, k / 30, f) for k, f in enumerate(coded[1:])]
+        result = track_frames(frames_in, scene.validate(), CAL, coded[0], subsampled=True)
+        px = result.pixels["ball"]
+        assert len(px) == 16
+        bias[shrunk] = float(np.mean((px[:, 1:] - truth) @ sphere.highlight()))
+    assert bias[0.0] < -0.7 and abs(bias[silhouette.SHRUNK]) < 0.3
