@@ -3,6 +3,7 @@ centroid it used before, over radii x colours x lights x walls, raw and H.264-co
 motion-blurred.
 
     python benchmarks/track_shading.py [--out results/track/shading.json]
+    python benchmarks/track_shading.py --gamma 2.2 --out results/track/shading_gamma22.json
 
 Each case: a sphere painted with numpy (:mod:`physbench.video.spheres`, not the ``camera``
 renderer: Lambert shading with an ambient share, a white Blinn-Phong highlight that may clip)
@@ -11,6 +12,8 @@ over half the frame interval and coded as H.264 at CRF 23, tracked against the w
 *bias* is the mean centre error along the direction of the highlight (px; negative: away from
 it), the *error* the mean distance. The *centroid* columns weigh the blob's pixels by their
 difference to the wall, as the tracker did before its centres came from the outline.
+``--gamma 2.2`` encodes the painted light by a 1/2.2 power, about as a camera's BT.709 or sRGB
+transfer does (the default keeps it linear, as the painter makes it).
 """
 
 from __future__ import annotations
@@ -53,8 +56,18 @@ FPS = 30.0
 MPP = 0.01
 
 
-def _clip(radius: float, colour: tuple, light: tuple, seed: int, *, blur: bool, coded: bool):
-    """Frames, plate, true centres ``(T, 2)`` and the sphere of one case."""
+def _clip(
+    radius: float,
+    colour: tuple,
+    light: tuple,
+    seed: int,
+    *,
+    blur: bool,
+    coded: bool,
+    gamma: float = 1.0,
+):
+    """Frames, plate, true centres ``(T, 2)`` and the sphere of one case (``gamma``: the
+    camera's transfer, :func:`~physbench.video.spheres.expose`)."""
     rng = np.random.default_rng(seed)
     plate = wall(SIZE, seed)
     sphere = Sphere(radius, colour, light, ambient=0.2, specular=0.7, shininess=25.0)
@@ -66,11 +79,11 @@ def _clip(radius: float, colour: tuple, light: tuple, seed: int, *, blur: bool, 
         img = plate.astype(np.float64)
         centre = start + velocity * k
         paint(img, sphere, centre + velocity * offsets[:, None])
-        frames.append(expose(img, rng))
+        frames.append(expose(img, rng, gamma=gamma))
         truth.append(centre)
     # The plate: the empty wall filmed by the same camera (its noise averaged away, as over a
     # few seconds of an empty scene), coded with the clip.
-    clean = expose(plate.astype(np.float64), rng, noise=0.0)
+    clean = expose(plate.astype(np.float64), rng, noise=0.0, gamma=gamma)
     frames = np.stack([clean, *frames])
     if coded:
         frames = h264_round_trip(frames, FPS, 0, 23)
@@ -99,9 +112,9 @@ def _centroids(frames: np.ndarray, plate: np.ndarray, truth: np.ndarray, radius:
     return np.array(out)
 
 
-def run_case(radius, colour, light, seed, *, blur, coded) -> dict:
+def run_case(radius, colour, light, seed, *, blur, coded, gamma: float = 1.0) -> dict:
     frames, plate, truth, sphere, velocity = _clip(
-        radius, COLOURS[colour], LIGHTS[light], seed, blur=blur, coded=coded
+        radius, COLOURS[colour], LIGHTS[light], seed, blur=blur, coded=coded, gamma=gamma
     )
     h = SIZE[0]
     cal = Calibration.from_scale(MPP, (0.0, h - 1.0))
@@ -120,6 +133,7 @@ def run_case(radius, colour, light, seed, *, blur, coded) -> dict:
         plate,
         allow_gaps=True,
         subsampled=coded,  # H.264 at 4:2:0, as track_video reads from the file
+        transfer="linear" if gamma == 1.0 else f"gamma{gamma:g}",
     )
     px = result.pixels["ball"]
     k = np.rint(px[:, 0] * FPS).astype(int)
@@ -185,23 +199,36 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results/track/shading.json")
     ap.add_argument("--walls", type=int, default=3, help="wall seeds per case")
+    ap.add_argument(
+        "--gamma",
+        type=float,
+        default=1.0,
+        choices=(1.0, 2.2, 2.8),
+        help="the camera's transfer: the light encoded by a 1/gamma power (default 1: linear)",
+    )
     args = ap.parse_args()
     cases = []
     grid = itertools.product(
         RADII, COLOURS, LIGHTS, range(args.walls), (False, True), (False, True)
     )
     for radius, colour, light, seed, blur, coded in grid:
-        cases.append(run_case(radius, colour, light, seed, blur=blur, coded=coded))
+        cases.append(
+            run_case(radius, colour, light, seed, blur=blur, coded=coded, gamma=args.gamma)
+        )
         print(json.dumps(cases[-1]), flush=True)
     rows = summarise(cases)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"summary": rows, "cases": cases}, indent=1) + "\n")
+    out.write_text(
+        json.dumps({"gamma": args.gamma, "summary": rows, "cases": cases}, indent=1) + "\n"
+    )
+    light = "linear light" if args.gamma == 1.0 else f"light encoded by a 1/{args.gamma:g} power"
+    flag = "" if args.gamma == 1.0 else f" --gamma {args.gamma:g}"
     out.with_suffix(".md").write_text(
         "# Centre bias on lit spheres with a highlight (px, |mean error along the highlight|)\n\n"
-        "`python benchmarks/track_shading.py`: the tracker's outline fit against the weighted "
-        "centroid it used before; per radius over colours x lights x walls x (still, blurred) x "
-        "(raw, H.264 CRF 23).\n\n" + table(rows)
+        f"`python benchmarks/track_shading.py{flag}` ({light}): the tracker's outline fit "
+        "against the weighted centroid it used before; per radius over colours x lights x walls "
+        "x (still, blurred) x (raw, H.264 CRF 23).\n\n" + table(rows)
     )
     print(table(rows))
     print(f"wrote {out} and {out.with_suffix('.md')}")

@@ -49,7 +49,8 @@ def pixel_errors(
 #: The systematic accuracy (px) of a disc's centre fitted to its outline: what shading, a
 #: highlight, lossy coding and motion blur leave in it (``benchmarks/track_shading.py``,
 #: ``results/track/shading.json``: the 95th percentile over three walls is 0.17-0.18 px at 13-22
-#: px radius, 0.14 px in raw frames and 0.22 px in H.264-coded ones).
+#: px radius, 0.14 px in raw frames and 0.22 px in H.264-coded ones; with the light encoded as
+#: a camera encodes it, ``shading_gamma22.json``, 0.19-0.22 px: raw 0.10, coded 0.24).
 DISC_ACCURACY_PX = 0.25
 #: ... of other bodies' centroids: the arc a turning body sweeps in one exposure (a swinging arm
 #: 0.4-0.5 px RMS along its length; ``tests/video/test_track.py``).

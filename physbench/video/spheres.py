@@ -5,7 +5,8 @@ Independent of the ``camera`` renderer on purpose (different code, its own shadi
 sphere of ``radius`` px at a sub-pixel centre, Lambert shading with an ambient term from a light
 in any direction, a white Blinn-Phong highlight that may saturate, anti-aliased by supersampling,
 over a wall of random tiles, stains and grain; a global gain and offset per frame (the light),
-Gaussian noise and 8-bit quantisation. Pixel centres are at integer ``(u, v)``, ``v`` down.
+Gaussian noise, optionally a camera's transfer function, and 8-bit quantisation. Pixel centres
+are at integer ``(u, v)``, ``v`` down.
 """
 
 from __future__ import annotations
@@ -113,10 +114,16 @@ def expose(
     gain: float | Sequence[float] = 1.0,
     offset: float = 0.0,
     noise: float = 0.01,
+    gamma: float = 1.0,
 ) -> np.ndarray:
     """What the sensor records of the light ``img`` (``(H, W, 3)`` float in [0, 1]): times
-    ``gain`` (one or per channel) plus ``offset``, Gaussian noise of std ``noise``, 8 bits."""
+    ``gain`` (one or per channel) plus ``offset``, Gaussian noise of std ``noise``, encoded by a
+    ``1 / gamma`` power (a camera's transfer function: 2.2 for about BT.709 or sRGB; 1 keeps it
+    linear), 8 bits."""
     out = img * np.asarray(gain, dtype=np.float64) + offset
     if noise > 0:
         out = out + noise * rng.standard_normal(out.shape)
-    return np.rint(np.clip(out, 0.0, 1.0) * 255).astype(np.uint8)
+    out = np.clip(out, 0.0, 1.0)
+    if gamma != 1.0:
+        out = out ** (1.0 / gamma)
+    return np.rint(out * 255).astype(np.uint8)
