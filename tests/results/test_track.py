@@ -108,8 +108,8 @@ def test_a_fast_flat_lit_ball_is_centred_along_its_smear() -> None:
 @pytest.mark.xfail(
     strict=True,
     reason="issue 26: a fast lit ball's centre leans along its smear, by 0.7 and 1.6 px where "
-    "the light comes from behind it (camera seeds 15, 16); its trailing end, the lit limb, is "
-    "placed 3-7 px beyond the radius (docs/video.md)",
+    "the light comes from behind it (camera seeds 15, 16): the shaded leading end's edges fail "
+    "the contrast test, and the lit trailing end sets the centre (docs/video.md)",
 )
 def test_a_fast_lit_ball_is_centred_along_its_smear() -> None:
     cases = json.loads((RESULTS / "fast_lit.json").read_text())["cases"]
