@@ -5,7 +5,7 @@ default sphere: Lambert shading and a highlight) and flat-lit, over camera seeds
 
 Each case: a 4 cm ball tossed at (2, 3) m/s in a 1.6 x 1.2 m view at 30 fps (about 15 px in
 radius, 25-43 px a frame: an exposure of a sixth to three fifths of the frame interval smears it
-over 4-25 px), filmed square-on without a lens's distortion or a light drift, each seed drawing
+over 4-27 px), filmed square-on without a lens's distortion or a light drift, each seed drawing
 the rest of the camera's domain (light direction, shutter, texture, CRF). Tracked against the
 plate with the true calibration. Per clip: the median centre error (px) and the mean error
 *along* the ball's motion (px; negative: the centre trails the ball), the shutter and the
