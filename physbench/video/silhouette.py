@@ -26,9 +26,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from physbench.video.compiled import jit
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -76,25 +79,6 @@ class DiscFit:
     kept: float
     rms_px: float
     fixed: bool = False
-
-
-def _sample(
-    flat: np.ndarray, base: np.ndarray, shape: np.ndarray, rows: np.ndarray, cols: np.ndarray
-) -> np.ndarray:
-    """Bilinear samples (float32) at fractional ``rows``, ``cols`` ``(n, m)`` (clamped to the
-    image) of images stored row-major in ``flat``: row ``j``'s image is ``shape[j] = (h, w)``
-    and starts at ``flat[base[j]]``."""
-    h, w = shape[:, :1], shape[:, 1:]
-    r = np.minimum(np.maximum(rows, 0), (h - 1.001).astype(np.float32))
-    c = np.minimum(np.maximum(cols, 0), (w - 1.001).astype(np.float32))
-    r0, c0 = r.astype(np.intp), c.astype(np.intp)
-    fr, fc = r - r0, c - c0
-    i = r0 * w + c0 + base[:, None]
-    a, b = flat[i].astype(np.float32), flat[i + 1].astype(np.float32)
-    top = a + (b - a) * fc
-    a, b = flat[i + w].astype(np.float32), flat[i + w + 1].astype(np.float32)
-    bottom = a + (b - a) * fc
-    return top + (bottom - top) * fr
 
 
 @dataclass(frozen=True)
@@ -159,100 +143,164 @@ def window_edges(
     their rays: a frame's discs cost one call, not one per window), their discs numbered on in
     order."""
     rays = [r for _, _, some in windows for r in some]
+    if not rays:
+        empty = np.empty(0)
+        return Edges(np.empty((0, 2)), empty, empty, empty, empty, np.empty(0, np.intp), empty > 0)
     counts = [min(max(round(2 * math.pi * r.radius / SPACING), 16), 64) for r in rays]
-    owner = np.repeat(np.arange(len(rays)), counts)
-    theta = np.concatenate([np.arange(n) * (2 * math.pi / n) for n in counts])
-    radius = np.array([r.radius for r in rays])[owner]
-    start = np.maximum(0.0, 0.7 * radius - INNER)
-    length = np.array([r.reach for r in rays])[owner] - start
-    m = int(np.ceil(length.max() / STEP)) + 1
-    steps = np.minimum(np.floor(length / STEP).astype(np.intp) + 1, m)  # samples per ray
-    s = (start[:, None] + STEP * np.arange(m)[None]).astype(np.float32)  # (n, m)
-    du, dv = np.cos(theta), np.sin(theta)
-    centres = np.array([r.centre for r in rays], dtype=float)[owner]
-    # Each ray's window: its offset, its shape and where its pixels start with the windows'
-    # laid end to end, and how far inside an edge its inner level is looked for (from the
-    # window's smallest disc).
-    window = np.repeat(np.arange(len(windows)), [len(some) for _, _, some in windows])[owner]
-    shape = np.array([diff.shape for diff, _, _ in windows], dtype=np.intp)
-    base = np.concatenate([[0], np.cumsum(shape[:-1, 0] * shape[:-1, 1])])[window]
-    shape, offset = shape[window], np.array([o for _, o, _ in windows], dtype=np.intp)[window]
+    # How far inside an edge its inner level is looked for, from the window's smallest disc.
     inner = [min(INNER, 0.5 * min(r.radius for r in some)) for _, _, some in windows]
-    ks = np.array([max(2, round(x / STEP)) for x in inner])[window]
-    cu, cv = centres[:, 0] - offset[:, 1], centres[:, 1] - offset[:, 0]
-    h, w = shape[:, 0], shape[:, 1]
-    # Rays are straight: inside the crop where both their ends are.
-    ok = np.ones(len(theta), dtype=bool)
-    for far in (start, start + STEP * (steps - 1)):
-        eu, ev = cu + du * far, cv + dv * far
-        ok &= (eu >= 0) & (eu <= w - 1) & (ev >= 0) & (ev <= h - 1)
-    f32 = np.float32
-    rows_, cols_ = (
-        cv.astype(f32)[:, None] + dv.astype(f32)[:, None] * s,
-        cu.astype(f32)[:, None] + du.astype(f32)[:, None] * s,
-    )
+    window = [w for w, (_, _, some) in enumerate(windows) for _ in some]
+    shape = np.array([diff.shape for diff, _, _ in windows], dtype=np.intp)
+    sizes = shape[:, 0] * shape[:, 1]
+    discs = np.array(
+        [(*r.centre, r.radius, r.reach, n, max(2, round(inner[w] / STEP)), w)
+         for r, n, w in zip(rays, counts, window, strict=True)]
+    )  # fmt: skip
+    origin = np.array([o for _, o, _ in windows], dtype=np.intp)
     flat = np.concatenate([diff.ravel() for diff, _, _ in windows])
-    p = _sample(flat, base, shape, rows_, cols_)  # (n, m)
-    groups = np.unique(ks)
-    if len(groups) == 1:
-        found = _edges_on(p, s, steps, int(groups[0]), low)
-    else:  # windows whose smallest discs look for the inner level at different depths
-        parts = [(ks == k, _edges_on(p[ks == k], s[ks == k], steps[ks == k], int(k), low))
-                 for k in groups]  # fmt: skip
-        found = tuple(np.empty(len(theta), dtype=a.dtype) for a in parts[0][1])
-        for mine, got in parts:
-            for out, part in zip(found, got, strict=True):
-                out[mine] = part
-    good, dist, contrast, width, halo = found
-    ok &= good
-    uv = np.column_stack([centres[:, 0] + du * dist, centres[:, 1] + dv * dist])
-    return Edges(uv[ok], theta[ok], contrast[ok], width[ok], dist[ok], owner[ok], halo[ok])
+    found = _ray_edges(
+        flat,
+        np.cumsum(sizes) - sizes,
+        shape,
+        origin,
+        discs,
+        np.concatenate([_directions(n) for n in counts]),
+        float(low),
+    )
+    return Edges(*found)
 
 
-def _edges_on(
-    p: np.ndarray, s: np.ndarray, steps: np.ndarray, k: int, low: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Each ray's edge on its profile ``p`` ``(n, m)`` sampled at distances ``s`` (``steps`` of
-    them its own), its inner level searched ``k`` samples inside: whether it has one, its
-    distance, contrast, width and whether it may be a halo (see :class:`Edges`)."""
-    m = p.shape[1]
-    above = (p >= low) & (np.arange(m)[None] < steps[:, None])
-    # The outermost run of foreground at least RUN samples long ends at the edge: a speck of the
-    # wall's texture the light does not quite match, a pixel or so past the rim, is not it.
-    run = above[:, RUN - 1 :].copy()
-    for j in range(1, RUN):
-        run &= above[:, RUN - 1 - j : m - j]
-    last = m - 1 - np.argmax(run[:, ::-1], axis=1)
-    ok = run.any(axis=1) & (last < steps - 1)
-    # The edge's inner level is where the profile stops falling steeply, walking in from its
-    # steepest point near the threshold crossing: the rim's own brightness, not the shading
-    # further in (a lit sphere brightens inwards from a limb as dark as the wall).
-    rows = np.arange(len(p))
-    idx = np.minimum(
-        np.maximum(last[:, None] + np.arange(-k, 2), 0), m - 1
-    )  # (n, k + 2): inside out
-    near = p[rows[:, None], idx]
-    slope = near[:, :-1] - near[:, 1:]  # (n, k + 1): the fall over each step outwards
+@cache
+def _directions(n: int) -> np.ndarray:
+    """``(n, 3)``: the angles of ``n`` rays spread evenly over a turn, their cosines and sines."""
+    theta = np.arange(n) * (2 * math.pi / n)
+    return np.column_stack([theta, np.cos(theta), np.sin(theta)])
+
+
+@jit
+def _ray_edges(flat, base, shape, origin, discs, directions, low):  # type: ignore[no-untyped-def]
+    """Each disc's rays (``discs`` rows: centre u, v, radius, reach, ray count, inner depth in
+    samples, window) sampled on its window's difference (``flat``: the windows' differences
+    laid end to end, each from ``base``, ``shape`` ``(h, w)``, top-left pixel ``origin``) and the
+    edge each finds: :class:`Edges`' arrays, for the rays inside their window that find one.
+
+    Along a ray, samples every :data:`STEP` px from 70 % of the radius less :data:`INNER` to
+    the reach, read bilinearly (clamped to the window). The outermost run of :data:`RUN`
+    samples at or above ``low`` ends at the edge: a speck of the wall's texture the light does
+    not quite match, a pixel or so past the rim, is not it. The edge's inner level is where the
+    profile stops falling steeply, walking in from its steepest point near the threshold
+    crossing: the rim's own brightness, not the shading further in (a lit sphere brightens
+    inwards from a limb as dark as the wall). An edge whose inner level is under ``low`` over
+    the outside is placed by the threshold, not by its half-way point: it adds nothing."""
+    n = 0
+    for d in range(len(discs)):
+        n += int(discs[d, 4])
+    radius = np.empty(n)
+    start = np.empty(n)
+    owner = np.empty(n, np.intp)
+    ray = 0
+    for d in range(len(discs)):
+        for _ in range(int(discs[d, 4])):
+            radius[ray] = discs[d, 2]
+            start[ray] = max(0.0, 0.7 * discs[d, 2] - INNER)
+            owner[ray] = d
+            ray += 1
+    longest = 0.0
+    for j in range(n):
+        longest = max(longest, discs[owner[j], 3] - start[j])
+    m = int(np.ceil(longest / STEP)) + 1
+    uv = np.empty((n, 2))
+    theta, contrast, width, reach = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    halo = np.empty(n, np.bool_)
+    kept = np.empty(n, np.intp)
+    p = np.empty(m)
+    s = np.empty(m, np.float32)
+    near = np.empty(m + 2)
     outer = max(1, round(2.0 / STEP))
-    steep = k + 1 - outer + np.argmax(slope[:, -outer:], axis=1)
-    flat = (slope < 0.3 * slope[rows, steep][:, None]) & (np.arange(k + 1) < steep[:, None])
-    shoulder = np.where(flat.any(axis=1), k - np.argmax(flat[:, ::-1], axis=1), 0)
-    inner = near[rows, shoulder]
-    outside = near[:, -1]
-    contrast = inner - outside
-    # An edge whose inner level is under the threshold over the outside is placed by the
-    # threshold, not by its half-way point (inwards by up to a pixel): it adds nothing.
-    ok &= contrast >= low
-    level = 0.5 * (inner + outside)
-    # The outermost sample at or above the level, and the next one out (below it).
-    at = near[:, :-1] >= level[:, None]
-    j = k - np.argmax(at[:, ::-1], axis=1)
-    pj, pn = near[rows, j], near[rows, j + 1]
-    frac = np.minimum(np.maximum((pj - level) / np.maximum(pj - pn, 1e-6), 0.0), 1.0)
-    dist = s[rows, idx[rows, j]] + STEP * frac
-    width = s[rows, last] + 0.5 * STEP - dist
-    halo = contrast < HALO * (near.max(axis=1) - outside)
-    return ok, dist, contrast, width, halo
+    count = 0
+    for j in range(n):
+        d = owner[j]
+        win = int(discs[d, 6])
+        h, w = shape[win, 0], shape[win, 1]
+        cu, cv = discs[d, 0] - origin[win, 1], discs[d, 1] - origin[win, 0]
+        du, dv = directions[j, 1], directions[j, 2]
+        length = discs[d, 3] - start[j]
+        steps = min(int(np.floor(length / STEP)) + 1, m)
+        # Rays are straight: inside the window where both their ends are.
+        inside = True
+        for far in (start[j], start[j] + STEP * (steps - 1)):
+            eu, ev = cu + du * far, cv + dv * far
+            inside &= eu >= 0 and eu <= w - 1 and ev >= 0 and ev <= h - 1
+        top_row, top_col = np.float32(h - 1.001), np.float32(w - 1.001)
+        fu, fv, fdu, fdv = np.float32(cu), np.float32(cv), np.float32(du), np.float32(dv)
+        b = base[win]
+        for i in range(m):
+            s[i] = np.float32(start[j] + STEP * i)
+            r = min(max(fv + fdv * s[i], np.float32(0.0)), top_row)
+            c = min(max(fu + fdu * s[i], np.float32(0.0)), top_col)
+            r0, c0 = int(r), int(c)
+            fr, fc = np.float64(r) - r0, np.float64(c) - c0
+            q = r0 * w + c0 + b
+            a0, a1 = np.float32(flat[q]), np.float32(flat[q + 1])
+            upper = np.float64(a0) + np.float64(a1 - a0) * fc
+            a0, a1 = np.float32(flat[q + w]), np.float32(flat[q + w + 1])
+            lower = np.float64(a0) + np.float64(a1 - a0) * fc
+            p[i] = upper + (lower - upper) * fr
+        last = -1
+        for i in range(min(steps, m) - 1, RUN - 2, -1):
+            run = True
+            for q in range(i - RUN + 1, i + 1):
+                run &= p[q] >= low
+            if run:
+                last = i
+                break
+        good = inside and last >= 0 and last < steps - 1
+        if last < 0:
+            last = m - 1
+        k = int(discs[d, 5])
+        for t in range(k + 2):  # inside out
+            near[t] = p[min(max(last - k + t, 0), m - 1)]
+        # The steepest fall over one step out of the last `outer` (the first of equals).
+        first = k + 1 - outer
+        lo = max(first, 0)
+        at = lo
+        for t in range(lo + 1, k + 1):
+            if near[t] - near[t + 1] > near[at] - near[at + 1]:
+                at = t
+        steep = first + at - lo  # below 0 (an inner depth under `outer`): counted from the end
+        top = near[steep % (k + 1)] - near[steep % (k + 1) + 1]
+        shoulder = 0
+        for t in range(min(steep, k + 1) - 1, -1, -1):
+            if near[t] - near[t + 1] < 0.3 * top:
+                shoulder = t
+                break
+        inner, outside = near[shoulder], near[k + 1]
+        good &= inner - outside >= low
+        level = 0.5 * (inner + outside)
+        # The outermost sample at or above the level, and the next one out (below it).
+        jj = k
+        for t in range(k, -1, -1):
+            if near[t] >= level:
+                jj = t
+                break
+        frac = (near[jj] - level) / max(near[jj] - near[jj + 1], 1e-6)
+        dist = np.float64(s[min(max(last - k + jj, 0), m - 1)]) + STEP * min(max(frac, 0.0), 1.0)
+        if not good:
+            continue
+        peak = near[0]
+        for t in range(1, k + 2):
+            peak = max(peak, near[t])
+        uv[count, 0] = discs[d, 0] + du * dist
+        uv[count, 1] = discs[d, 1] + dv * dist
+        theta[count] = directions[j, 0]
+        contrast[count] = inner - outside
+        width[count] = np.float64(s[last] + np.float32(0.5 * STEP)) - dist
+        reach[count] = dist
+        kept[count] = d
+        halo[count] = inner - outside < HALO * (peak - outside)
+        count += 1
+    return (uv[:count], theta[:count], contrast[:count], width[:count], reach[:count],
+            kept[:count], halo[:count])  # fmt: skip
 
 
 @dataclass(frozen=True)
