@@ -18,6 +18,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from physbench.errors import PhysbenchError
 
 
@@ -45,14 +47,84 @@ class _Compiled:
         self.__doc__, self.__name__ = fn.__doc__, fn.__name__
         self._machine: Callable[..., Any] | None = None
 
-    def __call__(self, *args: Any) -> Any:
+    def machine(self) -> Callable[..., Any]:
+        """The numba dispatcher (compiled on its first call). The module's name for the function
+        is pointed at it, and so are the names of the compiled functions it calls: numba calls
+        a compiled function from compiled code only through its dispatcher."""
         if self._machine is None:
             numba = load_numba()
             self._machine = numba.njit(cache=True, nogil=True, boundscheck=False)(self.fn)
-        return self._machine(*args)
+            names = self.fn.__globals__
+            names[self.__name__] = self._machine  # a recursive call finds it too
+            for name in self.fn.__code__.co_names:
+                other = names.get(name)
+                if isinstance(other, _Compiled):
+                    names[name] = other.machine()
+        return self._machine
+
+    def __call__(self, *args: Any) -> Any:
+        return (self._machine or self.machine())(*args)
 
 
 def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """``fn`` compiled in nopython mode on its first call, its machine code cached on disk. The
-    function may call no other compiled function (each is compiled on its own)."""
+    """``fn`` compiled in nopython mode on its first call, its machine code cached on disk. It
+    may call other functions of its module made with :func:`jit`, and itself."""
     return _Compiled(fn)
+
+
+@jit
+def pairwise_sum(a: Any, start: int, n: int) -> Any:
+    """The sum of ``a[start : start + n]`` as NumPy's ``sum`` adds it, to the bit: pairwise, 8
+    running sums over blocks of up to 128 values, halves (cut at a multiple of 8) above. For
+    compiled loops whose sums feed the decisions the NumPy expressions they replace fed. The
+    halving runs on a stack of its own: numba's cache cannot load a compiled caller of a
+    recursive function."""
+    if n <= 128:
+        return _block_sum(a, start, n)
+    # Post-order over the halving tree: each entry a range and how far it has got (0: neither
+    # half summed, 1: the first, 2: both), its halves' sums on a stack of values.
+    lo, size, state = np.empty(64, np.int64), np.empty(64, np.int64), np.empty(64, np.int64)
+    values = np.zeros(64, a.dtype)
+    lo[0], size[0], state[0] = start, n, 0
+    depth, held = 1, 0
+    while depth:
+        top = depth - 1
+        if size[top] <= 128:
+            values[held] = _block_sum(a, lo[top], size[top])
+            held += 1
+            depth -= 1
+            continue
+        half = size[top] // 2
+        half -= half % 8
+        if state[top] < 2:
+            first = state[top] == 0
+            lo[depth] = lo[top] if first else lo[top] + half
+            size[depth] = half if first else size[top] - half
+            state[depth] = 0
+            state[top] += 1
+            depth += 1
+        else:
+            held -= 1
+            values[held - 1] = values[held - 1] + values[held]
+            depth -= 1
+    return values[0]
+
+
+@jit
+def _block_sum(a: Any, start: int, n: int) -> Any:
+    """:func:`pairwise_sum` of at most 128 values."""
+    if n < 8:
+        total = np.zeros(1, a.dtype)[0]  # float32 values add up in float32, as in NumPy
+        for i in range(start, start + n):
+            total += a[i]
+        return total
+    r = a[start : start + 8].copy()
+    i = 8
+    while i < n - n % 8:
+        for j in range(8):
+            r[j] += a[start + i + j]
+        i += 8
+    total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    for k in range(start + i, start + n):
+        total += a[k]
+    return total

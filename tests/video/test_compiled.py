@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from physbench.video.compiled import CompiledError, jit
+from physbench.video.compiled import CompiledError, jit, pairwise_sum
 
 
 def test_a_compiled_function_gives_what_the_python_gives() -> None:
@@ -33,3 +33,22 @@ def test_without_numba_the_error_names_the_extra(monkeypatch: pytest.MonkeyPatch
     monkeypatch.setitem(sys.modules, "numba", None)  # import numba raises ImportError
     with pytest.raises(CompiledError, match=r"pip install 'physbench\[video\]'"):
         jit(lambda x: x)(1.0)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_the_pairwise_sum_is_numpys_to_the_bit(dtype: type) -> None:
+    rng = np.random.default_rng(3)
+    for n in [*range(0, 140), 255, 256, 1000, 1401, 9000]:
+        a = (rng.standard_normal(n) * 10 ** rng.uniform(-3, 3, n)).astype(dtype)
+        assert pairwise_sum(a, 0, n) == a.sum(), n
+        assert pairwise_sum(a, 3, max(n - 5, 0)) == a[3 : max(n - 2, 3)].sum(), n
+
+
+@jit
+def _twice_the_sum(a):  # type: ignore[no-untyped-def]
+    return 2.0 * pairwise_sum(a, 0, len(a))
+
+
+def test_a_compiled_function_may_call_another() -> None:
+    values = np.arange(200.0)
+    assert _twice_the_sum(values) == 2 * values.sum() == 39800.0
