@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from physbench.video.compiled import jit, pairwise_sum
+
 #: The covered area may be this many times smaller or larger than the scene's: motion blur keeps
 #: the area, a threshold or a partly hidden edge changes it by tens of per cent.
 SIZE_RATIO = 2.2
@@ -69,14 +71,6 @@ def _length(d: np.ndarray) -> float:
     return math.sqrt(float(d @ d))
 
 
-def colour_directions(colours: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit directions ``(n, 3)`` and lengths ``(n,)`` of pixel ``colours`` (in the background's
-    light, darkened by :data:`DARK` as a :class:`Look`'s), for :meth:`Appearance.matches`."""
-    d = np.asarray(colours, dtype=np.float64) + DARK
-    norms = np.sqrt(np.einsum("ij,ij->i", d, d))
-    return d / norms[:, None], norms
-
-
 @dataclass
 class Appearance:
     """A body's running appearance (see the module docstring)."""
@@ -121,11 +115,6 @@ class Appearance:
             return f"{bright:.2f} times its brightness"
         return None
 
-    def matches(self, units: np.ndarray, norms: np.ndarray) -> np.ndarray:
-        """Which pixels of a blob have this body's hue and brightness (its own pixels, in a blob
-        shared with bodies or things of other colours), from their :func:`colour_directions`."""
-        return matching([self], units, norms)[:, 0]
-
     def update(self, look: Look) -> None:
         """Called by the tracker with each accepted detection's appearance."""
         hue = _length(_direction(look.colour) - self._unit)
@@ -136,14 +125,58 @@ class Appearance:
         self.seen += 1
 
 
-def matching(looks: Sequence[Appearance], units: np.ndarray, norms: np.ndarray) -> np.ndarray:
-    """:meth:`Appearance.matches` of several bodies at once (one product for all): ``(n, k)``,
-    a column per body of ``looks``."""
+def matching(
+    looks: Sequence[Appearance],
+    image: np.ndarray,
+    u: np.ndarray,
+    v: np.ndarray,
+    w: np.ndarray,
+    ends: np.ndarray,
+    offset: np.ndarray,
+    gain: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Which pixels ``(u, v)`` of ``image`` (``(H, W, 3)`` uint8) have each of ``looks``' hue and
+    brightness (a body's own pixels, in a blob shared with bodies or things of other colours),
+    their colours taken back to the background's light (``(raw - offset) / gain``) and darkened
+    by :data:`DARK` as a :class:`Look`'s: ``(n, k)``, a column per look. With the pixels in
+    groups (blobs) that end at ``ends``, and their coverage ``w``: each group's coverage of each
+    look's pixels, ``(groups, k)``, summed as NumPy sums ``w[mask]``."""
     refs = np.array([look.colour for look in looks], dtype=float) + DARK  # (k, 3)
     size = np.array([_length(ref) for ref in refs])
     tolerance = np.array([max(HUE_TOLERANCE, 4 * look.hue_spread) for look in looks])
-    bright = norms[:, None] / size
     # |a - b| <= tol for unit vectors: a . b >= 1 - tol^2 / 2.
-    return (units @ (refs / size[:, None]).T >= 1 - 0.5 * tolerance**2) & (
-        (bright >= 1 / BRIGHTNESS_RATIO) & (bright <= BRIGHTNESS_RATIO)
-    )
+    least = 1 - 0.5 * tolerance**2
+    return _matching(image, u, v, w, ends, offset, gain, refs / size[:, None], size, least)
+
+
+@jit
+def _matching(image, u, v, w, ends, offset, gain, units, size, least):  # type: ignore[no-untyped-def]
+    """:func:`matching`'s pixels, one at a time."""
+    n, k = len(u), len(size)
+    masks = np.zeros((n, k), np.bool_)
+    for p in range(n):
+        raw = image[int(v[p]), int(u[p])]
+        d0 = (raw[0] - offset[0]) / gain[0] + DARK
+        d1 = (raw[1] - offset[1]) / gain[1] + DARK
+        d2 = (raw[2] - offset[2]) / gain[2] + DARK
+        norm = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        d0, d1, d2 = d0 / norm, d1 / norm, d2 / norm
+        for j in range(k):
+            bright = norm / size[j]
+            hue = d0 * units[j, 0] + d1 * units[j, 1] + d2 * units[j, 2]
+            masks[p, j] = (
+                hue >= least[j] and bright >= 1 / BRIGHTNESS_RATIO and bright <= BRIGHTNESS_RATIO
+            )
+    owned = np.zeros((len(ends), k))
+    mine = np.empty(n)
+    start = 0
+    for g in range(len(ends)):
+        for j in range(k):
+            count = 0
+            for p in range(start, ends[g]):
+                if masks[p, j]:
+                    mine[count] = w[p]
+                    count += 1
+            owned[g, j] = pairwise_sum(mine, 0, count)
+        start = ends[g]
+    return masks, owned

@@ -52,15 +52,10 @@ from scipy import ndimage
 
 from physbench.errors import PhysbenchError, PhysbenchWarning
 from physbench.scene import Box, Circle
+from physbench.video import medians
 from physbench.video.accuracy import stated_accuracy, stated_angle_accuracy
-from physbench.video.appearance import (
-    COLOUR_PIXELS,
-    HIDDEN,
-    Appearance,
-    Look,
-    colour_directions,
-    matching,
-)
+from physbench.video.appearance import COLOUR_PIXELS, HIDDEN, Appearance, Look, matching
+from physbench.video.compiled import jit, pairwise_sum
 from physbench.video.contacts import contact_samples
 from physbench.video.detect import (
     CROSS,
@@ -73,7 +68,6 @@ from physbench.video.detect import (
     split_pixels,
 )
 from physbench.video.faint import SHUTTER, SIGNIFICANCE, Faint, find_faint, look_elsewhere
-from physbench.video.medians import median
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import DEVIATIONS, Light, LightMeter, plate_index
@@ -933,7 +927,7 @@ class Tracker:
             owner, dist = self._assign(group, blobs, gates, own)
             for c, members in owner.items():
                 mixed = len(members) > 1 or (
-                    len(group) > 1 and _colours_of(blobs[c], own[c], self.states) > 1
+                    len(group) > 1 and _colours_of(own[c], self.states) > 1
                 )
                 for i in members:
                     if self.states[i].disc:
@@ -965,7 +959,7 @@ class Tracker:
         group: list[int],
         blobs: list,
         c: int,
-        own: list[Mapping[int, np.ndarray]],
+        own: list[_Split],
         dist: np.ndarray,
         gates: np.ndarray,
     ) -> list[int]:
@@ -985,7 +979,7 @@ class Tracker:
         window: tuple[np.ndarray, tuple[int, int]],
         blobs: list,
         c: int,
-        own: list[Mapping[int, np.ndarray]],
+        own: list[_Split],
         tries: list[int],
     ) -> tuple[_Found, int] | None:
         """Body ``i`` measured on the first blob of ``tries`` where it looks like itself (on
@@ -1002,7 +996,7 @@ class Tracker:
         return None
 
     def _assign(
-        self, ids: list[int], blobs: list, gates: np.ndarray, own: list[Mapping[int, np.ndarray]]
+        self, ids: list[int], blobs: list, gates: np.ndarray, own: list[_Split]
     ) -> tuple[dict[int, list[int]], np.ndarray]:
         """Blobs to bodies ``ids``: each blob's owners, and the distance of each body's prediction
         to each blob's centre (px). ``own``: per blob, the pixels of each body's colour."""
@@ -1041,7 +1035,7 @@ class Tracker:
         ids: list[int],
         blobs: list,
         gates: np.ndarray,
-        own: list[Mapping[int, np.ndarray]],
+        own: list[_Split],
         owner: dict[int, list[int]],
         dist: np.ndarray,
     ) -> None:
@@ -1055,8 +1049,7 @@ class Tracker:
         stay as the distances gave them."""
 
         def held(c: int, i: int) -> float:
-            mask = own[c].get(i)
-            return 0.0 if mask is None else float(blobs[c][3][mask].sum()) / self.states[i].area
+            return own[c].covered(i) / self.states[i].area if i in own[c] else 0.0
 
         for c, members in list(owner.items()):
             if blobs[c][0].area < COLOUR_PIXELS:
@@ -1080,21 +1073,25 @@ class Tracker:
 
     def _own_colours(
         self, image: np.ndarray, blobs: list, ids: list[int]
-    ) -> list[dict[int, np.ndarray]]:
+    ) -> list[tuple[dict[int, np.ndarray], dict[int, float]]]:
         """Which pixels of each of a window's blobs are of each body's colour, for the bodies of
-        ``ids`` whose looks are known (all the window's blobs in one pass)."""
-        looks = {i: self.states[i].look for i in ids}
-        known = {i: look for i, look in looks.items() if look is not None}
+        ``ids`` whose looks are known (all the window's blobs in one pass), and their coverage
+        (:func:`~physbench.video.appearance.matching`)."""
+        known = [i for i in ids if self.states[i].look is not None]
         if not known:
-            return [{} for _ in blobs]
+            return [({}, {}) for _ in blobs]
         u = np.concatenate([b[1] for b in blobs])
         v = np.concatenate([b[2] for b in blobs])
-        masks = matching(list(known.values()), *self._colours(image, u, v))
-        ends = np.cumsum([len(b[1]) for b in blobs]).tolist()
+        w = np.concatenate([b[3] for b in blobs])
+        ends = np.cumsum([len(b[1]) for b in blobs])
+        looks = [self.states[i].look for i in known]
+        masks, owned = matching(looks, image, u, v, w, ends, self.light.offset, self.light.gain)  # type: ignore[arg-type]
+        starts = [0, *ends[:-1].tolist()]
         return [
-            {i: masks[a:b, k] for k, i in enumerate(known)}
-            for a, b in zip([0, *ends[:-1]], ends, strict=True)
-        ]
+            ({i: masks[a:b, k] for k, i in enumerate(known)},
+             {i: float(owned[c, k]) for k, i in enumerate(known)})
+            for c, (a, b) in enumerate(zip(starts, ends.tolist(), strict=True))
+        ]  # fmt: skip
 
     def _members(
         self,
@@ -1104,7 +1101,7 @@ class Tracker:
         window: tuple[np.ndarray, tuple[int, int]],
         plans: dict[int, _Plan],
         fits: dict[int, DiscFit | None],
-        own: Mapping[int, np.ndarray],
+        own: _Split,
     ) -> dict[int, _Found]:
         """Measure ``members`` on one blob (pixels ``u``, ``v``, coverage ``w``): a disc by its
         outline (``fits``), a body alone by its centroid, bodies sharing the blob by its pixels
@@ -1151,7 +1148,7 @@ class Tracker:
                 # A disc whose outline is hidden by its neighbours, or another body: its share
                 # of the blob's pixels, those of its colour where the blob holds several.
                 mine, fit = split == j, (split == j) & inside
-                if i in own and len(own) > 1 and w[own[i]].sum() >= 0.2 * s.area:
+                if i in own and len(own) > 1 and own.covered(i) >= 0.2 * s.area:
                     mine = fit = own[i]
                     centres[j] = blob_from_pixels(u[mine], v[mine], w[mine]).centre
                 part = blob_from_pixels(u[mine], v[mine], w[mine])
@@ -1179,14 +1176,6 @@ class Tracker:
                 got = replace(got, split=True)
             out[i] = got
         return out
-
-    def _colours(
-        self, image: np.ndarray, u: np.ndarray, v: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The colours of pixels ``(u, v)`` in the background's light, as directions and lengths
-        (:func:`~physbench.video.appearance.colour_directions`)."""
-        raw = image[v.astype(np.intp), u.astype(np.intp)]
-        return colour_directions((raw - self.light.offset) / self.light.gain)
 
     def _plan(
         self,
@@ -1347,16 +1336,10 @@ class Tracker:
             look = self._look(i, blob.area, colours, w, mpp=plan.mpp)
             pose = plane_pose(u, v, w, self.cal)
             return _Found(pose.xy, blob.centre, pose, look, centroid=True)
-        rf = fit.radius / plan.mpp
         if plan.pixels is not None:  # its own colour's pixels of a shared blob
             u, v, w = plan.pixels
-        near = (u - fit.uv[0]) ** 2 + (v - fit.uv[1]) ** 2
-        area = float(w[near <= (rf + 1.0) ** 2].sum())
-        inner = np.flatnonzero(near <= (0.6 * rf) ** 2)
-        if len(inner) > 64:
-            inner = inner[::4]  # the pixels _look would keep, gathered alone
-        colours = image[v[inner].astype(np.intp), u[inner].astype(np.intp)]
-        look = self._look(i, area, colours, None, mpp=plan.mpp, thinned=True)
+        area, raw = _disc_pixels(image, u, v, w, fit.uv[0], fit.uv[1], fit.radius / plan.mpp)
+        look = self._look(i, area, raw, None, mpp=plan.mpp, median=True)
         radius = None if fit.fixed else fit.radius
         return _Found(fit.xy, fit.uv, PlanePose(fit.xy, 0.0, 1.0, 0.0), look, radius)
 
@@ -1400,21 +1383,24 @@ class Tracker:
         *,
         mpp: float | None = None,
         at: np.ndarray | None = None,
-        thinned: bool = False,
+        median: bool = False,
     ) -> Look:
         """What body ``i``'s detection looks like: its covered ``area`` (px) over the scene's
         area for the body (``mpp`` metres per pixel, or at pixel ``at``, or at its prediction),
         and the median colour of ``colours`` (``(n, 3)``; with ``weights``, of the best covered
-        quarter, which motion blur mixes least with the wall; every 4th of many, unless
-        ``thinned`` so already) in the background's light."""
+        quarter, which motion blur mixes least with the wall; every 4th of many; ``median``:
+        ``colours`` is that median already) in the background's light."""
         if mpp is None:
             mpp = self._mpp(self.pred_uv[i] if at is None else at)
         expected = self.states[i].body.shape.area() / mpp**2
-        if weights is not None and len(colours) > 3:
-            colours = colours[weights >= np.percentile(weights, 75)]
-        if len(colours) > 64 and not thinned:
-            colours = colours[::4]
-        raw = median(colours, axis=0) if len(colours) else np.zeros(3)
+        if median:
+            raw = colours
+        else:
+            if weights is not None and len(colours) > 3:
+                colours = colours[weights >= np.percentile(weights, 75)]
+            if len(colours) > 64:
+                colours = colours[::4]
+            raw = medians.median(colours, axis=0) if len(colours) else np.zeros(3)
         colour = (raw - self.light.offset) / np.maximum(self.light.gain, 1e-3)
         return Look(area / max(expected, 1e-9), colour, expected)
 
@@ -1804,22 +1790,58 @@ def _project(colour: np.ndarray, behind: np.ndarray, body: np.ndarray) -> np.nda
     return np.einsum("ij,ij->i", colour - behind, span) / np.maximum(norm, 1.0)
 
 
-def _colours_of(found_blob: tuple, own: Mapping[int, np.ndarray], states: list[_State]) -> int:
+@jit
+def _disc_pixels(image, u, v, w, cu, cv, rf):  # type: ignore[no-untyped-def]
+    """A disc fitted at ``(cu, cv)`` with radius ``rf`` (px) on pixels ``(u, v)`` of coverage
+    ``w``: their coverage within a pixel of its outline, and the median colour (``(3,)``) of
+    those within 60 % of its radius (every 4th of over 64), which shading and the rim mix least
+    with the wall."""
+    n = len(u)
+    covered = np.empty(n)
+    inner = np.empty(n, np.intp)
+    count = kept = 0
+    for p in range(n):
+        near = (u[p] - cu) ** 2 + (v[p] - cv) ** 2
+        if near <= (rf + 1.0) ** 2:
+            covered[count] = w[p]
+            count += 1
+        if near <= (0.6 * rf) ** 2:
+            inner[kept] = p
+            kept += 1
+    step = 4 if kept > 64 else 1
+    chosen = (kept + step - 1) // step
+    raw = np.zeros(3)
+    if chosen:
+        values = np.empty(chosen)
+        half = chosen // 2
+        for c in range(3):
+            for k in range(chosen):
+                p = inner[k * step]
+                values[k] = image[int(v[p]), int(u[p]), c]
+            values.sort()
+            raw[c] = values[half] if chosen % 2 else (values[half - 1] + values[half]) / 2
+    return pairwise_sum(covered, 0, count), raw
+
+
+def _colours_of(own: _Split, states: list[_State]) -> int:
     """How many bodies' colours a blob holds much of (a fifth of a body's area or more)."""
-    w = found_blob[3]
-    return sum(float(w[mask].sum()) >= 0.2 * states[i].area for i, mask in own.items())
+    return sum(own.covered(i) >= 0.2 * states[i].area for i in own)
 
 
 class _Lazy:
     """``split(*args)`` (:meth:`Tracker._own_colours`: every blob of a window's pixels of each
-    body's colour), computed when first asked for: most windows' blobs are one body's alone,
-    which never asks."""
+    body's colour, and their coverage), computed when first asked for: most windows' blobs are
+    one body's alone, which never asks."""
 
-    def __init__(self, split: Callable[..., list[dict[int, np.ndarray]]], *args: object) -> None:
+    def __init__(
+        self,
+        split: Callable[..., list[tuple[dict[int, np.ndarray], dict[int, float]]]],
+        *args: object,
+    ) -> None:
         self._split, self._args = split, args
-        self._masks: list[dict[int, np.ndarray]] | None = None
+        self._masks: list[tuple[dict[int, np.ndarray], dict[int, float]]] | None = None
 
-    def get(self) -> list[dict[int, np.ndarray]]:
+    def get(self) -> list[tuple[dict[int, np.ndarray], dict[int, float]]]:
         if self._masks is None:
             self._masks = self._split(*self._args)
         return self._masks
@@ -1832,7 +1854,11 @@ class _Split(Mapping[int, np.ndarray]):
         self._window, self._c = window, c
 
     def _get(self) -> dict[int, np.ndarray]:
-        return self._window.get()[self._c]
+        return self._window.get()[self._c][0]
+
+    def covered(self, i: int) -> float:
+        """The blob's coverage (px) of body ``i``'s pixels: ``w[self[i]].sum()``."""
+        return self._window.get()[self._c][1][i]
 
     def __getitem__(self, i: int) -> np.ndarray:
         return self._get()[i]
