@@ -61,14 +61,25 @@ class Look:
     pixels: float = math.inf
 
 
-def _direction(c: np.ndarray) -> np.ndarray:
-    d = np.asarray(c, dtype=float) + DARK
-    return d / _length(d)
+# A colour's arithmetic on its three channels as Python floats: NumPy's dispatch costs more than
+# the work on three values, and ``d @ d`` and ``np.sum`` of three add them in this order too.
 
 
-def _length(d: np.ndarray) -> float:
-    """``np.linalg.norm`` of a vector, without its generic handling (the same value)."""
-    return math.sqrt(float(d @ d))
+def _direction(c: Sequence[float]) -> tuple[float, float, float]:
+    r, g, b = (x + DARK for x in c)
+    n = _length((r, g, b))
+    return r / n, g / n, b / n
+
+
+def _length(d: Sequence[float]) -> float:
+    """``np.linalg.norm`` of a vector of three (the same value)."""
+    x, y, z = d
+    return math.sqrt(x * x + y * y + z * z)
+
+
+def _apart(a: Sequence[float], b: Sequence[float]) -> float:
+    """The length of ``a - b``."""
+    return _length([x - y for x, y in zip(a, b, strict=True)])
 
 
 @dataclass
@@ -85,8 +96,9 @@ class Appearance:
 
     def _colour_changed(self) -> None:
         """Its colour's direction and brightness, which every detection is compared with."""
-        self._unit = _direction(self.colour)
-        self._brightness = float(np.sum(self.colour)) + 3 * DARK
+        r, g, b = self.colour.tolist()
+        self._unit = _direction((r, g, b))
+        self._brightness = r + g + b + 3 * DARK
 
     @classmethod
     def first(cls, look: Look) -> Appearance:
@@ -106,18 +118,19 @@ class Appearance:
             return f"{ratio:.2f} times its size"
         if look.pixels < COLOUR_PIXELS:
             return None
-        hue = _length(_direction(look.colour) - self._unit)
-        near = _length(np.asarray(look.colour, dtype=float) - self.colour) < SAME_COLOUR
+        colour = np.asarray(look.colour, dtype=float).tolist()
+        hue = _apart(_direction(colour), self._unit)
+        near = _apart(colour, self.colour.tolist()) < SAME_COLOUR
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread) and not near:
             return f"another colour (hue {hue:.2f} off)"
-        bright = (float(np.sum(look.colour)) + 3 * DARK) / self._brightness
+        bright = (colour[0] + colour[1] + colour[2] + 3 * DARK) / self._brightness
         if not 1 / BRIGHTNESS_RATIO <= bright <= BRIGHTNESS_RATIO:
             return f"{bright:.2f} times its brightness"
         return None
 
     def update(self, look: Look) -> None:
         """Called by the tracker with each accepted detection's appearance."""
-        hue = _length(_direction(look.colour) - self._unit)
+        hue = _apart(_direction(np.asarray(look.colour, dtype=float).tolist()), self._unit)
         self.hue_spread += RATE * (hue - self.hue_spread)
         self.size += RATE * (look.size - self.size)
         self.colour = self.colour + RATE * (np.asarray(look.colour, dtype=float) - self.colour)
@@ -142,7 +155,7 @@ def matching(
     groups (blobs) that end at ``ends``, and their coverage ``w``: each group's coverage of each
     look's pixels, ``(groups, k)``, summed as NumPy sums ``w[mask]``."""
     refs = np.array([look.colour for look in looks], dtype=float) + DARK  # (k, 3)
-    size = np.array([_length(ref) for ref in refs])
+    size = np.array([_length(ref.tolist()) for ref in refs])
     tolerance = np.array([max(HUE_TOLERANCE, 4 * look.hue_spread) for look in looks])
     # |a - b| <= tol for unit vectors: a . b >= 1 - tol^2 / 2.
     least = 1 - 0.5 * tolerance**2

@@ -1071,27 +1071,21 @@ class Tracker:
                     owner.setdefault(int(c), []).append(i)
                     break
 
-    def _own_colours(
-        self, image: np.ndarray, blobs: list, ids: list[int]
-    ) -> list[tuple[dict[int, np.ndarray], dict[int, float]]]:
+    def _own_colours(self, image: np.ndarray, blobs: list, ids: list[int]) -> _Colours:
         """Which pixels of each of a window's blobs are of each body's colour, for the bodies of
         ``ids`` whose looks are known (all the window's blobs in one pass), and their coverage
         (:func:`~physbench.video.appearance.matching`)."""
         known = [i for i in ids if self.states[i].look is not None]
+        ends = np.cumsum([len(b[1]) for b in blobs])
         if not known:
-            return [({}, {}) for _ in blobs]
+            return _Colours({}, np.zeros((0, 0), bool), ends, np.zeros((len(blobs), 0)))
         u = np.concatenate([b[1] for b in blobs])
         v = np.concatenate([b[2] for b in blobs])
         w = np.concatenate([b[3] for b in blobs])
-        ends = np.cumsum([len(b[1]) for b in blobs])
         looks = [self.states[i].look for i in known]
-        masks, owned = matching(looks, image, u, v, w, ends, self.light.offset, self.light.gain)  # type: ignore[arg-type]
-        starts = [0, *ends[:-1].tolist()]
-        return [
-            ({i: masks[a:b, k] for k, i in enumerate(known)},
-             {i: float(owned[c, k]) for k, i in enumerate(known)})
-            for c, (a, b) in enumerate(zip(starts, ends.tolist(), strict=True))
-        ]  # fmt: skip
+        light = self.light
+        masks, owned = matching(looks, image, u, v, w, ends, light.offset, light.gain)  # type: ignore[arg-type]
+        return _Colours({i: k for k, i in enumerate(known)}, masks, ends, owned)
 
     def _members(
         self,
@@ -1828,23 +1822,30 @@ def _colours_of(own: _Split, states: list[_State]) -> int:
     return sum(own.covered(i) >= 0.2 * states[i].area for i in own)
 
 
+@dataclass(frozen=True)
+class _Colours:
+    """A window's blobs' pixels of each body's colour (:meth:`Tracker._own_colours`): the
+    column of ``masks`` (the blobs' pixels laid end to end, each blob's ending at ``ends``) and
+    of ``owned`` (each blob's coverage of those pixels) of each body whose looks are known."""
+
+    column: dict[int, int]
+    masks: np.ndarray
+    ends: np.ndarray
+    owned: np.ndarray
+
+
 class _Lazy:
-    """``split(*args)`` (:meth:`Tracker._own_colours`: every blob of a window's pixels of each
-    body's colour, and their coverage), computed when first asked for: most windows' blobs are
-    one body's alone, which never asks."""
+    """``split(*args)`` (:meth:`Tracker._own_colours`), computed when first asked for: most
+    windows' blobs are one body's alone, which never asks."""
 
-    def __init__(
-        self,
-        split: Callable[..., list[tuple[dict[int, np.ndarray], dict[int, float]]]],
-        *args: object,
-    ) -> None:
+    def __init__(self, split: Callable[..., _Colours], *args: object) -> None:
         self._split, self._args = split, args
-        self._masks: list[tuple[dict[int, np.ndarray], dict[int, float]]] | None = None
+        self._colours: _Colours | None = None
 
-    def get(self) -> list[tuple[dict[int, np.ndarray], dict[int, float]]]:
-        if self._masks is None:
-            self._masks = self._split(*self._args)
-        return self._masks
+    def get(self) -> _Colours:
+        if self._colours is None:
+            self._colours = self._split(*self._args)
+        return self._colours
 
 
 class _Split(Mapping[int, np.ndarray]):
@@ -1853,18 +1854,21 @@ class _Split(Mapping[int, np.ndarray]):
     def __init__(self, window: _Lazy, c: int) -> None:
         self._window, self._c = window, c
 
-    def _get(self) -> dict[int, np.ndarray]:
-        return self._window.get()[self._c][0]
-
     def covered(self, i: int) -> float:
         """The blob's coverage (px) of body ``i``'s pixels: ``w[self[i]].sum()``."""
-        return self._window.get()[self._c][1][i]
+        colours = self._window.get()
+        return float(colours.owned[self._c, colours.column[i]])
 
     def __getitem__(self, i: int) -> np.ndarray:
-        return self._get()[i]
+        colours = self._window.get()
+        start = int(colours.ends[self._c - 1]) if self._c else 0
+        return colours.masks[start : colours.ends[self._c], colours.column[i]]
+
+    def __contains__(self, i: object) -> bool:
+        return i in self._window.get().column
 
     def __iter__(self) -> Iterator[int]:
-        return iter(self._get())
+        return iter(self._window.get().column)
 
     def __len__(self) -> int:
-        return len(self._get())
+        return len(self._window.get().column)
