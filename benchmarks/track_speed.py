@@ -10,7 +10,9 @@ taken in CPU time (``time.process_time``), the best of ``--repeats`` runs, alter
 and decoding: on a machine shared with other work, wall-clock time counts the others' turns, CPU
 time the process's own (the best of several runs least of what sharing the caches costs). Wall
 time is recorded beside it. Memory is the peak of Python allocations (tracemalloc) in a separate,
-traced run: flat in clip length.
+traced run: flat in clip length. ``once``: what a fresh process's first tracking of the 5 s clip
+costs on top of the others (CPU s: loading numba and the tracker's compiled loops from their disk
+cache, and with an empty cache compiling them: the first run after installing).
 """
 
 from __future__ import annotations
@@ -18,6 +20,9 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import pickle
+import subprocess
+import sys
 import tempfile
 import time
 import tracemalloc
@@ -54,6 +59,34 @@ def _decode(path: Path) -> None:
         pass
 
 
+#: A fresh process's first and second tracking of a clip (CPU s), for :func:`_once`.
+_FIRST_CALLS = """
+import pickle, sys, time
+from physbench.video.track import track_video
+path, scene, cal, bg = pickle.load(open(sys.argv[1], "rb"))
+times = []
+for _ in range(2):
+    c = time.process_time()
+    track_video(path, scene, cal, background=bg, allow_gaps=True)
+    times.append(time.process_time() - c)
+print(times[0], times[1])
+"""
+
+
+def _once(path: Path, scene, cal, plate, cache: str | None) -> float:
+    """CPU s a fresh process's first tracking of ``path`` costs over its second, with numba's
+    cache in ``cache`` (``None``: where it is kept)."""
+    args = Path(path).with_suffix(".pkl")
+    args.write_bytes(pickle.dumps((str(path), scene, cal, plate)))
+    env = {**os.environ, **({"NUMBA_CACHE_DIR": cache} if cache else {})}
+    out = subprocess.run(
+        [sys.executable, "-c", _FIRST_CALLS, str(args)],
+        capture_output=True, text=True, check=True, env=env,
+    )  # fmt: skip
+    first, second = (float(x) for x in out.stdout.split())
+    return first - second
+
+
 def main() -> None:
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
@@ -61,7 +94,7 @@ def main() -> None:
     ap.add_argument("--out", default="results/track/speed.json")
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args()
-    rows = []
+    rows, once = [], {}
     with tempfile.TemporaryDirectory() as tmp:
         for seconds in (5, 20):
             scene = replace(bouncing_balls.generate(3, n_balls=6), frames=30 * seconds)
@@ -102,8 +135,17 @@ def main() -> None:
                     f"peak {peak:5.1f} MiB",
                     flush=True,
                 )
+            if seconds == 5:
+                _once(path, scene, cal, plate, None)  # the disk cache holds the loops now
+                once["cached_s"] = round(_once(path, scene, cal, plate, None), 2)
+                once["compiling_s"] = round(_once(path, scene, cal, plate, f"{tmp}/cache"), 2)
+                print(
+                    f"a fresh process's first tracking costs {once['cached_s']} CPU s more "
+                    f"({once['compiling_s']} s with an empty cache: compiling)",
+                    flush=True,
+                )
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(json.dumps({"clips": rows}, indent=2) + "\n")
+    Path(args.out).write_text(json.dumps({"clips": rows, "once": once}, indent=2) + "\n")
     print(f"wrote {args.out}")
 
 

@@ -118,13 +118,17 @@ def _block_sum(a: Any, start: int, n: int) -> Any:
         for i in range(start, start + n):
             total += a[i]
         return total
-    r = a[start : start + 8].copy()
+    # Eight running sums, each its own scalar (a slice copied into an array made the loops
+    # that call this compile for seconds longer).
+    r0, r1, r2, r3 = a[start], a[start + 1], a[start + 2], a[start + 3]
+    r4, r5, r6, r7 = a[start + 4], a[start + 5], a[start + 6], a[start + 7]
     i = 8
     while i < n - n % 8:
-        for j in range(8):
-            r[j] += a[start + i + j]
+        j = start + i
+        r0, r1, r2, r3 = r0 + a[j], r1 + a[j + 1], r2 + a[j + 2], r3 + a[j + 3]
+        r4, r5, r6, r7 = r4 + a[j + 4], r5 + a[j + 5], r6 + a[j + 6], r7 + a[j + 7]
         i += 8
-    total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
     for k in range(start + i, start + n):
         total += a[k]
     return total
