@@ -21,7 +21,7 @@ from functools import cached_property
 
 import numpy as np
 
-from physbench.video.medians import median
+from physbench.video.compiled import jit
 from physbench.video.segment import difference
 
 #: Pixels the meter samples per frame (a regular grid over the image): the gain's standard
@@ -121,40 +121,135 @@ class LightMeter:
         """Called by the tracker once per frame: the light of ``image`` (``(H, W, 3)`` uint8),
         leaving out the pixels within ``radius`` of each ``(u, v, radius)`` in ``avoid`` (the
         predicted bodies)."""
-        y = image.reshape(-1, 3)[self.flat].T  # (3, n): a channel a row
-        keep = self.usable & (np.maximum(np.maximum(y[0], y[1]), y[2]) < 254)
-        if len(avoid):
-            b = np.asarray(avoid, dtype=float)
-            near = (self.u[:, None] - b[:, 0]) ** 2 + (self.v[:, None] - b[:, 1]) ** 2
-            keep &= (near > b[:, 2] ** 2).all(axis=1)
-        if keep.sum() < 30:
+        bodies = np.asarray(avoid, dtype=np.float64).reshape(-1, 3)
+        gain, offset, sigma, samples, kept = _light(
+            image.reshape(-1, 3), self.flat, self.u, self.v, self.bg, self.usable, bodies
+        )
+        if kept < 30:
             return Light.unchanged()
-        return _fit(self.bg[:, keep], y[:, keep].astype(np.float64))
+        return Light(gain, offset, sigma, samples)
 
 
-def _fit(x: np.ndarray, y: np.ndarray) -> Light:
-    """``y ≈ gain * x + offset`` per channel (rows of ``(3, n)``), by iteratively reweighted
-    least squares with Tukey's biweight from the median ratio (the scale from its residuals):
-    foreground the meter did not know of (a hand, a shadow) gets weight 0."""
-    gain = median(y / np.maximum(x, 1.0), axis=1)[:, None]
-    r = y - gain * x
-    scale = TUKEY * np.maximum(1.4826 * median(np.abs(r), axis=1), 0.5)[:, None]
-    spread = x.std(axis=1) >= MIN_SPREAD
-    offset = np.zeros((3, 1))
-    w = np.ones_like(x)
-    for _ in range(2):
-        z = r / scale
-        w = np.maximum(1 - z * z, 0.0) ** 2
-        # Weighted sums of 1, x, y, xx and xy per channel, at once.
-        wx = w * x
-        sw, sx, sy = w.sum(axis=1), wx.sum(axis=1), (w * y).sum(axis=1)
-        sxx, sxy = (wx * x).sum(axis=1), (wx * y).sum(axis=1)
-        det = sw * sxx - sx * sx
-        sloped = (sw * sxy - sx * sy) / np.maximum(det, 1e-9)
-        g = np.where(spread, sloped, sxy / np.maximum(sxx, 1e-9))
-        o = np.where(spread, (sy - g * sx) / np.maximum(sw, 1e-9), 0.0)
-        gain, offset = g[:, None], o[:, None]
-        r = y - gain * x - offset
-    r = np.abs(r)
-    sigma = 1.4826 * float(median(np.maximum(np.maximum(r[0], r[1]), r[2])))
-    return Light(gain[:, 0], offset[:, 0], sigma, int((w > 0).all(axis=0).sum()))
+@jit
+def _light(pixels, flat, u, v, bg, usable, bodies):  # type: ignore[no-untyped-def]
+    """The light of a frame (``pixels``: its ``(H * W, 3)`` uint8 view) on the meter's grid
+    (``flat`` indices, at ``u``, ``v``; background ``bg`` ``(3, n)``, ``usable`` where it is
+    not clipped), away from ``bodies`` (rows ``u, v, radius``): gain, offset, sigma, samples
+    and the count of pixels kept (the fit is not made under 30).
+
+    Per channel, ``frame ≈ gain * background + offset`` by iteratively reweighted least
+    squares with Tukey's biweight from the median ratio (the scale from its residuals):
+    foreground the meter did not know of (a hand, a shadow) gets weight 0. The loop repeats
+    the NumPy expressions it replaced operation for operation; their sums added in index
+    order (``.sum(axis=1)`` of ``(3, kept)`` arrays laid out pixel by pixel, so not
+    pairwise), as these do, and a median of the same values is the same by any method."""
+    n = len(flat)
+    x = np.empty((3, n))
+    y = np.empty((3, n))
+    for i in range(n):  # gathered first: the reads do not wait on each other's tests
+        for c in range(3):
+            y[c, i] = pixels[flat[i], c]
+    m = 0
+    for i in range(n):
+        if not usable[i] or max(y[0, i], y[1, i], y[2, i]) >= 254:
+            continue
+        clear = True
+        for body in range(len(bodies)):
+            du, dv = u[i] - bodies[body, 0], v[i] - bodies[body, 1]
+            clear &= du * du + dv * dv > bodies[body, 2] * bodies[body, 2]
+        if clear:
+            for c in range(3):
+                x[c, m], y[c, m] = bg[c, i], y[c, i]
+            m += 1
+    gain, offset = np.ones(3), np.zeros(3)
+    if m < 30:
+        return gain, offset, 0.0, 0, m
+    scale, sigma = np.empty(3), 0.0
+    spread = np.empty(3, np.bool_)
+    r = np.empty((3, m))
+    w = np.empty((3, m))
+    work = np.empty((3, m))  # a median's values in row 0; the other rows its selection's
+    # Seven medians at one place in the code: per channel the ratio (the gain's start) and
+    # then its residuals' magnitude (their scale); after the fit, the largest channel residual.
+    for job in range(7):
+        c = job % 3
+        if job < 3:
+            for j in range(m):
+                work[0, j] = y[c, j] / max(x[c, j], 1.0)
+            mean = 0.0
+            for j in range(m):
+                mean += x[c, j]
+            mean /= m
+            var = 0.0
+            for j in range(m):
+                d = x[c, j] - mean
+                var += d * d
+            spread[c] = np.sqrt(var / m) >= MIN_SPREAD
+        elif job < 6:
+            for j in range(m):
+                r[c, j] = y[c, j] - gain[c] * x[c, j]
+                work[0, j] = abs(r[c, j])
+        else:
+            for _ in range(2):
+                for ch in range(3):
+                    # Weighted sums of 1, x, y, xx and xy.
+                    sw, sx, sy, sxx, sxy = 0.0, 0.0, 0.0, 0.0, 0.0
+                    for j in range(m):
+                        z = r[ch, j] / scale[ch]
+                        t = max(1 - z * z, 0.0)
+                        w[ch, j] = t * t
+                        wx = w[ch, j] * x[ch, j]
+                        sw += w[ch, j]
+                        sx += wx
+                        sy += w[ch, j] * y[ch, j]
+                        sxx += wx * x[ch, j]
+                        sxy += wx * y[ch, j]
+                    if spread[ch]:
+                        det = sw * sxx - sx * sx
+                        gain[ch] = (sw * sxy - sx * sy) / max(det, 1e-9)
+                        offset[ch] = (sy - gain[ch] * sx) / max(sw, 1e-9)
+                    else:
+                        gain[ch], offset[ch] = sxy / max(sxx, 1e-9), 0.0
+                    for j in range(m):
+                        r[ch, j] = y[ch, j] - gain[ch] * x[ch, j] - offset[ch]
+            for j in range(m):
+                work[0, j] = max(max(abs(r[0, j]), abs(r[1, j])), abs(r[2, j]))
+        # The median of work[0, :m], by quickselect with three-way partitions out of place:
+        # each value is written to both other rows, each write index moved on by a comparison
+        # (no branch on the data, which a branch predictor cannot learn).
+        k, size, cur, below = m // 2, m, 0, -np.inf  # below: the largest value left below
+        while True:
+            lo, hi = (cur + 1) % 3, (cur + 2) % 3
+            p0, p1, p2 = work[cur, 0], work[cur, size // 2], work[cur, size - 1]
+            pivot = max(min(p0, p1), min(max(p0, p1), p2))  # the median of three
+            less = more = 0
+            for j in range(size):
+                value = work[cur, j]
+                work[lo, less] = value
+                less += value < pivot
+                work[hi, more] = value
+                more += value > pivot
+            if k < less:
+                cur, size = lo, less
+            elif k < size - more:  # the pivot
+                break
+            else:
+                cur, size, k, below = hi, more, k - (size - more), pivot
+        middle = pivot
+        if m % 2 == 0:  # the mean of the two middle values
+            if k == less:
+                for j in range(less):
+                    below = max(below, work[lo, j])
+            else:
+                below = pivot
+            middle = (below + middle) / 2
+        if job < 3:
+            gain[c] = middle
+        elif job < 6:
+            scale[c] = TUKEY * max(1.4826 * middle, 0.5)
+        else:
+            sigma = 1.4826 * middle
+    samples = 0
+    for j in range(m):
+        samples += w[0, j] > 0 and w[1, j] > 0 and w[2, j] > 0
+    return gain, offset, sigma, samples, m

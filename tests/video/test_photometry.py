@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from physbench.video.photometry import LightMeter
+from physbench.video.medians import median
+from physbench.video.photometry import MIN_SPREAD, TUKEY, Light, LightMeter
 from physbench.video.spheres import expose, wall
 
 
@@ -40,3 +41,62 @@ def test_a_plain_wall_gives_a_gain_alone() -> None:
     np.testing.assert_allclose(got.gain, 1.1, atol=1e-6)
     np.testing.assert_allclose(got.offset, 0.0)
     assert got.difference(frame, background).max() == 0
+
+
+def _numpy_measure(
+    meter: LightMeter, image: np.ndarray, avoid: list[tuple[float, float, float]]
+) -> Light:
+    """:meth:`LightMeter.measure` as NumPy calls, before its compiled loop."""
+    y = image.reshape(-1, 3)[meter.flat].T
+    keep = meter.usable & (np.maximum(np.maximum(y[0], y[1]), y[2]) < 254)
+    if len(avoid):
+        b = np.asarray(avoid, dtype=float)
+        near = (meter.u[:, None] - b[:, 0]) ** 2 + (meter.v[:, None] - b[:, 1]) ** 2
+        keep &= (near > b[:, 2] ** 2).all(axis=1)
+    if keep.sum() < 30:
+        return Light.unchanged()
+    x, y = meter.bg[:, keep], y[:, keep].astype(np.float64)
+    gain = median(y / np.maximum(x, 1.0), axis=1)[:, None]
+    r = y - gain * x
+    scale = TUKEY * np.maximum(1.4826 * median(np.abs(r), axis=1), 0.5)[:, None]
+    spread = x.std(axis=1) >= MIN_SPREAD
+    offset = np.zeros((3, 1))
+    w = np.ones_like(x)
+    for _ in range(2):
+        z = r / scale
+        w = np.maximum(1 - z * z, 0.0) ** 2
+        wx = w * x
+        sw, sx, sy = w.sum(axis=1), wx.sum(axis=1), (w * y).sum(axis=1)
+        sxx, sxy = (wx * x).sum(axis=1), (wx * y).sum(axis=1)
+        det = sw * sxx - sx * sx
+        sloped = (sw * sxy - sx * sy) / np.maximum(det, 1e-9)
+        g = np.where(spread, sloped, sxy / np.maximum(sxx, 1e-9))
+        o = np.where(spread, (sy - g * sx) / np.maximum(sw, 1e-9), 0.0)
+        gain, offset = g[:, None], o[:, None]
+        r = y - gain * x - offset
+    r = np.abs(r)
+    sigma = 1.4826 * float(median(np.maximum(np.maximum(r[0], r[1]), r[2])))
+    return Light(gain[:, 0], offset[:, 0], sigma, int((w > 0).all(axis=0).sum()))
+
+
+def test_the_compiled_meter_measures_what_the_numpy_expressions_did_to_the_bit() -> None:
+    # Textured and plain walls (no offset), foreground, bodies to avoid, grids of odd and even
+    # counts, and too few pixels left.
+    rng = np.random.default_rng(7)
+    for case in range(120):
+        h, w = rng.integers(30, 300, 2)
+        background = rng.integers(0, 256, (h, w, 3)).astype(np.uint8)
+        if case % 3 == 0:
+            background[:] = rng.integers(0, 256, 3)
+        light = background * rng.uniform(0.8, 1.2, 3) + rng.uniform(-10, 10, 3)
+        light += rng.normal(0, rng.uniform(0, 5), light.shape)
+        if case % 2:
+            top, left = rng.integers(0, h), rng.integers(0, w)
+            light[top : top + h // 3, left : left + w // 3] = rng.integers(0, 256, 3)
+        frame = np.rint(np.clip(light, 0, 255)).astype(np.uint8)
+        avoid = [(*rng.uniform(0, (w, h)), rng.uniform(1, 80)) for _ in range(rng.integers(0, 4))]
+        meter = LightMeter(background, samples=int(rng.choice([40, 100, 500, 2000])))
+        got, want = meter.measure(frame, avoid), _numpy_measure(meter, frame, avoid)
+        assert got.gain.tobytes() == want.gain.tobytes()
+        assert got.offset.tobytes() == want.offset.tobytes()
+        assert (got.sigma, got.samples) == (want.sigma, want.samples)
