@@ -1,5 +1,6 @@
-"""Medians of the small arrays the tracker takes every frame (a blob's colours), equal to :func:`numpy.median`'s to the bit but without its generic handling, which
-costs ~50 µs a call: several times what partitioning a few hundred values does."""
+"""Medians of the small arrays the tracker takes every frame (a blob's colours), equal to
+:func:`numpy.median`'s to the bit but without its generic handling, which costs ~50 µs a call:
+several times what partitioning a few hundred values does."""
 
 from __future__ import annotations
 
