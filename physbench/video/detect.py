@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import ndimage
 
+from physbench.video.compiled import jit
+
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
 
@@ -94,17 +96,34 @@ def blob_from_pixels(u: np.ndarray, v: np.ndarray, w: np.ndarray) -> Blob | None
     cu, cv = float(w @ u) / total, float(w @ v) / total
     du, dv = u - cu, v - cv
     muu, mvv, muv = float(w @ (du * du)), float(w @ (dv * dv)), float(w @ (du * dv))
+    # (du + i dv)^4 in real arithmetic (complex arrays cost several times as much).
+    re, im = du * du - dv * dv, 2 * du * dv
+    z4 = float(w @ (re * re - im * im)), float(w @ (2 * re * im))
+    return _blob_of_moments(total, cu, cv, muu, mvv, muv, *z4, int(u.size))
+
+
+def _blob_of_moments(
+    total: float,
+    cu: float,
+    cv: float,
+    muu: float,
+    mvv: float,
+    muv: float,
+    z4_re: float,
+    z4_im: float,
+    count: int,
+) -> Blob:
+    """The :class:`Blob` of ``count`` pixels from their coverage ``total``, centre ``(cu, cv)``,
+    weighted second central moments and fourth-order moment ``z4`` (the weighted sum of
+    ``(du + i dv)^4``)."""
     axis = 0.5 * math.atan2(2 * muv, muu - mvv)
     spread = math.hypot(muu - mvv, 2 * muv)
     big, small = (muu + mvv + spread) / 2, (muu + mvv - spread) / 2
     elongation = big / small if small > 1e-12 else math.inf
-    # (du + i dv)^4 in real arithmetic (complex arrays cost several times as much).
-    re, im = du * du - dv * dv, 2 * du * dv
-    z4 = complex(float(w @ (re * re - im * im)), float(w @ (2 * re * im)))
     # A square's corners dominate the fourth moment: its phase points at a corner, 45 degrees
     # from a side.
-    square = (math.atan2(z4.imag, z4.real) / 4 - math.pi / 4) % (math.pi / 2)
-    return Blob(cu, cv, total, int(u.size), axis, elongation, square)
+    square = (math.atan2(z4_im, z4_re) / 4 - math.pi / 4) % (math.pi / 2)
+    return Blob(cu, cv, total, count, axis, elongation, square)
 
 
 def find_blobs(
@@ -113,39 +132,156 @@ def find_blobs(
     """Blobs of a difference image ``diff`` (``(H, W)``, a crop whose top-left pixel is
     ``offset = (row, col)`` of the frame): each with its pixels' ``u``, ``v`` (frame px) and
     coverage, largest first; blobs covering less than ``min_area`` px are noise and dropped."""
-    mask = diff > low
     # Labelled within the foreground's bounding box: a window is mostly wall, and labelling
-    # and scanning it cost more than the rest of this function.
-    some_rows = np.flatnonzero(mask.any(axis=1))
-    if not len(some_rows):
+    # and scanning it cost more than the rest of this function. (Compared in float64, the box
+    # holds at least the pixels that NumPy's comparison, in the difference's type, finds.)
+    r0, r1, c0, c1 = _extent(diff, float(low))
+    if r0 == r1:
         return []
-    some_cols = np.flatnonzero(mask.any(axis=0))
-    r0, c0 = int(some_rows[0]), int(some_cols[0])
-    box = mask[r0 : some_rows[-1] + 1, c0 : some_cols[-1] + 1]
-    labels, n = ndimage.label(box, CROSS)
-    # Every blob's pixels in one pass, each blob's in the frame's row-major order.
-    rows, cols = np.nonzero(box)
-    label = labels[rows, cols]
-    if n > 1:
-        order = np.argsort(label, kind="stable")
-        rows, cols = rows[order], cols[order]
-    rows += r0
-    cols += c0
-    cov = coverage(diff[rows, cols], low, high).astype(np.float64)
-    us = (cols + offset[1]).astype(np.float64)
-    vs = (rows + offset[0]).astype(np.float64)
-    ends = np.cumsum(np.bincount(label, minlength=n + 1)[1:]).tolist()
+    labels, n = ndimage.label(diff[r0:r1, c0:c1] > low, CROSS)
+    scale = np.float32(1.0 / max(high - low, 1e-6))  # as in coverage()
+    u, v, w, starts, sums = _blob_pixels(
+        labels, n, diff, r0, c0, r0 + offset[0], c0 + offset[1], float(low), scale, float(min_area)
+    )
     out = []
-    for a, b in zip([0, *ends[:-1]], ends, strict=True):
-        w = cov[a:b]
-        if w.sum() < min_area:
-            continue
-        u, v = us[a:b], vs[a:b]
-        blob = blob_from_pixels(u, v, w)
-        if blob is not None:
-            out.append((blob, u, v, w))
+    ends = starts.tolist()
+    for label, (total, *moments) in enumerate(sums.tolist()):
+        if total > 0:
+            a, b = ends[label], ends[label + 1]
+            blob = _blob_of_moments(total, *moments, b - a)
+            out.append((blob, u[a:b], v[a:b], w[a:b]))
     out.sort(key=lambda b: -b[0].area)
     return out
+
+
+@jit
+def _extent(diff, low):  # type: ignore[no-untyped-def]
+    """The bounding box ``(r0, r1, c0, c1)`` of the pixels of ``diff`` above ``low``, compared
+    in float64 (``r0 == r1`` when there are none)."""
+    h, w = diff.shape
+    # Or-ed along rows and columns without a branch, so that the loop is vectorised.
+    cols = np.zeros(w, np.uint8)
+    r0, r1 = h, 0
+    for i in range(h):
+        row = np.uint8(0)
+        for j in range(w):
+            above = np.uint8(diff[i, j] > low)
+            cols[j] |= above
+            row |= above
+        if row:
+            r0, r1 = min(r0, i), i + 1
+    c0, c1 = w, 0
+    for j in range(w):
+        if cols[j]:
+            c0, c1 = min(c0, j), j + 1
+    if r1 == 0:
+        return 0, 0, 0, 0
+    return r0, r1, c0, c1
+
+
+@jit
+def _blob_pixels(  # type: ignore[no-untyped-def]
+    labels, n, diff, r0, c0, row0, col0, low, scale, min_area
+):
+    """:func:`find_blobs`' work after labelling, in one call: from ``labels``
+    (:func:`scipy.ndimage.label` of ``diff[r0:, c0:]``'s pixels above ``low``, ``n`` blobs, its
+    top-left pixel the frame's ``(row0, col0)``), the pixels' ``u``, ``v`` (frame px) and
+    coverage (:func:`coverage`, ``scale`` its factor), blob after blob, each in row-major order;
+    each blob's first pixel (``n + 1`` starts, the last the end); and per blob its coverage
+    total, centre and moments for :func:`_blob_of_moments` (zeros for a blob covering less than
+    ``min_area``).
+
+    The sums are :func:`blob_from_pixels`': the total is ``w.sum()``'s pairwise summation
+    (blocks of up to 128 summed with 8 accumulators, halved at multiples of 8), each weighted sum
+    ``np.dot``, which calls BLAS as ``w @ u`` does (numba SciPy's, NumPy its own: the same to the
+    bit where both are OpenBLAS and choose the same kernel, as here)."""
+    h, w = labels.shape
+    # The foreground's pixels in row-major order, with their labels and coverage...
+    counts = np.zeros(n + 1, np.intp)
+    rows, cols, label = np.empty(h * w, np.intp), np.empty(h * w, np.intp), np.empty(h * w, np.intp)
+    low32, zero, one = np.float32(low), np.float32(0.0), np.float32(1.0)
+    found = 0
+    for i in range(h):
+        for j in range(w):
+            if labels[i, j]:
+                rows[found], cols[found], label[found] = i, j, labels[i, j]
+                counts[labels[i, j]] += 1
+                found += 1
+    # ... then sorted by label (stable: a counting sort).
+    starts = np.empty(n + 1, np.intp)
+    at = np.empty(n + 1, np.intp)
+    size, largest = 0, 0
+    for k in range(n):
+        starts[k] = at[k + 1] = size
+        size += counts[k + 1]
+        largest = max(largest, counts[k + 1])
+    starts[n] = size
+    us, vs, cov = np.empty(size), np.empty(size), np.empty(size)
+    for f in range(found):
+        k = at[label[f]]
+        at[label[f]] += 1
+        i, j = rows[f], cols[f]
+        us[k], vs[k] = np.float64(j + col0), np.float64(i + row0)
+        c = (np.float32(diff[i + r0, j + c0]) - low32) * scale
+        cov[k] = np.float64(min(max(c, zero), one))
+    sums = np.zeros((n, 8))
+    terms = np.empty((5, largest))  # each pixel's terms of the moments
+    # An explicit stack for the pairwise sum's halves (a jitted function cannot recurse here).
+    los, lengths, joins = np.empty(64, np.intp), np.empty(64, np.intp), np.empty(64, np.intp)
+    partial, acc = np.empty(64), np.empty(8)
+    for k in range(n):
+        a, m = starts[k], counts[k + 1]
+        sp, done = 1, 0
+        los[0], lengths[0], joins[0] = a, m, 0
+        while sp:
+            sp -= 1
+            lo, length = los[sp], lengths[sp]
+            if joins[sp]:
+                done -= 1
+                partial[done - 1] += partial[done]
+            elif length < 8:
+                r = 0.0
+                for q in range(lo, lo + length):
+                    r += cov[q]
+                partial[done] = r
+                done += 1
+            elif length <= 128:
+                for e in range(8):  # (assigning a slice took 4 s longer to compile)
+                    acc[e] = cov[lo + e]
+                q = 8
+                while q < length - length % 8:
+                    for e in range(8):
+                        acc[e] += cov[lo + q + e]
+                    q += 8
+                r = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + (
+                    (acc[4] + acc[5]) + (acc[6] + acc[7])
+                )
+                while q < length:
+                    r += cov[lo + q]
+                    q += 1
+                partial[done] = r
+                done += 1
+            else:
+                half = length // 2
+                half -= half % 8
+                los[sp], lengths[sp], joins[sp] = lo, length, 1
+                los[sp + 1], lengths[sp + 1], joins[sp + 1] = lo + half, length - half, 0
+                los[sp + 2], lengths[sp + 2], joins[sp + 2] = lo, half, 0
+                sp += 3
+        total = partial[0]
+        if total < min_area or total <= 0:
+            continue
+        wb, ub, vb = cov[a : a + m], us[a : a + m], vs[a : a + m]
+        cu, cv = np.dot(wb, ub) / total, np.dot(wb, vb) / total
+        for q in range(m):
+            du, dv = ub[q] - cu, vb[q] - cv
+            re, im = du * du - dv * dv, 2 * du * dv
+            terms[0, q], terms[1, q], terms[2, q] = du * du, dv * dv, du * dv
+            terms[3, q], terms[4, q] = re * re - im * im, 2 * re * im
+        sums[k, 0], sums[k, 1], sums[k, 2] = total, cu, cv
+        for e in range(5):
+            sums[k, 3 + e] = np.dot(wb, terms[e, :m])
+    return us, vs, cov, starts, sums
 
 
 def split_pixels(

@@ -79,3 +79,43 @@ def test_a_long_body_seen_obliquely_is_measured_on_the_plane() -> None:
     # Taken in the image and mapped, the centre is 33 cm off (the near end looks bigger).
     naive = cal.to_scene(blob_from_pixels(u, v, w).centre)
     assert np.hypot(*(naive - [2.0, 1.5])) > 0.03
+
+
+def test_blobs_pixels_and_moments_are_numpys() -> None:
+    """The compiled pass after labelling gives what NumPy gives: each blob's pixels in
+    row-major order with :func:`coverage`, blobs in label order then by area, small ones
+    dropped, and :func:`blob_from_pixels`' moments."""
+    from scipy import ndimage
+
+    from physbench.video.detect import CROSS, blob_from_pixels, coverage
+
+    rng = np.random.default_rng(3)
+    img = np.zeros((70, 90))
+    for u, v, r in [(25.3, 30.1, 18.0), (70.2, 20.4, 6.0), (68.0, 55.0, 9.5)]:
+        disc(img, u, v, r)
+    specks = img + 25 * rng.random(img.shape)  # just above the threshold: blobs to drop
+    # One blob of 6,300 px, most of them covered by 1e-8: summed in another order than
+    # w.sum()'s, its area differs (by 4e-12).
+    faint = img + 20 + 1e-4 * rng.random(img.shape)
+    for diff in (specks, np.minimum(specks, 255).astype(np.uint8), faint):
+        labels, n = ndimage.label(diff > 20.0, CROSS)
+        want = []
+        for label in range(1, n + 1):
+            rows, cols = np.nonzero(labels == label)
+            w = coverage(diff[rows, cols], 20.0, 250.0).astype(np.float64)
+            if w.sum() >= 3.0:
+                u, v = (cols + 9).astype(np.float64), (rows + 4).astype(np.float64)
+                want.append((blob_from_pixels(u, v, w), u, v, w))
+        want.sort(key=lambda b: -b[0].area)
+        got = find_blobs(diff, 20.0, 250.0, offset=(4, 9), min_area=3.0)
+        assert len(got) == len(want) == (1 if diff is faint else 3)
+        assert n == 1 if diff is faint else n > 400  # hundreds of specks dropped
+        for (blob, *pixels), (ref, *ref_pixels) in zip(got, want, strict=True):
+            for a, b in zip(pixels, ref_pixels, strict=True):
+                assert a.dtype == np.float64 and np.array_equal(a, b)
+            assert blob.area == ref.area and blob.count == ref.count  # the same pairwise sum
+            # The moments are BLAS dot products (NumPy's and SciPy's BLAS may differ in the
+            # last bits).
+            for field in ("u", "v", "axis", "elongation", "square"):
+                got_, want_ = getattr(blob, field), getattr(ref, field)
+                assert math.isclose(got_, want_, rel_tol=1e-9, abs_tol=1e-9)
