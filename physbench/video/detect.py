@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import ndimage
 
-from physbench.video.compiled import jit
+from physbench.video.compiled import jit, pairwise_sum
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -191,10 +191,9 @@ def _blob_pixels(  # type: ignore[no-untyped-def]
     total, centre and moments for :func:`_blob_of_moments` (zeros for a blob covering less than
     ``min_area``).
 
-    The sums are :func:`blob_from_pixels`': the total is ``w.sum()``'s pairwise summation
-    (blocks of up to 128 summed with 8 accumulators, halved at multiples of 8), each weighted sum
-    ``np.dot``, which calls BLAS as ``w @ u`` does (numba SciPy's, NumPy its own: the same to the
-    bit where both are OpenBLAS and choose the same kernel, as here)."""
+    The sums are :func:`blob_from_pixels`': the total is ``w.sum()``'s (``pairwise_sum``), each
+    weighted sum ``np.dot``, which calls BLAS as ``w @ u`` does (numba SciPy's, NumPy its own:
+    the same to the bit where both are OpenBLAS and choose the same kernel, as here)."""
     h, w = labels.shape
     # The foreground's pixels in row-major order, with their labels and coverage...
     counts = np.zeros(n + 1, np.intp)
@@ -226,49 +225,9 @@ def _blob_pixels(  # type: ignore[no-untyped-def]
         cov[k] = np.float64(min(max(c, zero), one))
     sums = np.zeros((n, 8))
     terms = np.empty((5, largest))  # each pixel's terms of the moments
-    # An explicit stack for the pairwise sum's halves (a jitted function cannot recurse here).
-    los, lengths, joins = np.empty(64, np.intp), np.empty(64, np.intp), np.empty(64, np.intp)
-    partial, acc = np.empty(64), np.empty(8)
     for k in range(n):
         a, m = starts[k], counts[k + 1]
-        sp, done = 1, 0
-        los[0], lengths[0], joins[0] = a, m, 0
-        while sp:
-            sp -= 1
-            lo, length = los[sp], lengths[sp]
-            if joins[sp]:
-                done -= 1
-                partial[done - 1] += partial[done]
-            elif length < 8:
-                r = 0.0
-                for q in range(lo, lo + length):
-                    r += cov[q]
-                partial[done] = r
-                done += 1
-            elif length <= 128:
-                for e in range(8):  # (assigning a slice took 4 s longer to compile)
-                    acc[e] = cov[lo + e]
-                q = 8
-                while q < length - length % 8:
-                    for e in range(8):
-                        acc[e] += cov[lo + q + e]
-                    q += 8
-                r = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + (
-                    (acc[4] + acc[5]) + (acc[6] + acc[7])
-                )
-                while q < length:
-                    r += cov[lo + q]
-                    q += 1
-                partial[done] = r
-                done += 1
-            else:
-                half = length // 2
-                half -= half % 8
-                los[sp], lengths[sp], joins[sp] = lo, length, 1
-                los[sp + 1], lengths[sp + 1], joins[sp + 1] = lo + half, length - half, 0
-                los[sp + 2], lengths[sp + 2], joins[sp + 2] = lo, half, 0
-                sp += 3
-        total = partial[0]
+        total = pairwise_sum(cov, a, m)
         if total < min_area or total <= 0:
             continue
         wb, ub, vb = cov[a : a + m], us[a : a + m], vs[a : a + m]
