@@ -3,12 +3,12 @@
 A pixel's *coverage* is how much of it a body covers, estimated from the difference to the
 background: ``(diff - low) / (high - low)`` clipped to ``[0, 1]``, with ``high`` about half the
 bodies' contrast and ``low`` above the noise. Blobs are the connected pixels above ``low``
-(:func:`scipy.ndimage.label`); a blob's centre is the coverage-weighted mean of its pixels, so a
-partly covered edge pixel counts in part and the centre moves smoothly with the body (and, under
-motion blur, sits at the middle of the smear: the body's pose at mid-exposure, for a body that
-does not turn much during the exposure; a fast-swinging arm's centre is biased towards where it
-stays longest). What the tracker records is measured on the scene's plane
-(:func:`plane_pose`): the centroid and axes of the pixels mapped into metres.
+(:func:`label`, numbered as :func:`scipy.ndimage.label` numbers them); a blob's centre is the
+coverage-weighted mean of its pixels, so a partly covered edge pixel counts in part and the centre
+moves smoothly with the body (and, under motion blur, sits at the middle of the smear: the body's
+pose at mid-exposure, for a body that does not turn much during the exposure; a fast-swinging arm's
+centre is biased towards where it stays longest). What the tracker records is measured on the
+scene's plane (:func:`plane_pose`): the centroid and axes of the pixels mapped into metres.
 
 Orientation comes from moments: the second moments give a blob's long axis (``symmetry=2``, for an
 elongated body), the fourth-order angular moment a square's sides (``symmetry=4``). Where one blob
@@ -138,20 +138,69 @@ def find_blobs(
     r0, r1, c0, c1 = _extent(diff, float(low))
     if r0 == r1:
         return []
-    labels, n = ndimage.label(diff[r0:r1, c0:c1] > low, CROSS)
+    labels, n = label(diff[r0:r1, c0:c1] > low)
     scale = np.float32(1.0 / max(high - low, 1e-6))  # as in coverage()
     u, v, w, starts, sums = _blob_pixels(
         labels, n, diff, r0, c0, r0 + offset[0], c0 + offset[1], float(low), scale, float(min_area)
     )
     out = []
     ends = starts.tolist()
-    for label, (total, *moments) in enumerate(sums.tolist()):
+    for k, (total, *moments) in enumerate(sums.tolist()):
         if total > 0:
-            a, b = ends[label], ends[label + 1]
+            a, b = ends[k], ends[k + 1]
             blob = _blob_of_moments(total, *moments, b - a)
             out.append((blob, u[a:b], v[a:b], w[a:b]))
     out.sort(key=lambda b: -b[0].area)
     return out
+
+
+@jit
+def label(mask):  # type: ignore[no-untyped-def]
+    """The 4-connected blobs of ``mask`` (bool ``(H, W)``): int32 labels ``(H, W)`` (0 off the
+    blobs) and their count, numbered in the order of their first pixels row by row, as
+    :func:`scipy.ndimage.label` with :data:`CROSS` numbers them. One pass with a union-find
+    over the blobs' provisional labels: scipy's own costs about 45 us a call before any pixel
+    (63-78 us on the tracker's windows' foreground boxes, against 19-24 us)."""
+    h, w = mask.shape
+    labels = np.zeros((h, w), np.int32)
+    parent = np.empty((h * w + 1) // 2 + 2, np.int32)  # at most a checkerboard's
+    made = 1
+    for i in range(h):
+        for j in range(w):
+            if not mask[i, j]:
+                continue
+            up = labels[i - 1, j] if i else 0
+            left = labels[i, j - 1] if j else 0
+            if up and left:
+                a, b = up, left
+                while parent[a] != a:
+                    a = parent[a]
+                while parent[b] != b:
+                    b = parent[b]
+                root = min(a, b)  # the first in row order
+                parent[a] = parent[b] = parent[up] = parent[left] = root
+                labels[i, j] = root
+            elif up or left:
+                labels[i, j] = up or left
+            else:
+                parent[made] = made
+                labels[i, j] = made
+                made += 1
+    final = np.zeros(made, np.int32)
+    n = 0
+    for k in range(1, made):
+        root = k
+        while parent[root] != root:
+            root = parent[root]
+        if root == k:
+            n += 1
+            final[k] = n
+        else:
+            final[k] = final[root]
+    for i in range(h):
+        for j in range(w):
+            labels[i, j] = final[labels[i, j]]
+    return labels, n
 
 
 @jit
@@ -184,7 +233,7 @@ def _blob_pixels(  # type: ignore[no-untyped-def]
     labels, n, diff, r0, c0, row0, col0, low, scale, min_area
 ):
     """:func:`find_blobs`' work after labelling, in one call: from ``labels``
-    (:func:`scipy.ndimage.label` of ``diff[r0:, c0:]``'s pixels above ``low``, ``n`` blobs, its
+    (:func:`label` of ``diff[r0:, c0:]``'s pixels above ``low``, ``n`` blobs, its
     top-left pixel the frame's ``(row0, col0)``), the pixels' ``u``, ``v`` (frame px) and
     coverage (:func:`coverage`, ``scale`` its factor), blob after blob, each in row-major order;
     each blob's first pixel (``n + 1`` starts, the last the end); and per blob its coverage

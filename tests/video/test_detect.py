@@ -119,3 +119,22 @@ def test_blobs_pixels_and_moments_are_numpys() -> None:
             for field in ("u", "v", "axis", "elongation", "square"):
                 got_, want_ = getattr(blob, field), getattr(ref, field)
                 assert math.isclose(got_, want_, rel_tol=1e-9, abs_tol=1e-9)
+
+
+def test_blobs_are_labelled_as_scipy_labels_them() -> None:
+    from scipy import ndimage
+
+    from physbench.video.detect import CROSS, label
+
+    rng = np.random.default_rng(5)
+    shapes = [(1, 1), (1, 9), (9, 1), (2, 2), (40, 31), (64, 64)]
+    for k in range(600):
+        h, w = shapes[k % len(shapes)] if k < 60 else rng.integers(1, 70, 2)
+        mask = rng.random((h, w)) < rng.random()
+        if k % 7 == 0:  # a spiral and a comb: blobs joined late in the scan
+            mask = np.zeros((h, w), bool)
+            mask[::2] = True
+            mask[:, :: max(1, w - 1)] = True
+        want, n = ndimage.label(mask, CROSS)
+        got, m = label(mask)
+        assert m == n and np.array_equal(got, want), (h, w)
