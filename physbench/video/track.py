@@ -1197,7 +1197,7 @@ class Tracker:
             pixels = None
             if own is not None and w[own].sum() >= 0.2 * expected:
                 u, v, w = pixels = u[own], v[own], w[own]
-            c = self._shift(u, v, w, pred, r)
+            c = _mean_shift(u, v, w, pred, r)
             rays = Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0)
             return _Plan(rays, mpp, expected, s.radius_m, pixels)
         return _Plan(Rays(c, r, 1.25 * r + 0.5 * s.step + 3.0), mpp, expected, s.radius_m)
@@ -1336,28 +1336,6 @@ class Tracker:
         look = self._look(i, area, raw, None, mpp=plan.mpp, median=True)
         radius = None if fit.fixed else fit.radius
         return _Found(fit.xy, fit.uv, PlanePose(fit.xy, 0.0, 1.0, 0.0), look, radius)
-
-    @staticmethod
-    def _shift(
-        u: np.ndarray, v: np.ndarray, w: np.ndarray, pred: np.ndarray, r: float
-    ) -> np.ndarray:
-        """The middle of the disc of radius ``r`` (px) nearest ``pred`` among pixels ``(u, v)``
-        of coverage ``w``: a mean shift from the pixel nearest ``pred``."""
-        d2 = (u - pred[0]) ** 2 + (v - pred[1]) ** 2
-        k = int(np.argmin(d2))
-        c = pred.copy() if d2[k] <= r * r else np.array([u[k], v[k]])
-        for _ in range(6):
-            sel = (u - c[0]) ** 2 + (v - c[1]) ** 2 <= r * r
-            ws = w[sel]
-            total = ws.sum()
-            if total <= 0:
-                break
-            new = np.array([ws @ u[sel], ws @ v[sel]]) / total
-            moved = float(np.hypot(*(new - c)))
-            c = new
-            if moved < 0.1:
-                break
-        return c
 
     def _mpp(self, uv: np.ndarray) -> float:
         """Metres per pixel near ``uv``, from a cache of 16 px cells."""
@@ -1782,6 +1760,38 @@ def _project(colour: np.ndarray, behind: np.ndarray, body: np.ndarray) -> np.nda
     span = body - behind
     norm = np.einsum("ij,ij->i", span, span)
     return np.einsum("ij,ij->i", colour - behind, span) / np.maximum(norm, 1.0)
+
+
+@jit
+def _mean_shift(u, v, w, pred, r):  # type: ignore[no-untyped-def]
+    """The middle of the disc of radius ``r`` (px) nearest ``pred`` among pixels ``(u, v)`` of
+    coverage ``w``: a mean shift from the pixel nearest ``pred`` (at most 6 steps, until one
+    moves under 0.1 px)."""
+    n = len(u)
+    if n == 0:
+        return pred.copy()
+    k, least = 0, np.inf
+    for p in range(n):
+        d2 = (u[p] - pred[0]) ** 2 + (v[p] - pred[1]) ** 2
+        if d2 < least:
+            k, least = p, d2
+    c = pred.copy() if least <= r * r else np.array([u[k], v[k]])
+    ws, us, vs = np.empty(n), np.empty(n), np.empty(n)
+    for _ in range(6):
+        m = 0
+        for p in range(n):
+            if (u[p] - c[0]) ** 2 + (v[p] - c[1]) ** 2 <= r * r:
+                ws[m], us[m], vs[m] = w[p], u[p], v[p]
+                m += 1
+        total = pairwise_sum(ws, 0, m)
+        if total <= 0:
+            break
+        new = np.array([np.dot(ws[:m], us[:m]), np.dot(ws[:m], vs[:m])]) / total
+        moved = np.hypot(new[0] - c[0], new[1] - c[1])
+        c = new
+        if moved < 0.1:
+            break
+    return c
 
 
 @jit
