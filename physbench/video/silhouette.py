@@ -654,8 +654,8 @@ def _stadium_fits(  # type: ignore[no-untyped-def]
     and ``rms`` where a disc's circle leaves :data:`STADIUM_RMS` and it is ``moving`` (``along``:
     its direction): the stadium along it, or where that fits worse than the circle (a bounce has
     turned it since), along the best of ``turned``, if any fits better than the circle. Returns
-    the discs left to :func:`_smear` (those whose equations were ill-conditioned) and which
-    discs' fits are good (as :func:`_good`).
+    the discs left to :func:`_smear` (those whose equations were ill-conditioned) and those whose
+    fits are good (as :func:`_good`).
 
     The stadium's centre, half length and radius by weighted Gauss-Newton on the edges'
     distances to it, twice, dropping edges off it by more than 3 robust deviations. The NumPy
@@ -786,7 +786,7 @@ def _stadium_fits(  # type: ignore[no-untyped-def]
     for d in range(len(r)):
         good[d] = kept[d] >= 6 and (gaps[d] <= MAX_ARC_GAP or fixed[d]) and abs(r[d]) < math.inf
         good[d] &= 0.5 * radius[d] * mpp[d] <= r[d] and r[d] <= 2.5 * radius[d] * mpp[d]
-    return redo, good
+    return np.nonzero(redo)[0], np.nonzero(good)[0]
 
 
 def _good(
@@ -917,33 +917,31 @@ def fit_discs(
         moving,
         along,
     )
-    chosen, dropped = _chosen(
-        edges.owner, edges.reach, halo, radius, flagged, np.ones(count, dtype=bool)
-    )
+    chosen, dropped = _chosen(edges.owner, edges.reach, halo, radius, flagged, False)
     fits = _fit_discs(chosen, *common)
-    failed = np.array([fit is None for fit in fits])
-    if dropped and failed.any():  # each disc is fitted on its own edges: refit only those
-        chosen, _ = _chosen(
-            edges.owner, edges.reach, halo, radius, np.zeros(count, dtype=bool), failed
+    if dropped and None in fits:  # each disc is fitted on its own edges: refit only those
+        failed = np.array([fit is None for fit in fits])
+        again = _fit_discs(
+            _chosen(edges.owner, edges.reach, halo, radius, failed, True)[0], *common
         )
-        again = _fit_discs(chosen, *common)
         for d in np.nonzero(failed)[0]:
             fits[d] = again[d]
     return fits
 
 
 @jit
-def _chosen(owner, reach, halo, radius, flagged, discs):  # type: ignore[no-untyped-def]
-    """The edges of ``discs`` (a mask) that :func:`fit_discs` fits to: those at least half the
-    radius from the rays' origin, less the :data:`HALO` edges of discs ``flagged`` for them; and
-    whether any such halo is left out."""
+def _chosen(owner, reach, halo, radius, discs, again):  # type: ignore[no-untyped-def]
+    """The edges that :func:`fit_discs` fits to, those at least half the radius from the rays'
+    origin: of every disc, less the :data:`HALO` edges of ``discs`` (a mask); or ``again``, only
+    those of ``discs``, halos and all. And whether any halo is left out."""
     chosen, count, dropped = np.empty(len(owner), np.intp), 0, False
     for i in range(len(owner)):
         d = owner[i]
         if d < 0 or d >= len(radius):
             raise IndexError("an edge's owner is not one of the discs")
-        dropped |= halo[i] and flagged[d]
-        if discs[d] and reach[i] >= 0.5 * radius[d] and not (halo[i] and flagged[d]):
+        out = (not discs[d]) if again else halo[i] and discs[d]
+        dropped |= out and not again
+        if reach[i] >= 0.5 * radius[d] and not out:
             chosen[count] = i
             count += 1
     return chosen[:count], dropped
@@ -996,26 +994,20 @@ def _fit_discs(
         moving,
         _TURNED,
     )
-    if redo.any():
+    if len(redo):
         assert along is not None
-        for d in np.nonzero(redo)[0]:
+        for d in redo:
             mine = slice(starts[d], starts[d] + sizes[d])
             smear = _smear(xy[mine], weight[mine], centre[d], r[d], along[d], rms[d], mpp[d])
             if smear is not None:
                 centre[d], r[d], rms[d], kept[d] = smear
-        good = _good(kept, gaps, fixed, r, radius, mpp)
+        good = np.nonzero(_good(kept, gaps, fixed, r, radius, mpp))[0]
     fits: list[DiscFit | None] = [None] * count
-    if good.any():
+    if len(good):
         uv = calibration.to_image(centre[good])
-        for k, d in enumerate(np.nonzero(good)[0].tolist()):
-            fits[d] = DiscFit(
-                centre[d],
-                uv[k],
-                float(r[d]),
-                float(kept[d] / sizes[d]),
-                float(rms[d]),
-                bool(fixed[d]),
-            )
+        rl, kl, nl, sl, fl = r.tolist(), kept.tolist(), sizes.tolist(), rms.tolist(), fixed.tolist()
+        for k, d in enumerate(good.tolist()):
+            fits[d] = DiscFit(centre[d], uv[k], rl[d], kl[d] / nl[d], sl[d], fl[d])
     return fits
 
 
