@@ -310,21 +310,20 @@ _TURNED = np.array([[math.cos(a), math.sin(a)] for a in np.arange(0.0, math.pi, 
 
 @jit
 def _circle_fits(  # type: ignore[no-untyped-def]
-    xy, chosen, owner, angle, strength, spread, radius, mpp, known, has_known
+    xy, chosen, owner, angle, strength, spread, radius, mpp, has_known
 ):
     """:func:`fit_discs`' circles: each disc's fitted robustly to its ``chosen`` edges (their
     points ``xy`` on the plane; :class:`Edges`' ``owner``, increasing, ``theta``, ``contrast``
-    and ``width`` as ``owner``, ``angle``, ``strength`` and ``spread``), and to the radius
-    ``known`` (where ``has_known``) where too little of its outline is kept. Returns the centres
-    ``(count, 2)``, radii, each edge's weight, the kept counts, the largest angle between
-    neighbouring kept rays (``theta``), whether each radius is the known one, the RMS distances
-    (px) of the kept edges, and each disc's edge count and first edge.
+    and ``width`` as ``owner``, ``angle``, ``strength`` and ``spread``). Returns the centres
+    ``(count, 2)`` and radii (m), each edge's weight and whether it is kept, the kept counts,
+    the largest angle between neighbouring kept rays, the discs seen over too little of their
+    outline to fit their radius whose radius is known from earlier frames (``has_known``; for
+    :func:`_circle_of_radius`), and each disc's edge count and first edge.
 
     As the NumPy expressions it replaces, to the bit: the normal equations are summed as
-    ``np.add.reduceat`` sums (pairwise) and solved as OpenBLAS's LAPACK ``dgesv`` solves them
-    (left-looking LU, partial pivoting, the pivot's reciprocal scaling its column); the known
-    radius's Gauss-Newton sums as its BLAS sums them (``gemm``: a fused multiply-add a term,
-    emulated exactly; ``gemv``: four at a time)."""
+    ``np.add.reduceat`` sums them (pairwise) and solved as OpenBLAS's LAPACK ``dgesv`` solves
+    them (left-looking LU, partial pivoting, the pivot's reciprocal scaling its column, no
+    fused products)."""
     count, n = len(radius), len(chosen)
     own, theta = np.empty(n, np.intp), np.empty(n)
     contrast, width = np.empty(n), np.empty(n)
@@ -559,103 +558,38 @@ def _circle_fits(  # type: ignore[no-untyped-def]
                 if not (gaps[own[i]] >= gap or gaps[own[i]] != gaps[own[i]]):
                     gaps[own[i]] = gap
             before = i
-    # Too little of the outline to fit its radius: the circle of the radius known from earlier
-    # frames, fitted to the kept edges' distances by Gauss-Newton.
-    fixed = np.zeros(count, np.bool_)
-    ju, jv, jr, acc = np.empty(n), np.empty(n), np.empty(n), np.empty(4)
+    short = np.zeros(count, np.bool_)  # to be fitted with their known radius
     for d in range(count):
-        if not (gaps[d] > MAX_ARC_GAP and kept[d] >= 6 and has_known[d]):
-            continue
-        if not gaps[d] <= 2 * math.pi - MIN_ARC:
-            continue
-        cu, cv, rk = centre[d, 0], centre[d, 1], known[d]
-        for _ in range(8):
-            m = 0
-            for e in range(4):
-                acc[e] = 0.0
-            for i in range(starts[d], starts[d] + sizes[d]):
-                if not keep[i]:
-                    continue
-                du, dv = xy[i, 0] - cu, xy[i, 1] - cv
-                h = math.hypot(du, dv)
-                h = h if h >= 1e-12 or h != h else 1e-12
-                ju[m], jv[m], jr[m] = -du / h * weight[i], -dv / h * weight[i], h - rk
-                for e in range(4):  # J^T W J += x y, one rounding (x y + z emulated exactly)
-                    x, y, z = ju[m] if e < 2 else jv[m], -du / h if e % 2 == 0 else -dv / h, acc[e]
-                    p = x * y
-                    big = 134217729.0 * x  # Dekker's split: p + lo is x y exactly
-                    xh = big - (big - x)
-                    big = 134217729.0 * y
-                    yh = big - (big - y)
-                    lo = ((xh * yh - p) + xh * (y - yh) + (x - xh) * yh) + (x - xh) * (y - yh)
-                    s = z + p
-                    b = s - z
-                    t = (z - (s - b)) + (p - b)
-                    v = t + lo
-                    b = v - t
-                    low = (t - (v - b)) + (lo - b)  # v rounded to odd: the last rounding counts
-                    if low != 0.0:
-                        fraction, exponent = math.frexp(v)
-                        if not int(math.ldexp(fraction, 53)) & 1:  # even: step to the odd neighbour
-                            ulp = math.ldexp(1.0, exponent - 53)
-                            if (low > 0.0) != (v > 0.0) and abs(fraction) == 0.5:
-                                ulp *= 0.5  # below a power of two
-                            v += ulp if low > 0.0 else -ulp
-                    acc[e] = s + v
-                m += 1
-            g0, g1, k = 0.0, 0.0, 0
-            while k < m - m % 4:  # J^T W r
-                g0 += ju[k] * jr[k] + ju[k + 1] * jr[k + 1]
-                g1 += jv[k] * jr[k] + jv[k + 1] * jr[k + 1]
-                g0 += ju[k + 2] * jr[k + 2] + ju[k + 3] * jr[k + 3]
-                g1 += jv[k + 2] * jr[k + 2] + jv[k + 3] * jr[k + 3]
-                k += 4
-            for q in range(k, m):
-                g0 += ju[q] * jr[q]
-                g1 += jv[q] * jr[q]
-            m00, m01, m10, m11, b0, b1 = (
-                acc[0] + 1e-12,
-                acc[1] + 0.0,
-                acc[2] + 0.0,
-                acc[3] + 1e-12,
-                -g0,
-                -g1,
-            )
-            if abs(m10) > abs(m00):  # dgesv's 2 x 2: the larger pivot
-                m00, m01, m10, m11, b0, b1 = m10, m11, m00, m01, b1, b0
-            if m00 == 0.0:
-                break
-            ell = m10 * (1.0 / m00)
-            m11 -= ell * m01
-            if m11 == 0.0:
-                break
-            b1 = (b1 + -b0 * ell) / m11
-            b0 = (b0 + -b1 * m01) / m00
-            cu, cv = cu + b0, cv + b1
-            if math.hypot(b0, b1) < 1e-6 * rk:
-                break
-        centre[d, 0], centre[d, 1], r[d], fixed[d] = cu, cv, rk, True
-    rms = np.zeros(count)
-    for i in range(n):
-        if keep[i]:
-            d = own[i]
-            q = math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1]) - r[d]
-            rms[d] += q * q
-    for d in range(count):
-        rms[d] = math.sqrt(rms[d] / max(kept[d], 1.0)) / mpp[d]
-    return centre, r, weight, kept, gaps, fixed, rms, sizes, starts
+        short[d] = gaps[d] > MAX_ARC_GAP and kept[d] >= 6 and has_known[d]
+        short[d] &= gaps[d] <= 2 * math.pi - MIN_ARC
+    return centre, r, weight, keep, kept, gaps, np.nonzero(short)[0], sizes, starts
 
 
 @jit
 def _stadium_fits(  # type: ignore[no-untyped-def]
-    xy, weight, starts, sizes, centre, r, kept, gaps, fixed, rms, radius, mpp, along, moving, turned
+    xy,
+    weight,
+    keep,
+    starts,
+    sizes,
+    centre,
+    r,
+    kept,
+    gaps,
+    fixed,
+    radius,
+    mpp,
+    along,
+    moving,
+    turned,
 ):
-    """:func:`fit_discs`' smears, in place of :func:`_circle_fits`' ``centre``, ``r``, ``kept``
-    and ``rms`` where a disc's circle leaves :data:`STADIUM_RMS` and it is ``moving`` (``along``:
-    its direction): the stadium along it, or where that fits worse than the circle (a bounce has
-    turned it since), along the best of ``turned``, if any fits better than the circle. Returns
-    the discs left to :func:`_smear` (those whose equations were ill-conditioned) and those whose
-    fits are good (as :func:`_good`).
+    """:func:`fit_discs`' smears: each circle's RMS distance (px) from its ``keep`` edges; then,
+    in place of ``centre``, ``r`` and ``kept``, where a disc's circle leaves :data:`STADIUM_RMS`
+    and it is ``moving`` (``along``: its direction), the stadium along it, or where that fits
+    worse than the circle (a bounce has turned it since), along the best of ``turned``, if any
+    fits better than the circle. Returns the RMS distances, the discs left to :func:`_smear`
+    (those whose equations were ill-conditioned) and those whose fits are good (as
+    :func:`_good`).
 
     The stadium's centre, half length and radius by weighted Gauss-Newton on the edges'
     distances to it, twice, dropping edges off it by more than 3 robust deviations. The NumPy
@@ -666,6 +600,13 @@ def _stadium_fits(  # type: ignore[no-untyped-def]
     (edges at one end of the smear only, at neither, or along one side only): there the two
     solvers' rounding, amplified by 1e12, moved centres by up to 0.003 px; such a disc (a pivot
     under 1e-7 of the largest) is left to :func:`_smear`, which fits it as NumPy did."""
+    rms = np.zeros(len(r))
+    for d in range(len(r)):
+        for i in range(starts[d], starts[d] + sizes[d]):
+            if keep[i]:
+                q = math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1]) - r[d]
+                rms[d] += q * q
+        rms[d] = math.sqrt(rms[d] / max(kept[d], 1.0)) / mpp[d]
     lu, rhs, res, ranked = np.empty((4, 4)), np.empty(4), np.empty(len(xy)), np.empty(len(xy))
     inner, best = np.empty(len(xy), np.bool_), np.empty(len(xy), np.bool_)
     redo = np.zeros(len(r), np.bool_)
@@ -786,7 +727,7 @@ def _stadium_fits(  # type: ignore[no-untyped-def]
     for d in range(len(r)):
         good[d] = kept[d] >= 6 and (gaps[d] <= MAX_ARC_GAP or fixed[d]) and abs(r[d]) < math.inf
         good[d] &= 0.5 * radius[d] * mpp[d] <= r[d] and r[d] <= 2.5 * radius[d] * mpp[d]
-    return np.nonzero(redo)[0], np.nonzero(good)[0]
+    return rms, np.nonzero(redo)[0], np.nonzero(good)[0]
 
 
 def _good(
@@ -801,6 +742,25 @@ def _good(
     radius), and a radius (m) of about the disc's (``radius`` px)."""
     good = (kept >= 6) & ((gaps <= MAX_ARC_GAP) | fixed) & np.isfinite(r)
     return good & (0.5 * radius * mpp <= r) & (r <= 2.5 * radius * mpp)
+
+
+def _circle_of_radius(
+    xy: np.ndarray, weight: np.ndarray, start: np.ndarray, r: float
+) -> np.ndarray:
+    """The centre of the circle of radius ``r`` through ``xy`` (weighted least squares on the
+    distances to it, Gauss-Newton from ``start``)."""
+    c = np.asarray(start, dtype=float).copy()
+    for _ in range(8):
+        d = xy - c
+        dist = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-12)
+        jac = -d / dist[:, None]
+        res = dist - r
+        jw = jac * weight[:, None]
+        step = np.linalg.solve(jw.T @ jac + 1e-12 * np.eye(2), -(jw.T @ res))
+        c += step
+        if float(np.hypot(*step)) < 1e-6 * r:
+            break
+    return c
 
 
 def _smear(
@@ -965,21 +925,19 @@ def _fit_discs(
     if not len(chosen):
         return [None] * count
     xy = calibration.to_scene(edges.uv[chosen])
-    centre, r, weight, kept, gaps, fixed, rms, sizes, starts = _circle_fits(
-        xy,
-        chosen,
-        edges.owner,
-        edges.theta,
-        edges.contrast,
-        edges.width,
-        radius,
-        mpp,
-        known,
-        has_known,
+    centre, r, weight, keep, kept, gaps, short, sizes, starts = _circle_fits(
+        xy, chosen, edges.owner, edges.theta, edges.contrast, edges.width, radius, mpp, has_known
     )
-    redo, good = _stadium_fits(
+    fixed = np.zeros(count, dtype=bool)
+    for d in short:  # too little of the outline: the radius known from earlier frames
+        mine = slice(starts[d], starts[d] + sizes[d])
+        on = keep[mine]
+        centre[d] = _circle_of_radius(xy[mine][on], weight[mine][on], centre[d], known[d])
+        r[d], fixed[d] = known[d], True
+    rms, redo, good = _stadium_fits(
         xy,
         weight,
+        keep,
         starts,
         sizes,
         centre,
@@ -987,7 +945,6 @@ def _fit_discs(
         kept,
         gaps,
         fixed,
-        rms,
         radius,
         mpp,
         way,
