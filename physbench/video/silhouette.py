@@ -303,81 +303,445 @@ def _ray_edges(flat, base, shape, origin, discs, directions, low):  # type: igno
             kept[:count], halo[:count])  # fmt: skip
 
 
-@dataclass(frozen=True)
-class _Groups:
-    """Points in ``count`` contiguous groups (``owner`` increasing): each group's ``sizes`` and
-    the index of its first point (``starts``)."""
-
-    owner: np.ndarray
-    count: int
-    sizes: np.ndarray
-    starts: np.ndarray
-
-    @classmethod
-    def of(cls, owner: np.ndarray, count: int) -> _Groups:
-        sizes = np.bincount(owner, minlength=count)
-        return cls(owner, count, sizes, np.cumsum(sizes) - sizes)
-
-    def rank(self, values: np.ndarray) -> np.ndarray:
-        """Each value's rank (0: smallest) within its group."""
-        order = np.lexsort((values, self.owner))
-        rank = np.empty(len(values), dtype=np.intp)
-        rank[order] = np.arange(len(values)) - self.starts[self.owner[order]]
-        return rank
-
-    def median(self, values: np.ndarray) -> np.ndarray:
-        """Each group's (lower) median of ``values`` (inf values sort last); 0 if empty."""
-        order = np.lexsort((values, self.owner))
-        at = np.clip(self.starts + (self.sizes - 1) // 2, 0, len(values) - 1)
-        return np.where(self.sizes > 0, values[order][at], 0.0)
-
-    def total(self, values: np.ndarray) -> np.ndarray:
-        return np.bincount(self.owner, values, self.count)
+#: The directions (unit vectors over half a turn, :data:`TURNS` of them) a smear is fitted along
+#: where the track's last direction of motion fits its edges worse than a circle.
+_TURNED = np.array([[math.cos(a), math.sin(a)] for a in np.arange(0.0, math.pi, math.pi / TURNS)])
 
 
-_ROW, _COLUMN = np.repeat(np.arange(3), 4), np.tile(np.arange(4), 3)
-_EYE = np.eye(3)
+@jit
+def _circle_fits(  # type: ignore[no-untyped-def]
+    xy, chosen, owner, angle, strength, spread, radius, mpp, has_known
+):
+    """:func:`fit_discs`' circles: each disc's fitted robustly to its ``chosen`` edges (their
+    points ``xy`` on the plane; :class:`Edges`' ``owner``, increasing, ``theta``, ``contrast``
+    and ``width`` as ``owner``, ``angle``, ``strength`` and ``spread``). Returns the centres
+    ``(count, 2)`` and radii (m), each edge's weight and whether it is kept, the kept counts,
+    the largest angle between neighbouring kept rays, the discs seen over too little of their
+    outline to fit their radius whose radius is known from earlier frames (``has_known``; for
+    :func:`_circle_of_radius`), and each disc's edge count and first edge.
+
+    As the NumPy expressions it replaces, to the bit: the normal equations are summed as
+    ``np.add.reduceat`` sums them (pairwise) and solved as OpenBLAS's LAPACK ``dgesv`` solves
+    them (left-looking LU, partial pivoting, the pivot's reciprocal scaling its column, no
+    fused products)."""
+    count, n = len(radius), len(chosen)
+    own, theta = np.empty(n, np.intp), np.empty(n)
+    contrast, width = np.empty(n), np.empty(n)
+    for i in range(n):
+        own[i], theta[i] = owner[chosen[i]], angle[chosen[i]]
+        contrast[i], width[i] = strength[chosen[i]], spread[chosen[i]]
+    sizes, starts = np.empty(count, np.intp), np.empty(count, np.intp)
+    for d in range(count):
+        sizes[d], starts[d] = 0, 0
+    for i in range(n):
+        sizes[own[i]] += 1
+    for d in range(1, count):
+        starts[d] = starts[d - 1] + sizes[d - 1]
+    top = np.empty(count)
+    for d in range(count):
+        top[d] = 0.0
+    for i in range(n):
+        if contrast[i] > top[own[i]] or contrast[i] != contrast[i]:
+            top[own[i]] = contrast[i]
+    weight, w, keys, dist, res = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    order = np.empty(n, np.intp)
+    trim, keep = np.empty(n, np.bool_), np.empty(n, np.bool_)
+    a, terms, sums = np.empty((n, 4)), np.empty((12, n)), np.empty((count, 12))
+    mean, centre, r = np.zeros((count, 2)), np.empty((count, 2)), np.empty(count)
+    todo, part, lanes = np.empty((64, 3), np.intp), np.empty(64), np.empty(8)
+    lu, rhs, piv = np.empty((3, 3)), np.empty(3), np.empty(3, np.intp)
+    # Stage 0: each disc's mean and median edge width. Then its circle through all its edges;
+    # through the three quarters nearest that circle (least trimmed squares: a highlight's rim
+    # is a tight cluster of edges inside the outline, which a fit to all of them leans to); and
+    # through those within 3 robust deviations (at least 0.75 px) of the second circle and not
+    # inside 70 % of its radius.
+    for stage in range(4):
+        if stage == 0:
+            for i in range(n):
+                keys[i] = width[i]
+        elif stage == 2:
+            for i in range(n):
+                d = own[i]
+                keys[i] = abs(math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1]) - r[d])
+                if keys[i] != keys[i]:
+                    keys[i] = math.inf
+        elif stage == 3:
+            for i in range(n):
+                d = own[i]
+                dist[i] = math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1])
+                res[i] = dist[i] - r[d]
+                keys[i] = abs(res[i]) if trim[i] else math.inf
+        if stage != 1:  # each disc's points ranked by their keys, stably, NaN last (np.lexsort)
+            for i in range(n):
+                order[i] = i
+            for d in range(count):
+                for k in range(starts[d] + 1, starts[d] + sizes[d]):
+                    i, q = order[k], k - 1
+                    while q >= starts[d]:
+                        other = keys[order[q]]
+                        if not (other > keys[i] or (other != other and keys[i] == keys[i])):
+                            break
+                        order[q + 1] = order[q]
+                        q -= 1
+                    order[q + 1] = i
+        if stage == 0:  # weights: contrast against the disc's strongest, sharpness its median's
+            for i in range(n):
+                d = own[i]
+                floor = width[i] if width[i] >= 1e-3 or width[i] != width[i] else 1e-3
+                sharp = keys[order[starts[d] + (sizes[d] - 1) // 2]] / floor
+                if top[d] != 0.0:
+                    share = contrast[i] / (0.5 * top[d])
+                else:
+                    share = (
+                        math.inf if contrast[i] > 0 else -math.inf if contrast[i] < 0 else math.nan
+                    )
+                share = (1.0 if share >= 1.0 else share) * (1.0 if sharp >= 1.0 else sharp)
+                weight[i] = share * share
+                terms[0, i], terms[1, i] = xy[i, 0], xy[i, 1]
+        elif stage == 1:
+            for i in range(n):
+                w[i] = weight[i]
+        elif stage == 2:
+            for d in range(count):
+                for k in range(sizes[d]):
+                    trim[order[starts[d] + k]] = k < max(6, 3 * sizes[d] // 4)
+            for i in range(n):
+                w[i] = weight[i] * (1.0 if trim[i] else 0.0)
+        else:
+            for i in range(n):
+                d = own[i]
+                scale = 1.4826 * keys[order[starts[d] + (sizes[d] - 1) // 2]]
+                bound, least = 3.0 * scale, radius[d] * mpp[d]
+                if not (bound >= 0.75 * mpp[d] or bound != bound):
+                    bound = 0.75 * mpp[d]
+                if r[d] >= least or r[d] != r[d]:
+                    least = r[d]
+                keep[i] = abs(res[i]) <= bound and dist[i] >= 0.7 * least
+                w[i] = weight[i] * (1.0 if keep[i] else 0.0)
+        if stage:
+            for i in range(n):
+                for j in range(3):  # the products a_j w a_k (j < 3, k < 4)
+                    aw = a[i, j] * w[i]
+                    for k in range(4):
+                        terms[4 * j + k, i] = aw * a[i, k]
+        # Each disc's sums of the terms as np.add.reduceat sums: the first term, then the rest
+        # by NumPy's pairwise summation (runs of up to 128 summed in eight lanes; a longer run
+        # split in two, the first a multiple of 8, and the halves' sums added).
+        for d in range(count):
+            for col in range(2 if stage == 0 else 12):
+                if sizes[d] == 0:
+                    continue
+                todo[0, 0], todo[0, 1], todo[0, 2] = starts[d] + 1, sizes[d] - 1, 0
+                top_, depth = 1, 0
+                while top_ > 0:
+                    top_ -= 1
+                    lo, m = todo[top_, 0], todo[top_, 1]
+                    if todo[top_, 2]:  # both halves summed
+                        depth -= 1
+                        part[depth - 1] += part[depth]
+                    elif m > 128:
+                        half = m // 2 - (m // 2) % 8
+                        todo[top_, 0], todo[top_, 1], todo[top_, 2] = 0, 0, 1
+                        todo[top_ + 1, 0], todo[top_ + 1, 1], todo[top_ + 1, 2] = (
+                            lo + half,
+                            m - half,
+                            0,
+                        )
+                        todo[top_ + 2, 0], todo[top_ + 2, 1], todo[top_ + 2, 2] = lo, half, 0
+                        top_ += 3
+                    else:
+                        s = 0.0
+                        if m < 8:
+                            for i in range(lo, lo + m):
+                                s += terms[col, i]
+                        else:
+                            for k in range(8):
+                                lanes[k] = terms[col, lo + k]
+                            k = 8
+                            while k < m - m % 8:
+                                for j in range(8):
+                                    lanes[j] += terms[col, lo + k + j]
+                                k += 8
+                            s = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + (
+                                (lanes[4] + lanes[5]) + (lanes[6] + lanes[7])
+                            )
+                            for i in range(lo + k, lo + m):
+                                s += terms[col, i]
+                        part[depth] = s
+                        depth += 1
+                sums[d, col] = (
+                    terms[col, starts[d]] + part[0] if sizes[d] > 1 else terms[col, starts[d]]
+                )
+        if stage == 0:
+            for d in range(count):
+                if sizes[d]:
+                    mean[d, 0], mean[d, 1] = sums[d, 0] / sizes[d], sums[d, 1] / sizes[d]
+            for i in range(n):
+                a[i, 0], a[i, 1] = xy[i, 0] - mean[own[i], 0], xy[i, 1] - mean[own[i], 1]
+                a[i, 2], a[i, 3] = 1.0, a[i, 0] * a[i, 0] + a[i, 1] * a[i, 1]
+            continue
+        for d in range(count):  # the circle: (2 centre, r^2 - |centre|^2) by the normal equations
+            centre[d, 0], centre[d, 1], r[d] = math.nan, math.nan, math.nan
+            weighted = 0
+            for i in range(starts[d], starts[d] + sizes[d]):
+                if w[i] > 0:
+                    weighted += 1
+            if weighted < 3:
+                continue
+            eps = 1e-12 * ((sums[d, 0] + sums[d, 5]) + sums[d, 10])
+            for j in range(3):
+                rhs[j] = sums[d, 4 * j + 3]
+                for k in range(3):
+                    lu[j, k] = sums[d, 4 * j + k] + eps * (1.0 if j == k else 0.0)
+            singular = False
+            for j in range(3):
+                for i in range(j):  # this column's rows interchanged as the earlier ones were
+                    if piv[i] != i:
+                        lu[i, j], lu[piv[i], j] = lu[piv[i], j], lu[i, j]
+                for i in range(1, 3):  # less the products of the rows above: U above, L below
+                    if min(i, j):
+                        dot = 0.0
+                        for q in range(min(i, j)):
+                            dot += lu[i, q] * lu[q, j]
+                        lu[i, j] -= dot
+                p = j
+                for i in range(j + 1, 3):
+                    if abs(lu[i, j]) > abs(lu[p, j]):
+                        p = i
+                piv[j] = p
+                if lu[p, j] == 0.0:
+                    singular = True  # where NumPy raises
+                    break
+                inverse = 1.0 / lu[p, j]
+                if p != j:
+                    for q in range(j + 1):
+                        lu[j, q], lu[p, q] = lu[p, q], lu[j, q]
+                for i in range(j + 1, 3):
+                    lu[i, j] *= inverse
+            if singular:
+                continue
+            for i in range(3):
+                if piv[i] != i:
+                    rhs[i], rhs[piv[i]] = rhs[piv[i]], rhs[i]
+            for i in range(3):
+                for q in range(i + 1, 3):
+                    rhs[q] += -rhs[i] * lu[q, i]
+            for i in range(2, -1, -1):
+                rhs[i] /= lu[i, i]
+                for q in range(i):
+                    rhs[q] += -rhs[i] * lu[q, i]
+            cu, cv = rhs[0] / 2, rhs[1] / 2
+            q = rhs[2] + (cu * cu + cv * cv)
+            r[d] = math.sqrt(q if q >= 0.0 or q != q else 0.0)
+            centre[d, 0], centre[d, 1] = cu + mean[d, 0], cv + mean[d, 1]
+    kept = np.zeros(count)
+    first, last = np.empty(count, np.intp), np.empty(count, np.intp)
+    for d in range(count):
+        first[d], last[d] = -1, -1
+    for i in range(n):
+        if keep[i]:
+            kept[own[i]] += 1.0
+            if first[own[i]] < 0:
+                first[own[i]] = i
+            last[own[i]] = i
+    gaps = np.empty(count)
+    for d in range(count):
+        gaps[d] = 2 * math.pi
+    for d in range(count):
+        if last[d] > first[d]:
+            gaps[d] = theta[first[d]] + 2 * math.pi - theta[last[d]]
+    before = -1
+    for i in range(n):
+        if keep[i]:
+            if before >= 0 and own[before] == own[i]:
+                gap = theta[i] - theta[before]
+                if not (gaps[own[i]] >= gap or gaps[own[i]] != gaps[own[i]]):
+                    gaps[own[i]] = gap
+            before = i
+    short = np.zeros(count, np.bool_)  # to be fitted with their known radius
+    for d in range(count):
+        short[d] = gaps[d] > MAX_ARC_GAP and kept[d] >= 6 and has_known[d]
+        short[d] &= gaps[d] <= 2 * math.pi - MIN_ARC
+    return centre, r, weight, keep, kept, gaps, np.nonzero(short)[0], sizes, starts
 
 
-@dataclass(frozen=True)
-class _Centred:
-    """Points ``xy`` ``(n, 2)`` about their group's mean, as the algebraic circle fit's normal
-    equations use them: built once for the weightings :func:`fit_discs` tries."""
+@jit
+def _stadium_fits(  # type: ignore[no-untyped-def]
+    xy,
+    weight,
+    keep,
+    starts,
+    sizes,
+    centre,
+    r,
+    kept,
+    gaps,
+    fixed,
+    radius,
+    mpp,
+    along,
+    moving,
+    turned,
+):
+    """:func:`fit_discs`' smears: each circle's RMS distance (px) from its ``keep`` edges; then,
+    in place of ``centre``, ``r`` and ``kept``, where a disc's circle leaves :data:`STADIUM_RMS`
+    and it is ``moving`` (``along``: its direction), the stadium along it, or where that fits
+    worse than the circle (a bounce has turned it since), along the best of ``turned``, if any
+    fits better than the circle. Returns the RMS distances, the discs left to :func:`_smear`
+    (those whose equations were ill-conditioned) and those whose fits are good (as
+    :func:`_good`).
 
-    mean: np.ndarray  # (count, 2)
-    rows: np.ndarray  # (n, 12): a_i of the products a_i a_j (i < 3, j < 4)
-    columns: np.ndarray  # (n, 12): a_j
+    The stadium's centre, half length and radius by weighted Gauss-Newton on the edges'
+    distances to it, twice, dropping edges off it by more than 3 robust deviations. The NumPy
+    expressions this replaces summed each step's 4 x 4 normal equations by BLAS and solved them
+    by ``lstsq`` (an SVD); here they are summed in order and solved by Gaussian elimination:
+    the fits agree to rounding (1e-13 px), not to the bit. Not where the edges leave a
+    combination of centre, length and radius unfixed, held only by the 1e-12 regularisation
+    (edges at one end of the smear only, at neither, or along one side only): there the two
+    solvers' rounding, amplified by 1e12, moved centres by up to 0.003 px; such a disc (a pivot
+    under 1e-7 of the largest) is left to :func:`_smear`, which fits it as NumPy did."""
+    rms = np.zeros(len(r))
+    for d in range(len(r)):
+        for i in range(starts[d], starts[d] + sizes[d]):
+            if keep[i]:
+                q = math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1]) - r[d]
+                rms[d] += q * q
+        rms[d] = math.sqrt(rms[d] / max(kept[d], 1.0)) / mpp[d]
+    lu, rhs, res, ranked = np.empty((4, 4)), np.empty(4), np.empty(len(xy)), np.empty(len(xy))
+    inner, best = np.empty(len(xy), np.bool_), np.empty(len(xy), np.bool_)
+    redo = np.zeros(len(r), np.bool_)
+    for d in range(len(r)):
+        if not moving[d] or fixed[d] or kept[d] < 6 or rms[d] < STADIUM_RMS:
+            continue
+        lo, m = starts[d], sizes[d]
+        spread, bu, bv, br = math.inf, 0.0, 0.0, 0.0
+        for turn in range(len(turned) + 1):
+            way = along[d] if turn == 0 else turned[turn - 1]
+            cu, cv, h, rr = centre[d, 0], centre[d, 1], 0.25 * r[d], r[d]
+            for i in range(m):
+                inner[i] = True
+            for round_ in range(2):
+                for _ in range(8):
+                    for p in range(4):
+                        rhs[p] = 0.0
+                        for q in range(4):
+                            lu[p, q] = 0.0
+                    for i in range(m):
+                        t = (xy[lo + i, 0] - cu) * way[0] + (xy[lo + i, 1] - cv) * way[1]
+                        ts = t if t != t or t > -h else -h  # np.clip(t, -h, h)
+                        ts = ts if ts != ts or ts < h else h
+                        ou, ov = (
+                            xy[lo + i, 0] - (cu + ts * way[0]),
+                            xy[lo + i, 1] - (cv + ts * way[1]),
+                        )
+                        gap = math.hypot(ou, ov)
+                        gap = gap if gap >= 1e-12 or gap != gap else 1e-12
+                        uu, uv = ou / gap, ov / gap
+                        ends = (
+                            (1.0 if t < 0 else -1.0) * (uu * way[0] + uv * way[1])
+                            if abs(t) > h
+                            else 0.0
+                        )
+                        jac = (-uu, -uv, ends, -1.0)
+                        res[i] = gap - rr
+                        wk = weight[lo + i] * (1.0 if inner[i] else 0.0)
+                        for p in range(4):
+                            for q in range(4):
+                                lu[p, q] += jac[p] * wk * jac[q]
+                            rhs[p] -= jac[p] * wk * res[i]
+                    least, most = math.inf, 0.0
+                    for j in range(4):  # Gaussian elimination, partial pivoting
+                        lu[j, j] += 1e-12
+                    for j in range(4):
+                        p = j
+                        for i in range(j + 1, 4):
+                            if abs(lu[i, j]) > abs(lu[p, j]):
+                                p = i
+                        least, most = min(least, abs(lu[p, j])), max(most, abs(lu[p, j]))
+                        if not least >= 1e-7 * most:
+                            break
+                        for q in range(4):
+                            lu[j, q], lu[p, q] = lu[p, q], lu[j, q]
+                        rhs[j], rhs[p] = rhs[p], rhs[j]
+                        for i in range(j + 1, 4):
+                            f = lu[i, j] / lu[j, j]
+                            for q in range(j + 1, 4):
+                                lu[i, q] -= f * lu[j, q]
+                            rhs[i] -= f * rhs[j]
+                    if not least >= 1e-7 * most:
+                        redo[d] = True
+                        break
+                    for i in range(3, -1, -1):
+                        for q in range(i + 1, 4):
+                            rhs[i] -= lu[i, q] * rhs[q]
+                        rhs[i] /= lu[i, i]
+                    cu, cv, h, rr = cu + rhs[0], cv + rhs[1], h + rhs[2], rr + rhs[3]
+                    if h < 0.0:
+                        h = 0.0
+                    small = True
+                    for p in range(4):
+                        small &= abs(rhs[p]) < 1e-6 * r[d]
+                    if small:
+                        break
+                if redo[d]:
+                    break
+                if round_ == 0:  # np.median of the distances: the middle two's mean; NaN if any
+                    for i in range(m):
+                        q = i - 1
+                        while q >= 0 and (ranked[q] > abs(res[i]) or ranked[q] != ranked[q]):
+                            ranked[q + 1] = ranked[q]
+                            q -= 1
+                        ranked[q + 1] = abs(res[i])
+                    if ranked[m - 1] != ranked[m - 1]:
+                        middle = math.nan
+                    elif m % 2:
+                        middle = ranked[m // 2]
+                    else:
+                        middle = (ranked[m // 2 - 1] + ranked[m // 2]) / 2.0
+                    bound = 3.0 * (1.4826 * middle)
+                    if bound < 1e-9:
+                        bound = 1e-9
+                    for i in range(m):
+                        inner[i] = abs(res[i]) <= bound
+            if redo[d]:
+                break
+            total, k = 0.0, 0
+            for i in range(m):
+                if inner[i]:
+                    total += res[i] * res[i]
+                    k += 1
+            other = math.sqrt(total / k) if k else math.nan
+            if turn == 0 or other < spread:
+                spread, bu, bv, br = other, cu, cv, rr
+                for i in range(m):
+                    best[i] = inner[i]
+            if turn == 0 and not spread / mpp[d] >= rms[d]:
+                break
+        if redo[d] or spread / mpp[d] >= rms[d]:
+            continue
+        centre[d, 0], centre[d, 1], r[d], rms[d] = bu, bv, br, spread / mpp[d]
+        kept[d] = 0.0
+        for i in range(m):
+            kept[d] += 1.0 if best[i] else 0.0
+    good = np.empty(len(r), np.bool_)
+    for d in range(len(r)):
+        good[d] = kept[d] >= 6 and (gaps[d] <= MAX_ARC_GAP or fixed[d]) and abs(r[d]) < math.inf
+        good[d] &= 0.5 * radius[d] * mpp[d] <= r[d] and r[d] <= 2.5 * radius[d] * mpp[d]
+    return rms, np.nonzero(redo)[0], np.nonzero(good)[0]
 
-    @classmethod
-    def of(cls, xy: np.ndarray, g: _Groups) -> _Centred:
-        some = g.sizes > 0
-        mean = np.zeros((g.count, 2))
-        mean[some] = np.add.reduceat(xy, g.starts[some], axis=0) / g.sizes[some, None]
-        a = np.ones((len(xy), 4))
-        a[:, :2] = xy - mean[g.owner]
-        a[:, 3] = a[:, 0] ** 2 + a[:, 1] ** 2
-        return cls(mean, a[:, _ROW], a[:, _COLUMN])
 
-
-def _circles(points: _Centred, weight: np.ndarray, g: _Groups) -> tuple[np.ndarray, np.ndarray]:
-    """Each group's weighted least-squares circle through its ``points`` (algebraic: Kasa, by
-    its normal equations), as centres ``(count, 2)`` and radii ``(count,)``; NaN for a group
-    without three weighted points."""
-    some = g.sizes > 0
-    # The products a_i a_j (weighted, i < 3, j < 4) as 12 columns: an (n, 3, 4) broadcast costs
-    # several times as much for the same values.
-    outer = points.rows * weight[:, None] * points.columns  # (n, 12)
-    m = np.zeros((g.count, 3, 4))
-    m[some] = np.add.reduceat(outer, g.starts[some], axis=0).reshape(-1, 3, 4)
-    sol = np.full((g.count, 3), np.nan)
-    ok = g.total(weight > 0) >= 3
-    if ok.any():
-        lhs = m[ok, :, :3]
-        lhs += 1e-12 * np.trace(lhs, axis1=1, axis2=2)[:, None, None] * _EYE
-        sol[ok] = np.linalg.solve(lhs, m[ok, :, 3:])[:, :, 0]
-    c = sol[:, :2] / 2
-    r = np.sqrt(np.maximum(sol[:, 2] + (c * c).sum(axis=1), 0.0))
-    return c + points.mean, r
+def _good(
+    kept: np.ndarray,
+    gaps: np.ndarray,
+    fixed: np.ndarray,
+    r: np.ndarray,
+    radius: np.ndarray,
+    mpp: np.ndarray,
+) -> np.ndarray:
+    """Which discs' fits are good: enough edges kept, of enough of the outline (or of a known
+    radius), and a radius (m) of about the disc's (``radius`` px)."""
+    good = (kept >= 6) & ((gaps <= MAX_ARC_GAP) | fixed) & np.isfinite(r)
+    return good & (0.5 * radius * mpp <= r) & (r <= 2.5 * radius * mpp)
 
 
 def _circle_of_radius(
@@ -397,6 +761,29 @@ def _circle_of_radius(
         if float(np.hypot(*step)) < 1e-6 * r:
             break
     return c
+
+
+def _smear(
+    xy: np.ndarray,
+    weight: np.ndarray,
+    start: np.ndarray,
+    r: float,
+    along: np.ndarray,
+    rms: float,
+    mpp: float,
+) -> tuple[np.ndarray, float, float, int] | None:
+    """:func:`_stadium_fits` for one disc, in NumPy (for one whose equations are
+    ill-conditioned): the stadium's centre, radius, RMS distance (px) and kept edge count, if it
+    fits better than the circle (``rms`` px)."""
+    c, rd, spread, inner = _stadium(xy, weight, start, r, along)
+    if spread / mpp >= rms:
+        for a in np.arange(0.0, math.pi, math.pi / TURNS):
+            other = _stadium(xy, weight, start, r, np.array([math.cos(a), math.sin(a)]))
+            if other[2] < spread:
+                c, rd, spread, inner = other
+        if spread / mpp >= rms:
+            return None
+    return c, rd, spread / mpp, int(inner.sum())
 
 
 def _stadium(
@@ -436,19 +823,6 @@ def _stadium(
     return c, rr, float(np.sqrt(np.mean(res[keep] ** 2))), keep
 
 
-def _arc_gaps(theta: np.ndarray, g: _Groups) -> np.ndarray:
-    """Each group's largest angle (rad) between neighbouring rays ``theta`` (increasing within
-    a group) round the circle; 2 pi for a group of fewer than two."""
-    gaps = np.full(g.count, 2 * math.pi)
-    full = g.sizes >= 2
-    if full.any():
-        ends = g.starts + g.sizes - 1
-        gaps[full] = theta[g.starts[full]] + 2 * math.pi - theta[ends[full]]
-        same = g.owner[1:] == g.owner[:-1]
-        np.maximum.at(gaps, g.owner[1:][same], np.diff(theta)[same])
-    return gaps
-
-
 def fit_discs(
     edges: Edges,
     radii: Sequence[float],
@@ -483,92 +857,114 @@ def fit_discs(
     as H.264: the centre's bias 0.33 px at the 95th percentile with them, 0.23 px without),
     else with them (a side whose rim is faint throughout, a lit limb as bright as the wall, is
     all halos by that rule). Not for a long smear, whose ends fade out over its length."""
-    per = np.broadcast_to(np.asarray(halos, dtype=bool), (len(radii),))
-    if edges.halo is None or not (edges.halo & per[edges.owner]).any():
-        return _fit_discs(edges, radii, calibration, mpp, known, along)
-    fits = _fit_discs(
-        edges.select(~(edges.halo & per[edges.owner])), radii, calibration, mpp, known, along
+    count = len(radii)
+    radius, mpp_ = np.asarray(radii, dtype=float), np.asarray(mpp, dtype=float)
+    halo = np.zeros(len(edges.owner), dtype=bool) if edges.halo is None else edges.halo
+    flagged = np.zeros(count, dtype=bool)
+    flagged[:] = halos
+    way, moving = np.zeros((count, 2)), np.zeros(count, dtype=bool)
+    for d, a in enumerate(() if along is None else along):
+        if a is not None:
+            way[d], moving[d] = a, True
+    common = (
+        edges,
+        radius,
+        calibration,
+        mpp_,
+        np.array([math.nan if k is None else k for k in known], dtype=float),
+        np.array([k is not None for k in known]),
+        way,
+        moving,
+        along,
     )
-    failed = [d for d, fit in enumerate(fits) if fit is None]
-    if failed:  # each disc is fitted on its own edges: refit only those
-        mine = edges.select(np.isin(edges.owner, failed))
-        again = _fit_discs(mine, radii, calibration, mpp, known, along)
-        for d in failed:
+    chosen, dropped = _chosen(edges.owner, edges.reach, halo, radius, flagged, False)
+    fits = _fit_discs(chosen, *common)
+    if dropped and None in fits:  # each disc is fitted on its own edges: refit only those
+        failed = np.array([fit is None for fit in fits])
+        again = _fit_discs(
+            _chosen(edges.owner, edges.reach, halo, radius, failed, True)[0], *common
+        )
+        for d in np.nonzero(failed)[0]:
             fits[d] = again[d]
     return fits
 
 
+@jit
+def _chosen(owner, reach, halo, radius, discs, again):  # type: ignore[no-untyped-def]
+    """The edges that :func:`fit_discs` fits to, those at least half the radius from the rays'
+    origin: of every disc, less the :data:`HALO` edges of ``discs`` (a mask); or ``again``, only
+    those of ``discs``, halos and all. And whether any halo is left out."""
+    chosen, count, dropped = np.empty(len(owner), np.intp), 0, False
+    for i in range(len(owner)):
+        d = owner[i]
+        if d < 0 or d >= len(radius):
+            raise IndexError("an edge's owner is not one of the discs")
+        out = (not discs[d]) if again else halo[i] and discs[d]
+        dropped |= out and not again
+        if reach[i] >= 0.5 * radius[d] and not out:
+            chosen[count] = i
+            count += 1
+    return chosen[:count], dropped
+
+
 def _fit_discs(
+    chosen: np.ndarray,
     edges: Edges,
-    radii: Sequence[float],
+    radius: np.ndarray,
     calibration: Calibration,
-    mpp: Sequence[float],
-    known: Sequence[float | None],
+    mpp: np.ndarray,
+    known: np.ndarray,
+    has_known: np.ndarray,
+    way: np.ndarray,
+    moving: np.ndarray,
     along: Sequence[np.ndarray | None] | None,
 ) -> list[DiscFit | None]:
-    """:func:`fit_discs` on all of ``edges``."""
-    count = len(radii)
-    radius = np.asarray(radii, dtype=float)
-    mpp_ = np.asarray(mpp, dtype=float)
-    e = edges.select(edges.reach >= 0.5 * radius[edges.owner])
-    if not len(e.owner):
+    """:func:`fit_discs` on the ``chosen`` edges (``known``: NaN where not ``has_known``;
+    ``way``: ``along``'s directions, where ``moving``)."""
+    count = len(radius)
+    if not len(chosen):
         return [None] * count
-    g = _Groups.of(e.owner, count)
-    own = e.owner
-    xy = calibration.to_scene(e.uv)
-    top = np.zeros(count)
-    np.maximum.at(top, own, e.contrast)
-    sharp = np.minimum(1.0, g.median(e.width)[own] / np.maximum(e.width, 1e-3))
-    weight = (np.minimum(1.0, e.contrast / (0.5 * top[own])) * sharp) ** 2
-    points = _Centred.of(xy, g)
-    centre, r = _circles(points, weight, g)
-    res = np.abs(np.hypot(*(xy - centre[own]).T) - r[own])
-    # Least trimmed squares: the three quarters nearest the circle (a highlight's rim is a tight
-    # cluster of edges inside the outline, which a fit to all of them leans to).
-    trim = g.rank(np.where(np.isnan(res), np.inf, res)) < np.maximum(6, 3 * g.sizes // 4)[own]
-    centre, r = _circles(points, weight * trim, g)
-    dist = np.hypot(*(xy - centre[own]).T)
-    res = dist - r[own]
-    scale = 1.4826 * g.median(np.where(trim, np.abs(res), np.inf))
-    bound = np.maximum(3.0 * scale, 0.75 * mpp_)
-    keep = (np.abs(res) <= bound[own]) & (dist >= 0.7 * np.maximum(r, radius * mpp_)[own])
-    centre, r = _circles(points, weight * keep, g)
-    kept = g.total(keep)
-    gaps = _arc_gaps(e.theta[keep], _Groups.of(own[keep], count))
+    xy = calibration.to_scene(edges.uv[chosen])
+    centre, r, weight, keep, kept, gaps, short, sizes, starts = _circle_fits(
+        xy, chosen, edges.owner, edges.theta, edges.contrast, edges.width, radius, mpp, has_known
+    )
     fixed = np.zeros(count, dtype=bool)
-    for d in np.nonzero((gaps > MAX_ARC_GAP) & (kept >= 6))[0]:
-        if known[d] is not None and gaps[d] <= 2 * math.pi - MIN_ARC:
-            mine = keep & (own == d)
-            centre[d] = _circle_of_radius(xy[mine], weight[mine], centre[d], known[d])
-            r[d], fixed[d] = known[d], True
-    res = np.hypot(*(xy - centre[own]).T) - r[own]
-    rms = np.sqrt(g.total(np.where(keep, res * res, 0.0)) / np.maximum(kept, 1)) / mpp_
-    for d in range(count):
-        # A stadium where the circle does not fit its edges: a smear, not a still disc.
-        if along is None or along[d] is None or fixed[d] or kept[d] < 6 or rms[d] < STADIUM_RMS:
-            continue
-        mine = own == d
-        c, rd, spread, inner = _stadium(xy[mine], weight[mine], centre[d], r[d], along[d])
-        if spread / mpp_[d] >= rms[d]:
-            # Not a smear along the track's last direction of motion (a bounce has turned it
-            # since): the direction that fits the edges best, if any fits better than a circle.
-            for a in np.arange(0.0, math.pi, math.pi / TURNS):
-                way = np.array([math.cos(a), math.sin(a)])
-                other = _stadium(xy[mine], weight[mine], centre[d], r[d], way)
-                if other[2] < spread:
-                    c, rd, spread, inner = other
-            if spread / mpp_[d] >= rms[d]:
-                continue
-        centre[d], r[d], rms[d] = c, rd, spread / mpp_[d]
-        kept[d] = inner.sum()
-    good = (kept >= 6) & ((gaps <= MAX_ARC_GAP) | fixed) & np.isfinite(r)
-    good &= (0.5 * radius * mpp_ <= r) & (r <= 2.5 * radius * mpp_)
+    for d in short:  # too little of the outline: the radius known from earlier frames
+        mine = slice(starts[d], starts[d] + sizes[d])
+        on = keep[mine]
+        centre[d] = _circle_of_radius(xy[mine][on], weight[mine][on], centre[d], known[d])
+        r[d], fixed[d] = known[d], True
+    rms, redo, good = _stadium_fits(
+        xy,
+        weight,
+        keep,
+        starts,
+        sizes,
+        centre,
+        r,
+        kept,
+        gaps,
+        fixed,
+        radius,
+        mpp,
+        way,
+        moving,
+        _TURNED,
+    )
+    if len(redo):
+        assert along is not None
+        for d in redo:
+            mine = slice(starts[d], starts[d] + sizes[d])
+            smear = _smear(xy[mine], weight[mine], centre[d], r[d], along[d], rms[d], mpp[d])
+            if smear is not None:
+                centre[d], r[d], rms[d], kept[d] = smear
+        good = np.nonzero(_good(kept, gaps, fixed, r, radius, mpp))[0]
     fits: list[DiscFit | None] = [None] * count
-    if good.any():
+    if len(good):
         uv = calibration.to_image(centre[good])
-        for k, d in enumerate(np.nonzero(good)[0]):
-            share = float(kept[d] / g.sizes[d])
-            fits[d] = DiscFit(centre[d], uv[k], float(r[d]), share, float(rms[d]), bool(fixed[d]))
+        rl, kl, nl, sl, fl = r.tolist(), kept.tolist(), sizes.tolist(), rms.tolist(), fixed.tolist()
+        for k, d in enumerate(good.tolist()):
+            fits[d] = DiscFit(centre[d], uv[k], rl[d], kl[d] / nl[d], sl[d], fl[d])
     return fits
 
 

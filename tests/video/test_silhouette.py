@@ -102,6 +102,21 @@ def test_rays_that_never_leave_the_foreground_add_nothing() -> None:
     assert fit_disc(edges, 15.0, Calibration.from_scale(1.0, (0.0, 0.0)), 1.0) is None
 
 
+def test_a_disc_seen_over_too_little_of_its_outline_is_fitted_with_its_known_radius() -> None:
+    # The lower half hidden by a floor: with the radius known from earlier frames, the upper
+    # half fixes the centre (0.18 px off, towards the visible edges).
+    img = np.zeros((100, 120), np.float32)
+    vv, uu = np.mgrid[0:100, 0:120]
+    img[np.hypot(uu - 50.3, vv - 49.6) <= 15] = 100.0
+    img[50:, :] = 100.0
+    edges = edge_points(img, (0, 0), [Rays(np.array([52.0, 50.0]), 15.0, 22.0)], 20.0)
+    cal = Calibration.from_scale(1.0, (0.0, 0.0))
+    assert fit_disc(edges, 15.0, cal, 1.0) is None
+    fit = fit_disc(edges, 15.0, cal, 1.0, known=15.0)
+    assert fit is not None and fit.fixed and fit.radius == 15.0
+    assert np.hypot(*(fit.uv - [50.3, 49.6])) < 0.25
+
+
 def test_a_smear_turned_by_a_bounce_is_fitted_along_its_own_direction() -> None:
     # After a bounce the track's last direction of motion is the one before it (on the field
     # camera's bouncing ball, 113 degrees off): a stadium along it fitted a 12 px disc's smear
