@@ -15,6 +15,7 @@ folder where that is read-only), so only the first call after installing compile
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from typing import Any
 
@@ -46,6 +47,7 @@ class _Compiled:
         self.fn = fn
         self.__doc__, self.__name__ = fn.__doc__, fn.__name__
         self._machine: Callable[..., Any] | None = None
+        _ALL.append(self)
 
     def machine(self) -> Callable[..., Any]:
         """The numba dispatcher (compiled on its first call). The module's name for the function
@@ -64,6 +66,20 @@ class _Compiled:
 
     def __call__(self, *args: Any) -> Any:
         return (self._machine or self.machine())(*args)
+
+
+#: Every function made with :func:`jit` in the modules imported so far.
+_ALL: list[_Compiled] = []
+
+
+def cached() -> bool:
+    """Whether the machine code of every compiled function imported so far is in numba's disk
+    cache (``True`` where that cannot be told). Where it is not, the first call compiles: the
+    tracker's loops take about a minute on a slow machine, once after installing."""
+    try:
+        return all(os.path.exists(f.machine()._cache._cache_file._index_path) for f in _ALL)
+    except AttributeError:  # numba's cache is not a public API
+        return True
 
 
 def jit(fn: Callable[..., Any]) -> Callable[..., Any]:

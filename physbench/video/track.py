@@ -52,7 +52,7 @@ from scipy import ndimage
 
 from physbench.errors import PhysbenchError, PhysbenchWarning
 from physbench.scene import Box, Circle
-from physbench.video import medians
+from physbench.video import compiled, medians
 from physbench.video.accuracy import stated_accuracy, stated_angle_accuracy
 from physbench.video.appearance import COLOUR_PIXELS, HIDDEN, Appearance, Look, matching
 from physbench.video.compiled import jit, pairwise_sum
@@ -1510,6 +1510,13 @@ def track_frames(
     tracker = Tracker(
         scene, calibration, background, median=median, transfer=transfer, subsampled=subsampled
     )
+    if progress and not compiled.cached():
+        print(
+            "  compiling the tracker's loops (once after installing, up to a minute; kept for "
+            "the next runs)",
+            file=sys.stderr,
+            flush=True,
+        )
     tic = _time.perf_counter()
     for fr in frames:
         tracker.update(fr.image, fr.time)

@@ -52,3 +52,12 @@ def _twice_the_sum(a):  # type: ignore[no-untyped-def]
 def test_a_compiled_function_may_call_another() -> None:
     values = np.arange(200.0)
     assert _twice_the_sum(values) == 2 * values.sum() == 39800.0
+
+
+def test_an_empty_cache_is_told_apart(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # With numba's cache in an empty folder the tracker's loops are not cached: tracking says
+    # it compiles them before its first frame, where it shows progress.
+    code = "from physbench.video import compiled, track; print(compiled.cached())"
+    env = {**__import__("os").environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert out.stdout.strip() == "False", out.stderr
