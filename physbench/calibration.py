@@ -48,6 +48,7 @@ import math
 import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -114,9 +115,15 @@ class Calibration:
             uv = self.lens.undistort(uv)
         return _apply(self.homography, uv)
 
+    @cached_property
+    def _inverse(self) -> np.ndarray:
+        """The homography's inverse: scene metres to undistorted pixels (the tracker maps its
+        predictions with it several times a frame)."""
+        return np.linalg.inv(self.homography)
+
     def to_image(self, xy: Sequence[float] | np.ndarray) -> np.ndarray:
         """Image pixels ``(..., 2)`` of scene metres ``(..., 2)``."""
-        uv = _apply(np.linalg.inv(self.homography), np.asarray(xy, dtype=float))
+        uv = _apply(self._inverse, np.asarray(xy, dtype=float))
         return uv if self.lens is None else self.lens.distort(uv)
 
     def metres_per_pixel(self, uv: Sequence[float]) -> float:
