@@ -130,10 +130,12 @@ class Appearance:
 
     def update(self, look: Look) -> None:
         """Called by the tracker with each accepted detection's appearance."""
-        hue = _apart(_direction(np.asarray(look.colour, dtype=float).tolist()), self._unit)
+        colour = np.asarray(look.colour, dtype=float).tolist()
+        hue = _apart(_direction(colour), self._unit)
         self.hue_spread += RATE * (hue - self.hue_spread)
         self.size += RATE * (look.size - self.size)
-        self.colour = self.colour + RATE * (np.asarray(look.colour, dtype=float) - self.colour)
+        mine = self.colour.tolist()
+        self.colour = np.array([c + RATE * (x - c) for c, x in zip(mine, colour, strict=True)])
         self._colour_changed()
         self.seen += 1
 
