@@ -39,9 +39,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
+from physbench.video.compiled import jit
 from physbench.video.photometry import Light
 
 #: Side (px) of the box a sample averages.
@@ -125,6 +127,9 @@ class ShiftMeter:
         box = np.arange(BOX) - BOX // 2
         box = (box[:, None] * w + box[None, :]).ravel()
         self.at = 3 * (self.flat[:, None] + box[None]).ravel()  # each box's pixels' red bytes
+        # The compiled loops read float16 by its bits (numba has no float16), and sum as NumPy.
+        self.bits = tuple(a.view(np.uint16) for a in (self.grey, self.gu, self.gv))
+        self.plans = {nth: _plan(len(self.rows[::nth])) for nth in (1, COARSE)}
         self.best = np.inf  # the best agreement of a frame so far
         self.last = (0, 0)  # the last frame's whole-pixel shift: the walk starts there
         self.noise = np.inf  # the least noise of a frame so far (grey levels)
@@ -141,9 +146,7 @@ class ShiftMeter:
         clipped alike at every shift."""
         if not self.usable:
             return None
-        flat = image.reshape(-1)
-        seen = sum(flat.take(self.at + k).astype(np.float32) for k in range(3))
-        seen = seen.reshape(len(self.flat), -1).mean(axis=1) / np.float32(3.0)
+        seen = _box_means(image.reshape(-1), self.at, len(self.flat))
         # The frame's noise as the light meter measured it is inflated where the picture moved
         # (every edge disagrees): the least of the clip's frames is its noise.
         if light.samples:
@@ -151,31 +154,26 @@ class ShiftMeter:
         noise = light.sigma if np.isinf(self.noise) else self.noise
         clip2 = np.float32(CLIP * max(noise, 2.0)) ** 2
 
-        def residuals(shifts: list[tuple[int, int]], nth: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        def residuals(
+            shifts: list[tuple[int, int]], nth: int = 1
+        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             """Per whole-pixel shift, the background's samples there (every ``nth``) in the
             frame's light (a gain and an offset fitted at that shift: the light meter's, fitted
             at none, is off where the picture moved) less the frame's (a picture moved by +du
-            shows at u what was at u - du), and where they are read."""
-            du = np.array([s[0] for s in shifts])[:, None]
-            dv = np.array([s[1] for s in shifts])[:, None]
-            rows, cols = self.rows[None, ::nth], self.cols[None, ::nth]
-            where = (rows - dv) * self.w + (cols - du)
-            if np.abs(du).max() >= BOX or np.abs(dv).max() >= BOX:  # may leave the picture
-                r = np.minimum(np.maximum(rows - dv, 0), self.h - 1)
-                c = np.minimum(np.maximum(cols - du, 0), self.w - 1)
-                where = r * self.w + c
-            e = self.grey.take(where).astype(np.float32)
-            mine = seen[::nth]
-            return _in_light(e, mine) - mine, where
+            shows at u what was at u - du), where they are read, and the clipped mean squared
+            disagreement."""
+            return _residuals(
+                self.bits[0], _halves(), self.rows, self.cols, self.h, self.w, seen,
+                np.array(shifts, dtype=np.intp), nth, clip2, *self.plans[nth],
+            )  # fmt: skip
 
         def cost(shifts: list[tuple[int, int]], nth: int = 1) -> np.ndarray:
             """The clipped mean squared disagreement at each shift (on every ``nth`` sample)."""
-            d = residuals(shifts, nth)[0]
-            return np.minimum(d * d, clip2).mean(axis=1)
+            return residuals(shifts, nth)[2]
 
         centre = self.last
         at_last = residuals([centre])
-        here = float(np.minimum(at_last[0] ** 2, clip2).mean())
+        here = float(at_last[2][0])
         if not np.isfinite(self.best) or here > WORSE * self.best:  # off the last frame's shift
             centre, here = self._walk(centre, cost)
         if np.isfinite(self.best) and here > WORSE * self.best:
@@ -190,7 +188,7 @@ class ShiftMeter:
         # back at a pixel already stepped from, it ends at the shortest step taken.
         steps: dict[tuple[int, int], tuple[float, float]] = {}
         while centre not in steps and len(steps) < 3:
-            d, where = at_last if centre == self.last else residuals([centre])
+            d, where, _ = at_last if centre == self.last else residuals([centre])
             got = self._between(d[0], where[0], seen, clip2)
             steps[centre] = (0.0, 0.0) if got is None else got
             if got is None or (abs(got[0]) <= 0.5 and abs(got[1]) <= 0.5):
@@ -208,25 +206,8 @@ class ShiftMeter:
         background(u - s) + offset, linear in the gain, the offset and gain times s), on the
         samples that agree (clipped ones left out), each axis within a pixel; ``None`` where
         the samples' edges run one way only."""
-        spread = 1.4826 * float(np.median(np.abs(d)))  # what is left of the noise, and any body
-        ok = d * d < min(float(clip2), (CLIP * max(spread, 1.0)) ** 2)
-        if ok.sum() < MIN_SAMPLES:
-            return None
-        where = where[ok]
-        e = self.grey.take(where).astype(np.float64)
-        gu = self.gu.take(where).astype(np.float64)
-        gv = self.gv.take(where).astype(np.float64)
-        uu, uv, vv = float(gu @ gu), float(gu @ gv), float(gv @ gv)
-        if not uu * vv - uv * uv > 1e-6 * (uu + vv) ** 2:
-            return None  # edges of one direction only
-        a = np.column_stack([e, np.ones_like(e), -gu, -gv])
-        try:
-            gain, _, pu, pv = np.linalg.solve(a.T @ a, a.T @ seen[ok].astype(np.float64))
-        except np.linalg.LinAlgError:
-            return None
-        if not gain > 0.1:
-            return None
-        return min(max(pu / gain, -1.0), 1.0), min(max(pv / gain, -1.0), 1.0)
+        ok, su, sv = _lucas_kanade(d, where, seen, *self.bits, _halves(), clip2)
+        return (su, sv) if ok else None
 
     @staticmethod
     def _walk(
@@ -255,12 +236,203 @@ def _around(centre: tuple[int, int], radius: int) -> list[tuple[int, int]]:
     ]
 
 
-def _in_light(e: np.ndarray, seen: np.ndarray) -> np.ndarray:
-    """Each row of background samples ``e`` ``(K, n)`` in the light that fits ``seen`` ``(n,)``
-    best: ``gain e + offset`` by least squares, per row."""
-    em, sm = e.mean(axis=1, keepdims=True), seen.mean()
-    de = e - em
-    gain = (de * (seen - sm)).sum(axis=1, keepdims=True) / np.maximum(
-        (de * de).sum(axis=1, keepdims=True), 1e-6
-    )
-    return gain * de + sm
+@cache
+def _halves() -> np.ndarray:
+    """Every float16 as a float32, indexed by its bits."""
+    return np.arange(1 << 16, dtype=np.uint16).view(np.float16).astype(np.float32)
+
+
+def _plan(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """How NumPy sums ``n`` float32 values along a row, pairwise: halves split at a multiple of
+    8 down to blocks of at most 128, each summed by 8 accumulators. The blocks ``(start,
+    count)`` and the order to add them in (postfix: a block's index, or -1 to add the last two
+    sums)."""
+    blocks: list[tuple[int, int]] = []
+    order: list[int] = []
+    parts = [(0, n)]  # depth first, left before right; (-1, 0) adds the two sums before it
+    while parts:
+        start, count = parts.pop()
+        if start < 0:
+            order.append(-1)
+        elif count <= 128:
+            order.append(len(blocks))
+            blocks.append((start, count))
+        else:
+            half = count // 2 - count // 2 % 8
+            parts += [(-1, 0), (start + half, count - half), (start, half)]
+    return np.array(blocks, dtype=np.intp).reshape(-1, 2), np.array(order, dtype=np.intp)
+
+
+@jit
+def _box_means(flat, at, n):  # type: ignore[no-untyped-def]
+    """The frame's grey over each sample's box: ``flat`` the frame's bytes, ``at`` each box's
+    pixels' red bytes ``(n * BOX * BOX,)``, float32 as ``ShiftMeter.measure`` had it in NumPy
+    (the channels summed, the mean of each box, a third of it; the sums are of whole numbers,
+    so exact in any order)."""
+    seen = np.empty(n, np.float32)
+    per = len(at) // n
+    for i in range(n):
+        total = np.float32(0.0)
+        for j in range(i * per, (i + 1) * per):
+            q = at[j]
+            total += np.float32(flat[q]) + np.float32(flat[q + 1]) + np.float32(flat[q + 2])
+        seen[i] = np.float32(np.float32(np.float64(total) / per) / np.float32(3.0))
+    return seen
+
+
+@jit
+def _residuals(grey, halves, rows, cols, h, w, seen, shifts, nth, clip2, blocks, order):  # type: ignore[no-untyped-def]
+    """``residuals`` of :meth:`ShiftMeter.measure` at each of ``shifts`` ``(K, 2)`` on every
+    ``nth`` of the samples at ``rows``, ``cols`` (``seen`` the frame's grey there; ``grey`` the
+    background's float16 bits, ``halves`` their values): the residuals ``(K, m)``, where each
+    is read (clamped to the picture), and each shift's clipped mean squared residual.
+
+    Each row of background samples ``e`` is fitted to the frame's ``s`` by least squares (``gain
+    (e - mean e) + mean s``, gain ``sum((e - mean e)(s - mean s)) / max(sum((e - mean e)^2),
+    1e-6)``), as NumPy computed it in float32, each sum NumPy's pairwise one (``blocks``,
+    ``order``: :func:`_plan` of ``m``): the results are the same to the bit."""
+    m = (len(rows) + nth - 1) // nth
+    k = len(shifts)
+    d = np.empty((k, m), np.float32)
+    where = np.empty((k, m), np.intp)
+    cost = np.empty(k, np.float32)
+    mine, off = np.empty(m, np.float32), np.empty(m, np.float32)
+    de, a, b = np.empty(m, np.float32), np.empty(m, np.float32), np.empty(m, np.float32)
+    sums = np.empty(len(order), np.float32)
+    acc = np.empty(8, np.float32)
+
+    def total(x):  # type: ignore[no-untyped-def]
+        """NumPy's sum of the float32 values ``x`` (``0 +`` its pairwise sum)."""
+        top = 0
+        for step in order:
+            if step < 0:
+                top -= 1
+                sums[top - 1] = sums[top - 1] + sums[top]
+                continue
+            lo, count = blocks[step, 0], blocks[step, 1]
+            if count < 8:
+                res = np.float32(0.0)
+                for i in range(lo, lo + count):
+                    res += x[i]
+            else:
+                for t in range(8):
+                    acc[t] = x[lo + t]
+                i = 8
+                while i < count - count % 8:
+                    for t in range(8):
+                        acc[t] += x[lo + i + t]
+                    i += 8
+                res = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + (
+                    (acc[4] + acc[5]) + (acc[6] + acc[7])
+                )
+                while i < count:
+                    res += x[lo + i]
+                    i += 1
+            sums[top] = res
+            top += 1
+        return np.float32(0.0) + sums[0]
+
+    for i in range(m):
+        mine[i] = seen[i * nth]
+    sm = np.float32(np.float64(total(mine)) / m)
+    for i in range(m):
+        off[i] = mine[i] - sm
+    floor = np.float32(1e-6)
+    for j in range(k):
+        for i in range(m):
+            r = min(max(rows[i * nth] - shifts[j, 1], 0), h - 1)
+            c = min(max(cols[i * nth] - shifts[j, 0], 0), w - 1)
+            where[j, i] = r * w + c
+            de[i] = halves[grey[r * w + c]]
+        em = np.float32(np.float64(total(de)) / m)
+        for i in range(m):
+            de[i] = de[i] - em
+            a[i] = de[i] * off[i]
+            b[i] = de[i] * de[i]
+        gain = total(a) / max(total(b), floor)
+        for i in range(m):
+            d[j, i] = (gain * de[i] + sm) - mine[i]
+            a[i] = min(d[j, i] * d[j, i], clip2)
+        cost[j] = np.float32(np.float64(total(a)) / m)
+    return d, where, cost
+
+
+@jit
+def _lucas_kanade(d, where, seen, grey, gu, gv, halves, clip2):  # type: ignore[no-untyped-def]
+    """:meth:`ShiftMeter._between` as ``(found, du, dv)``. The median and the mask are NumPy's
+    float32 ones. The normal equations are summed in sample order (their products, of float16
+    and float32 values, are exact in float64) and solved as OpenBLAS's ``dgesv`` solves them
+    for ``np.linalg.solve``: the same to the bit on the machine measured (OpenBLAS 0.3.31, AMD
+    EPYC), where BLAS's sums came out the same; elsewhere to rounding. An exactly zero pivot,
+    which LAPACK calls singular, finds nothing."""
+    n = len(d)
+    size = np.sort(np.abs(d))
+    mid = size[n // 2] if n % 2 else np.float32(np.float64(size[n // 2 - 1] + size[n // 2]) / 2)
+    # Squares as products: Python's ** 2 (libm's pow) is a last bit off for about 0.1 % of
+    # values, which moves the float32 bound only where it lies on a float32 rounding boundary.
+    bound = CLIP * max(1.4826 * np.float64(mid), 1.0)
+    keep = np.float32(min(np.float64(clip2), bound * bound))
+    m = np.zeros((4, 4))
+    rhs = np.zeros(4)
+    a = np.ones(4)
+    uu = uv = vv = 0.0
+    count = 0
+    for i in range(n):
+        if not d[i] * d[i] < keep:
+            continue
+        q = where[i]
+        a[0] = halves[grey[q]]
+        a[2], a[3] = -np.float64(halves[gu[q]]), -np.float64(halves[gv[q]])
+        uu += a[2] * a[2]
+        uv += a[2] * a[3]
+        vv += a[3] * a[3]
+        s = np.float64(seen[i])
+        for p in range(4):
+            rhs[p] += a[p] * s
+            for t in range(4):
+                m[p, t] += a[p] * a[t]
+        count += 1
+    if count < MIN_SAMPLES or not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
+        return False, 0.0, 0.0  # too few samples agree, or edges of one direction only
+    # LU with partial pivoting as OpenBLAS's dgetf2 (column by column, each entry less one dot
+    # product; the multipliers scaled by the pivot's reciprocal), then its dgetrs (updates
+    # column by column, dividing by the diagonal). Of 100 systems from shaken walls, textbook
+    # elimination matched np.linalg.solve to the bit in 3; this in all.
+    for j in range(4):
+        for i in range(1, j):
+            dot = 0.0
+            for t in range(i):
+                dot += m[i, t] * m[t, j]
+            m[i, j] -= dot
+        for i in range(j, 4):
+            dot = 0.0
+            for t in range(j):
+                dot += m[i, t] * m[t, j]
+            m[i, j] -= dot
+        p = j
+        for i in range(j + 1, 4):
+            if abs(m[i, j]) > abs(m[p, j]):
+                p = i
+        if m[p, j] == 0.0:
+            return False, 0.0, 0.0  # singular: np.linalg.solve's LinAlgError
+        for t in range(4):
+            m[j, t], m[p, t] = m[p, t], m[j, t]
+        rhs[j], rhs[p] = rhs[p], rhs[j]
+        scale = 1.0 / m[j, j]
+        for i in range(j + 1, 4):
+            m[i, j] *= scale
+    x = rhs
+    for j in range(4):
+        for i in range(j + 1, 4):
+            x[i] += -x[j] * m[i, j]
+    for j in range(3, -1, -1):
+        x[j] /= m[j, j]
+        for i in range(j):
+            x[i] += -x[j] * m[i, j]
+    gain = x[0]
+    if not gain > 0.1:
+        return False, 0.0, 0.0
+    su, sv = x[2] / gain, x[3] / gain
+    su, sv = -1.0 if su < -1.0 else su, -1.0 if sv < -1.0 else sv  # Python's max(s, -1.0)
+    su, sv = 1.0 if su > 1.0 else su, 1.0 if sv > 1.0 else sv  # and min(s, 1.0)
+    return True, su, sv
