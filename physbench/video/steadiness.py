@@ -39,7 +39,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cache
 
 import numpy as np
 
@@ -78,6 +77,9 @@ MIN_SAMPLES = 20
 #: than its best frame in frames where nothing moved, so the search runs in about half of them.
 COARSE = 4
 FEW = 3
+#: The background's values at each sample are kept for every shift up to this (px, each axis):
+#: the search's and its walks' first steps. Read in a row each, not scattered over the picture.
+BANK = SEARCH + 1
 
 
 @dataclass(frozen=True)
@@ -107,10 +109,13 @@ class ShiftMeter:
         for k in range(3):
             grey += ndimage.uniform_filter(background[..., k].astype(np.float32), BOX)
         grey /= np.float32(3.0)
-        self.grey = grey.ravel().astype(np.float16)
+        # The compiled loops read float16 by its bits (numba has no float16): one array of them.
+        self.planes = np.empty((3, h * w), np.uint16)
+        self.grey, self.gu, self.gv = (plane.view(np.float16) for plane in self.planes)
+        self.grey[:] = grey.ravel().astype(np.float16)
         gv, gu = np.gradient(grey)
         del grey
-        self.gu, self.gv = gu.astype(np.float16).ravel(), gv.astype(np.float16).ravel()
+        self.gu[:], self.gv[:] = gu.astype(np.float16).ravel(), gv.astype(np.float16).ravel()
         steep = np.hypot(gu, gv)
         del gu, gv
         rows, cols = [], []
@@ -127,9 +132,13 @@ class ShiftMeter:
         box = np.arange(BOX) - BOX // 2
         box = (box[:, None] * w + box[None, :]).ravel()
         self.at = 3 * (self.flat[:, None] + box[None]).ravel()  # each box's pixels' red bytes
-        # The compiled loops read float16 by its bits (numba has no float16), and sum as NumPy.
-        self.bits = tuple(a.view(np.uint16) for a in (self.grey, self.gu, self.gv))
-        self.plans = {nth: _plan(len(self.rows[::nth])) for nth in (1, COARSE)}
+        # Each plane at each sample, for each shift up to BANK px (row-major over (dv, du)):
+        # (3, (2 BANK + 1)^2, samples), 726 bytes a sample.
+        reach = np.arange(-BANK, BANK + 1)
+        r = np.clip(self.rows[None, None] - reach[:, None, None], 0, h - 1)
+        c = np.clip(self.cols[None, None] - reach[None, :, None], 0, w - 1)
+        self.bank = self.planes[:, (r * w + c).reshape(len(reach) ** 2, -1)]
+        self.plans = {nth: _plan(len(self.rows[::nth])) for nth in (1, COARSE)}  # NumPy's sums
         self.best = np.inf  # the best agreement of a frame so far
         self.last = (0, 0)  # the last frame's whole-pixel shift: the walk starts there
         self.noise = np.inf  # the least noise of a frame so far (grey levels)
@@ -155,25 +164,25 @@ class ShiftMeter:
         clip2 = np.float32(CLIP * max(noise, 2.0)) ** 2
 
         def residuals(
-            shifts: list[tuple[int, int]], nth: int = 1
-        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            shifts: list[tuple[int, int]], nth: int = 1, full: bool = False
+        ) -> tuple[np.ndarray, np.ndarray]:
             """Per whole-pixel shift, the background's samples there (every ``nth``) in the
             frame's light (a gain and an offset fitted at that shift: the light meter's, fitted
             at none, is off where the picture moved) less the frame's (a picture moved by +du
-            shows at u what was at u - du), where they are read, and the clipped mean squared
-            disagreement."""
+            shows at u what was at u - du), where ``full`` (else none), and the clipped mean
+            squared disagreement."""
             return _residuals(
-                self.bits[0], _halves(), self.rows, self.cols, self.h, self.w, seen,
-                np.array(shifts, dtype=np.intp), nth, clip2, *self.plans[nth],
+                self.bank, self.planes, self.rows, self.cols, self.h, self.w, seen,
+                np.array(shifts, dtype=np.intp), nth, clip2, *self.plans[nth], full,
             )  # fmt: skip
 
         def cost(shifts: list[tuple[int, int]], nth: int = 1) -> np.ndarray:
             """The clipped mean squared disagreement at each shift (on every ``nth`` sample)."""
-            return residuals(shifts, nth)[2]
+            return residuals(shifts, nth)[1]
 
         centre = self.last
-        at_last = residuals([centre])
-        here = float(at_last[2][0])
+        at_last = residuals([centre], full=True)
+        here = float(at_last[1][0])
         if not np.isfinite(self.best) or here > WORSE * self.best:  # off the last frame's shift
             centre, here = self._walk(centre, cost)
         if np.isfinite(self.best) and here > WORSE * self.best:
@@ -188,8 +197,8 @@ class ShiftMeter:
         # back at a pixel already stepped from, it ends at the shortest step taken.
         steps: dict[tuple[int, int], tuple[float, float]] = {}
         while centre not in steps and len(steps) < 3:
-            d, where, _ = at_last if centre == self.last else residuals([centre])
-            got = self._between(d[0], where[0], seen, clip2)
+            d = (at_last if centre == self.last else residuals([centre], full=True))[0]
+            got = self._between(d[0], centre, seen, clip2)
             steps[centre] = (0.0, 0.0) if got is None else got
             if got is None or (abs(got[0]) <= 0.5 and abs(got[1]) <= 0.5):
                 break
@@ -199,14 +208,16 @@ class ShiftMeter:
         return Shift(centre[0] + steps[centre][0], centre[1] + steps[centre][1])
 
     def _between(
-        self, d: np.ndarray, where: np.ndarray, seen: np.ndarray, clip2: np.float32
+        self, d: np.ndarray, shift: tuple[int, int], seen: np.ndarray, clip2: np.float32
     ) -> tuple[float, float] | None:
-        """The shift between whole pixels from the residuals ``d`` at a whole-pixel shift, read
-        at ``where``: a Lucas-Kanade step with the light fitted with it (frame = gain
+        """The shift between whole pixels from the residuals ``d`` at whole-pixel ``shift``: a
+        Lucas-Kanade step with the light fitted with it (frame = gain
         background(u - s) + offset, linear in the gain, the offset and gain times s), on the
         samples that agree (clipped ones left out), each axis within a pixel; ``None`` where
         the samples' edges run one way only."""
-        ok, su, sv = _lucas_kanade(d, where, seen, *self.bits, _halves(), clip2)
+        ok, su, sv = _lucas_kanade(
+            d, *shift, self.bank, self.planes, self.rows, self.cols, self.h, self.w, seen, clip2
+        )
         return (su, sv) if ok else None
 
     @staticmethod
@@ -236,10 +247,9 @@ def _around(centre: tuple[int, int], radius: int) -> list[tuple[int, int]]:
     ]
 
 
-@cache
-def _halves() -> np.ndarray:
-    """Every float16 as a float32, indexed by its bits."""
-    return np.arange(1 << 16, dtype=np.uint16).view(np.float16).astype(np.float32)
+#: A float16's scale by its exponent bits: its 11-bit significand (10 bits and the leading 1,
+#: none where the exponent is 0) times this.
+_SCALE = np.array([2.0 ** (max(e, 1) - 25) for e in range(32)], np.float32)
 
 
 def _plan(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -266,26 +276,29 @@ def _plan(n: int) -> tuple[np.ndarray, np.ndarray]:
 @jit
 def _box_means(flat, at, n):  # type: ignore[no-untyped-def]
     """The frame's grey over each sample's box: ``flat`` the frame's bytes, ``at`` each box's
-    pixels' red bytes ``(n * BOX * BOX,)``, float32 as ``ShiftMeter.measure`` had it in NumPy
-    (the channels summed, the mean of each box, a third of it; the sums are of whole numbers,
-    so exact in any order)."""
+    pixels' red bytes ``(n * BOX * BOX,)``, row by row; float32 as ``ShiftMeter.measure`` had
+    it in NumPy (the channels summed, the mean of each box, a third of it). The sums are of
+    whole numbers, so exact in any order: summed as integers, a box's row (``3 BOX`` bytes) at
+    a time."""
     seen = np.empty(n, np.float32)
     per = len(at) // n
     for i in range(n):
-        total = np.float32(0.0)
-        for j in range(i * per, (i + 1) * per):
+        total = 0
+        for j in range(i * per, (i + 1) * per, BOX):
             q = at[j]
-            total += np.float32(flat[q]) + np.float32(flat[q + 1]) + np.float32(flat[q + 2])
+            for t in range(3 * BOX):
+                total += np.int32(flat[q + t])
         seen[i] = np.float32(np.float32(np.float64(total) / per) / np.float32(3.0))
     return seen
 
 
 @jit
-def _residuals(grey, halves, rows, cols, h, w, seen, shifts, nth, clip2, blocks, order):  # type: ignore[no-untyped-def]
+def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks, order, full):  # type: ignore[no-untyped-def]
     """``residuals`` of :meth:`ShiftMeter.measure` at each of ``shifts`` ``(K, 2)`` on every
-    ``nth`` of the samples at ``rows``, ``cols`` (``seen`` the frame's grey there; ``grey`` the
-    background's float16 bits, ``halves`` their values): the residuals ``(K, m)``, where each
-    is read (clamped to the picture), and each shift's clipped mean squared residual.
+    ``nth`` of the samples at ``rows``, ``cols`` (``seen`` the frame's grey there): the
+    residuals ``(K, m)`` where ``full`` (else none) and each shift's clipped mean squared
+    residual. The background is read from ``bank`` (``ShiftMeter.bank``) where it holds the
+    shift, else from ``planes`` at the sample less the shift, clamped to the picture.
 
     Each row of background samples ``e`` is fitted to the frame's ``s`` by least squares (``gain
     (e - mean e) + mean s``, gain ``sum((e - mean e)(s - mean s)) / max(sum((e - mean e)^2),
@@ -293,8 +306,7 @@ def _residuals(grey, halves, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
     ``order``: :func:`_plan` of ``m``): the results are the same to the bit."""
     m = (len(rows) + nth - 1) // nth
     k = len(shifts)
-    d = np.empty((k, m), np.float32)
-    where = np.empty((k, m), np.intp)
+    d = np.empty((k if full else 0, m), np.float32)
     cost = np.empty(k, np.float32)
     mine, off = np.empty(m, np.float32), np.empty(m, np.float32)
     de, a, b = np.empty(m, np.float32), np.empty(m, np.float32), np.empty(m, np.float32)
@@ -332,6 +344,15 @@ def _residuals(grey, halves, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
             top += 1
         return np.float32(0.0) + sums[0]
 
+    def half(bits):  # type: ignore[no-untyped-def]
+        """The float16 of ``bits`` as a float32."""
+        e = (bits >> 10) & 31
+        if e == 31:
+            v = np.float32(np.inf) if bits & 1023 == 0 else np.float32(np.nan)
+        else:
+            v = np.float32((bits & 1023) + (1024 if e else 0)) * _SCALE[e]
+        return -v if bits & 32768 else v
+
     for i in range(m):
         mine[i] = seen[i * nth]
     sm = np.float32(np.float64(total(mine)) / m)
@@ -339,11 +360,16 @@ def _residuals(grey, halves, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
         off[i] = mine[i] - sm
     floor = np.float32(1e-6)
     for j in range(k):
-        for i in range(m):
-            r = min(max(rows[i * nth] - shifts[j, 1], 0), h - 1)
-            c = min(max(cols[i * nth] - shifts[j, 0], 0), w - 1)
-            where[j, i] = r * w + c
-            de[i] = halves[grey[r * w + c]]
+        du, dv = shifts[j, 0], shifts[j, 1]
+        if abs(du) <= BANK and abs(dv) <= BANK:
+            row = bank[0, (dv + BANK) * (2 * BANK + 1) + du + BANK]
+            for i in range(m):
+                de[i] = half(row[i * nth])
+        else:
+            for i in range(m):
+                r = min(max(rows[i * nth] - dv, 0), h - 1)
+                c = min(max(cols[i * nth] - du, 0), w - 1)
+                de[i] = half(planes[0, r * w + c])
         em = np.float32(np.float64(total(de)) / m)
         for i in range(m):
             de[i] = de[i] - em
@@ -351,20 +377,23 @@ def _residuals(grey, halves, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
             b[i] = de[i] * de[i]
         gain = total(a) / max(total(b), floor)
         for i in range(m):
-            d[j, i] = (gain * de[i] + sm) - mine[i]
-            a[i] = min(d[j, i] * d[j, i], clip2)
+            res = (gain * de[i] + sm) - mine[i]
+            if full:
+                d[j, i] = res
+            a[i] = min(res * res, clip2)
         cost[j] = np.float32(np.float64(total(a)) / m)
-    return d, where, cost
+    return d, cost
 
 
 @jit
-def _lucas_kanade(d, where, seen, grey, gu, gv, halves, clip2):  # type: ignore[no-untyped-def]
-    """:meth:`ShiftMeter._between` as ``(found, du, dv)``. The median and the mask are NumPy's
-    float32 ones. The normal equations are summed in sample order (their products, of float16
-    and float32 values, are exact in float64) and solved as OpenBLAS's ``dgesv`` solves them
-    for ``np.linalg.solve``: the same to the bit on the machine measured (OpenBLAS 0.3.31, AMD
-    EPYC), where BLAS's sums came out the same; elsewhere to rounding. An exactly zero pivot,
-    which LAPACK calls singular, finds nothing."""
+def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # type: ignore[no-untyped-def]
+    """:meth:`ShiftMeter._between` as ``(found, du, dv)`` from the residuals ``d`` at whole-pixel
+    shift ``(du, dv)`` (the background read as :func:`_residuals` reads it). The median and the
+    mask are NumPy's float32 ones. The normal equations are summed in sample order (their
+    products, of float16 and float32 values, are exact in float64) and solved as OpenBLAS's
+    ``dgesv`` solves them for ``np.linalg.solve``: the same to the bit on the machine measured
+    (OpenBLAS 0.3.31, AMD EPYC), where BLAS's sums came out the same; elsewhere to rounding. An
+    exactly zero pivot, which LAPACK calls singular, finds nothing."""
     n = len(d)
     size = np.sort(np.abs(d))
     mid = size[n // 2] if n % 2 else np.float32(np.float64(size[n // 2 - 1] + size[n // 2]) / 2)
@@ -376,24 +405,50 @@ def _lucas_kanade(d, where, seen, grey, gu, gv, halves, clip2):  # type: ignore[
     rhs = np.zeros(4)
     a = np.ones(4)
     uu = uv = vv = 0.0
+
+    def half(bits):  # type: ignore[no-untyped-def]
+        """The float16 of ``bits`` as a float32."""
+        e = (bits >> 10) & 31
+        if e == 31:
+            v = np.float32(np.inf) if bits & 1023 == 0 else np.float32(np.nan)
+        else:
+            v = np.float32((bits & 1023) + (1024 if e else 0)) * _SCALE[e]
+        return -v if bits & 32768 else v
+
+    # The samples that agree, read first (each read independent of the sums), then summed.
+    kept = np.empty(n, np.intp)
     count = 0
     for i in range(n):
-        if not d[i] * d[i] < keep:
-            continue
-        q = where[i]
-        a[0] = halves[grey[q]]
-        a[2], a[3] = -np.float64(halves[gu[q]]), -np.float64(halves[gv[q]])
+        if d[i] * d[i] < keep:
+            kept[count] = i
+            count += 1
+    if count < MIN_SAMPLES:
+        return False, 0.0, 0.0
+    values = np.empty((count, 3), np.uint16)
+    if abs(du) <= BANK and abs(dv) <= BANK:
+        row = (dv + BANK) * (2 * BANK + 1) + du + BANK
+        for t in range(count):
+            for p in range(3):
+                values[t, p] = bank[p, row, kept[t]]
+    else:
+        for t in range(count):
+            i = kept[t]
+            q = min(max(rows[i] - dv, 0), h - 1) * w + min(max(cols[i] - du, 0), w - 1)
+            for p in range(3):
+                values[t, p] = planes[p, q]
+    for t in range(count):
+        a[0] = half(values[t, 0])
+        a[2], a[3] = -np.float64(half(values[t, 1])), -np.float64(half(values[t, 2]))
         uu += a[2] * a[2]
         uv += a[2] * a[3]
         vv += a[3] * a[3]
-        s = np.float64(seen[i])
+        s = np.float64(seen[kept[t]])
         for p in range(4):
             rhs[p] += a[p] * s
-            for t in range(4):
-                m[p, t] += a[p] * a[t]
-        count += 1
-    if count < MIN_SAMPLES or not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
-        return False, 0.0, 0.0  # too few samples agree, or edges of one direction only
+            for r in range(4):
+                m[p, r] += a[p] * a[r]
+    if not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
+        return False, 0.0, 0.0  # edges of one direction only
     # LU with partial pivoting as OpenBLAS's dgetf2 (column by column, each entry less one dot
     # product; the multipliers scaled by the pivot's reciprocal), then its dgetrs (updates
     # column by column, dividing by the diagonal). Of 100 systems from shaken walls, textbook

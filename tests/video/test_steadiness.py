@@ -93,10 +93,10 @@ def _numpy_step(  # type: ignore[no-untyped-def]
 
 
 def test_the_compiled_loops_compute_what_numpy_did() -> None:
-    """On a wall moved by a fraction of a pixel: the frame's box means, the residuals, where
-    they are read and the costs (every shift within SEARCH px and one far off, on all samples
-    and on every COARSE-th) are NumPy's to the bit; each shift's Lucas-Kanade step within 1e-9 px
-    of NumPy's (to the bit where BLAS sums as the loop does)."""
+    """On a wall moved by a fraction of a pixel: the frame's box means, the residuals and the
+    costs (every shift within SEARCH px, read from the meter's bank, and one beyond it, on all
+    samples and on every COARSE-th) are NumPy's to the bit; each shift's Lucas-Kanade step
+    within 1e-9 px of NumPy's (to the bit where BLAS sums as the loop does)."""
     rng = np.random.default_rng(4)
     plate = wall((240, 320), 4)
     background = expose(plate.astype(np.float64), rng, noise=0.0)
@@ -111,19 +111,22 @@ def test_the_compiled_loops_compute_what_numpy_did() -> None:
     clip2 = np.float32(3.0 * 2.5) ** 2
     shifts = [(du, dv) for dv in range(-SEARCH, SEARCH + 1) for du in range(-SEARCH, SEARCH + 1)]
     shifts.append((9, -7))
-    halves = steadiness._halves()
     for nth in (1, COARSE):
         want = _numpy_residuals(meter, seen, shifts, nth, clip2)
         got = steadiness._residuals(
-            meter.bits[0], halves, meter.rows, meter.cols, meter.h, meter.w, seen,
-            np.array(shifts, dtype=np.intp), nth, clip2, *meter.plans[nth],
+            meter.bank, meter.planes, meter.rows, meter.cols, meter.h, meter.w, seen,
+            np.array(shifts, dtype=np.intp), nth, clip2, *meter.plans[nth], True,
         )  # fmt: skip
-        for a, b in zip(got, want, strict=True):
+        for a, b in zip(got, (want[0], want[2]), strict=True):
             assert a.dtype == b.dtype and np.array_equal(a, b)
     found = 0
-    for d, where in zip(*_numpy_residuals(meter, seen, shifts, 1, clip2)[:2], strict=True):
+    residuals = _numpy_residuals(meter, seen, shifts, 1, clip2)
+    for shift, d, where in zip(shifts, *residuals[:2], strict=True):
         want = _numpy_step(meter, d, where, seen, clip2)
-        ok, su, sv = steadiness._lucas_kanade(d, where, seen, *meter.bits, halves, clip2)
+        ok, su, sv = steadiness._lucas_kanade(
+            d, *shift, meter.bank, meter.planes, meter.rows, meter.cols, meter.h, meter.w, seen,
+            clip2,
+        )  # fmt: skip
         assert ok == (want is not None)
         if want is not None:
             found += 1
