@@ -132,12 +132,13 @@ class ShiftMeter:
         box = np.arange(BOX) - BOX // 2
         box = (box[:, None] * w + box[None, :]).ravel()
         self.at = 3 * (self.flat[:, None] + box[None]).ravel()  # each box's pixels' red bytes
-        # Each plane at each sample, for each shift up to BANK px (row-major over (dv, du)):
-        # (3, (2 BANK + 1)^2, samples), 726 bytes a sample.
+        # Each plane's values (float32) at each sample for each shift up to BANK px (row-major
+        # over (dv, du)): (3, (2 BANK + 1)^2, samples), 1452 bytes a sample.
         reach = np.arange(-BANK, BANK + 1)
         r = np.clip(self.rows[None, None] - reach[:, None, None], 0, h - 1)
         c = np.clip(self.cols[None, None] - reach[None, :, None], 0, w - 1)
-        self.bank = self.planes[:, (r * w + c).reshape(len(reach) ** 2, -1)]
+        where = (r * w + c).reshape(len(reach) ** 2, -1)
+        self.bank = np.stack([a[where].astype(np.float32) for a in (self.grey, self.gu, self.gv)])
         self.plans = {nth: _plan(len(self.rows[::nth])) for nth in (1, COARSE)}  # NumPy's sums
         self.best = np.inf  # the best agreement of a frame so far
         self.last = (0, 0)  # the last frame's whole-pixel shift: the walk starts there
@@ -311,7 +312,6 @@ def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
     mine, off = np.empty(m, np.float32), np.empty(m, np.float32)
     de, a, b = np.empty(m, np.float32), np.empty(m, np.float32), np.empty(m, np.float32)
     sums = np.empty(len(order), np.float32)
-    acc = np.empty(8, np.float32)
 
     def total(x):  # type: ignore[no-untyped-def]
         """NumPy's sum of the float32 values ``x`` (``0 +`` its pairwise sum)."""
@@ -327,19 +327,14 @@ def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
                 for i in range(lo, lo + count):
                     res += x[i]
             else:
-                for t in range(8):
-                    acc[t] = x[lo + t]
-                i = 8
-                while i < count - count % 8:
-                    for t in range(8):
-                        acc[t] += x[lo + i + t]
-                    i += 8
-                res = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + (
-                    (acc[4] + acc[5]) + (acc[6] + acc[7])
-                )
-                while i < count:
-                    res += x[lo + i]
-                    i += 1
+                r0, r1, r2, r3 = x[lo], x[lo + 1], x[lo + 2], x[lo + 3]
+                r4, r5, r6, r7 = x[lo + 4], x[lo + 5], x[lo + 6], x[lo + 7]
+                for i in range(lo + 8, lo + count - count % 8, 8):
+                    r0, r1, r2, r3 = r0 + x[i], r1 + x[i + 1], r2 + x[i + 2], r3 + x[i + 3]
+                    r4, r5, r6, r7 = r4 + x[i + 4], r5 + x[i + 5], r6 + x[i + 6], r7 + x[i + 7]
+                res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+                for i in range(lo + count - count % 8, lo + count):
+                    res += x[i]
             sums[top] = res
             top += 1
         return np.float32(0.0) + sums[0]
@@ -364,7 +359,7 @@ def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
         if abs(du) <= BANK and abs(dv) <= BANK:
             row = bank[0, (dv + BANK) * (2 * BANK + 1) + du + BANK]
             for i in range(m):
-                de[i] = half(row[i * nth])
+                de[i] = row[i * nth]
         else:
             for i in range(m):
                 r = min(max(rows[i * nth] - dv, 0), h - 1)
@@ -424,7 +419,7 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
             count += 1
     if count < MIN_SAMPLES:
         return False, 0.0, 0.0
-    values = np.empty((count, 3), np.uint16)
+    values = np.empty((count, 3), np.float32)
     if abs(du) <= BANK and abs(dv) <= BANK:
         row = (dv + BANK) * (2 * BANK + 1) + du + BANK
         for t in range(count):
@@ -435,10 +430,10 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
             i = kept[t]
             q = min(max(rows[i] - dv, 0), h - 1) * w + min(max(cols[i] - du, 0), w - 1)
             for p in range(3):
-                values[t, p] = planes[p, q]
+                values[t, p] = half(planes[p, q])
     for t in range(count):
-        a[0] = half(values[t, 0])
-        a[2], a[3] = -np.float64(half(values[t, 1])), -np.float64(half(values[t, 2]))
+        a[0] = values[t, 0]
+        a[2], a[3] = -np.float64(values[t, 1]), -np.float64(values[t, 2])
         uu += a[2] * a[2]
         uv += a[2] * a[3]
         vv += a[3] * a[3]
