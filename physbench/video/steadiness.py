@@ -165,40 +165,39 @@ class ShiftMeter:
         clip2 = np.float32(CLIP * max(noise, 2.0)) ** 2
 
         def residuals(
-            shifts: list[tuple[int, int]], nth: int = 1, full: bool = False
+            centre: tuple[int, int], around: np.ndarray, nth: int = 1, full: bool = False
         ) -> tuple[np.ndarray, np.ndarray]:
-            """Per whole-pixel shift, the background's samples there (every ``nth``) in the
-            frame's light (a gain and an offset fitted at that shift: the light meter's, fitted
-            at none, is off where the picture moved) less the frame's (a picture moved by +du
-            shows at u what was at u - du), where ``full`` (else none), and the clipped mean
-            squared disagreement."""
+            """Per whole-pixel shift (``centre`` plus each of ``around``), the background's
+            samples there (every ``nth``) in the frame's light (a gain and an offset fitted at
+            that shift: the light meter's, fitted at none, is off where the picture moved) less
+            the frame's (a picture moved by +du shows at u what was at u - du), where ``full``
+            (else none), and the clipped mean squared disagreement."""
             return _residuals(
-                self.bank, self.planes, self.rows, self.cols, self.h, self.w, seen,
-                np.array(shifts, dtype=np.intp), nth, clip2, *self.plans[nth], full,
+                self.bank, self.planes, self.rows, self.cols, self.h, self.w, seen, *centre,
+                around, nth, clip2, *self.plans[nth], full,
             )  # fmt: skip
 
-        def cost(shifts: list[tuple[int, int]], nth: int = 1) -> np.ndarray:
+        def cost(centre: tuple[int, int], around: np.ndarray, nth: int = 1) -> np.ndarray:
             """The clipped mean squared disagreement at each shift (on every ``nth`` sample)."""
-            return residuals(shifts, nth)[1]
+            return residuals(centre, around, nth)[1]
 
         centre = self.last
-        at_last = residuals([centre], full=True)
+        at_last = residuals(centre, _HERE, full=True)
         here = float(at_last[1][0])
         if not np.isfinite(self.best) or here > WORSE * self.best:  # off the last frame's shift
             centre, here = self._walk(centre, cost)
         if np.isfinite(self.best) and here > WORSE * self.best:
-            every = _around((0, 0), SEARCH)
-            few = [every[k] for k in np.argsort(cost(every, COARSE), kind="stable")[:FEW]]
-            agree = cost(few)
+            few = _SEARCH[np.argsort(cost((0, 0), _SEARCH, COARSE), kind="stable")[:FEW]]
+            agree = cost((0, 0), few)
             k = int(np.argmin(agree))
             if agree[k] < BETTER * here:
-                centre, here = self._walk(few[k], cost)
+                centre, here = self._walk((int(few[k, 0]), int(few[k, 1])), cost)
         self.best = min(self.best, here)
         # A step of over half a pixel moves to the next whole pixel and steps again from there;
         # back at a pixel already stepped from, it ends at the shortest step taken.
         steps: dict[tuple[int, int], tuple[float, float]] = {}
         while centre not in steps and len(steps) < 3:
-            d = (at_last if centre == self.last else residuals([centre], full=True))[0]
+            d = (at_last if centre == self.last else residuals(centre, _HERE, full=True))[0]
             got = self._between(d[0], centre, seen, clip2)
             steps[centre] = (0.0, 0.0) if got is None else got
             if got is None or (abs(got[0]) <= 0.5 and abs(got[1]) <= 0.5):
@@ -223,29 +222,29 @@ class ShiftMeter:
 
     @staticmethod
     def _walk(
-        centre: tuple[int, int], cost: Callable[[list[tuple[int, int]]], np.ndarray]
+        centre: tuple[int, int], cost: Callable[[tuple[int, int], np.ndarray], np.ndarray]
     ) -> tuple[tuple[int, int], float]:
         """Downhill from ``centre`` over whole-pixel shifts, a 3 x 3 neighbourhood at a time, to
         where no neighbour agrees better by :data:`STEEP`; that shift and its cost."""
         costs = np.zeros(9)
         for _ in range(STEPS):
-            costs = cost(_around(centre, 1))
+            costs = cost(centre, _NEAR)
             k = int(np.argmin(costs))
             if k == 4 or costs[k] > STEEP * costs[4]:
                 break
             centre = (centre[0] + k % 3 - 1, centre[1] + k // 3 - 1)
         else:
-            costs = cost(_around(centre, 1))
+            costs = cost(centre, _NEAR)
         return centre, float(costs[4])
 
 
-def _around(centre: tuple[int, int], radius: int) -> list[tuple[int, int]]:
-    """The whole-pixel shifts within ``radius`` of ``centre``, row-major over (dv, du)."""
-    return [
-        (centre[0] + du, centre[1] + dv)
-        for dv in range(-radius, radius + 1)
-        for du in range(-radius, radius + 1)
-    ]
+def _around(radius: int) -> np.ndarray:
+    """The whole-pixel shifts ``(du, dv)`` within ``radius`` of none, row-major over (dv, du)."""
+    span = 2 * radius + 1
+    return np.column_stack(np.divmod(np.arange(span * span), span)[::-1]) - radius
+
+
+_HERE, _NEAR, _SEARCH = _around(0), _around(1), _around(SEARCH)
 
 
 #: A float16's scale by its exponent bits: its 11-bit significand (10 bits and the leading 1,
@@ -280,25 +279,31 @@ def _box_means(flat, at, n):  # type: ignore[no-untyped-def]
     pixels' red bytes ``(n * BOX * BOX,)``, row by row; float32 as ``ShiftMeter.measure`` had
     it in NumPy (the channels summed, the mean of each box, a third of it). The sums are of
     whole numbers, so exact in any order: summed as integers, a box's row (``3 BOX`` bytes) at
-    a time."""
+    a time, each row's first byte read in a pass of their own, whose reads (mostly cache misses
+    in the tracker) overlap."""
+    first = np.empty(len(at) // BOX, np.int32)
+    for j in range(len(first)):
+        first[j] = flat[at[j * BOX]]
     seen = np.empty(n, np.float32)
-    per = len(at) // n
+    per = len(first) // n
     for i in range(n):
         total = 0
-        for j in range(i * per, (i + 1) * per, BOX):
-            q = at[j]
-            for t in range(3 * BOX):
-                total += np.int32(flat[q + t])
-        seen[i] = np.float32(np.float32(np.float64(total) / per) / np.float32(3.0))
+        for j in range(i * per, (i + 1) * per):
+            total += first[j]
+            for t in range(1, 3 * BOX):
+                total += np.int32(flat[at[j * BOX] + t])
+        seen[i] = np.float32(np.float32(np.float64(total) / (per * BOX)) / np.float32(3.0))
     return seen
 
 
 @jit
-def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks, order, full):  # type: ignore[no-untyped-def]
-    """``residuals`` of :meth:`ShiftMeter.measure` at each of ``shifts`` ``(K, 2)`` on every
-    ``nth`` of the samples at ``rows``, ``cols`` (``seen`` the frame's grey there): the
-    residuals ``(K, m)`` where ``full`` (else none) and each shift's clipped mean squared
-    residual. The background is read from ``bank`` (``ShiftMeter.bank``) where it holds the
+def _residuals(  # type: ignore[no-untyped-def]
+    bank, planes, rows, cols, h, w, seen, cu, cv, around, nth, clip2, blocks, order, full
+):
+    """``residuals`` of :meth:`ShiftMeter.measure` at ``(cu, cv)`` plus each of ``around``
+    ``(K, 2)``, on every ``nth`` of the samples at ``rows``, ``cols`` (``seen`` the frame's grey
+    there): the residuals ``(K, m)`` where ``full`` (else none) and each shift's clipped mean
+    squared residual. The background is read from ``bank`` (``ShiftMeter.bank``) where it holds the
     shift, else from ``planes`` at the sample less the shift, clamped to the picture.
 
     Each row of background samples ``e`` is fitted to the frame's ``s`` by least squares (``gain
@@ -306,7 +311,7 @@ def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
     1e-6)``), as NumPy computed it in float32, each sum NumPy's pairwise one (``blocks``,
     ``order``: :func:`_plan` of ``m``): the results are the same to the bit."""
     m = (len(rows) + nth - 1) // nth
-    k = len(shifts)
+    k = len(around)
     d = np.empty((k if full else 0, m), np.float32)
     cost = np.empty(k, np.float32)
     mine, off = np.empty(m, np.float32), np.empty(m, np.float32)
@@ -354,8 +359,9 @@ def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
     for i in range(m):
         off[i] = mine[i] - sm
     floor = np.float32(1e-6)
+    got = np.empty(4, np.float32)
     for j in range(k):
-        du, dv = shifts[j, 0], shifts[j, 1]
+        du, dv = cu + around[j, 0], cv + around[j, 1]
         if abs(du) <= BANK and abs(dv) <= BANK:
             row = bank[0, (dv + BANK) * (2 * BANK + 1) + du + BANK]
             for i in range(m):
@@ -365,18 +371,26 @@ def _residuals(bank, planes, rows, cols, h, w, seen, shifts, nth, clip2, blocks,
                 r = min(max(rows[i * nth] - dv, 0), h - 1)
                 c = min(max(cols[i * nth] - du, 0), w - 1)
                 de[i] = half(planes[0, r * w + c])
-        em = np.float32(np.float64(total(de)) / m)
-        for i in range(m):
-            de[i] = de[i] - em
-            a[i] = de[i] * off[i]
-            b[i] = de[i] * de[i]
-        gain = total(a) / max(total(b), floor)
-        for i in range(m):
-            res = (gain * de[i] + sm) - mine[i]
-            if full:
-                d[j, i] = res
-            a[i] = min(res * res, clip2)
-        cost[j] = np.float32(np.float64(total(a)) / m)
+        # The shift's four sums (of e; of (e - mean e)(s - mean s) and (e - mean e)^2; of the
+        # clipped squared residuals) at one call of `total`: numba copies a closure into each
+        # place it is called from, and each copy added about 1.1 s to the compile (8.0 s with
+        # five, 4.6 s with two).
+        for q in range(4):
+            if q == 1:
+                em = np.float32(np.float64(got[0]) / m)
+                for i in range(m):
+                    de[i] = de[i] - em
+                    a[i] = de[i] * off[i]
+                    b[i] = de[i] * de[i]
+            elif q == 3:
+                gain = got[1] / max(got[2], floor)
+                for i in range(m):
+                    res = (gain * de[i] + sm) - mine[i]
+                    if full:
+                        d[j, i] = res
+                    a[i] = min(res * res, clip2)
+            got[q] = total(de if q == 0 else b if q == 2 else a)
+        cost[j] = np.float32(np.float64(got[3]) / m)
     return d, cost
 
 
@@ -390,8 +404,33 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
     (OpenBLAS 0.3.31, AMD EPYC), where BLAS's sums came out the same; elsewhere to rounding. An
     exactly zero pivot, which LAPACK calls singular, finds nothing."""
     n = len(d)
-    size = np.sort(np.abs(d))
-    mid = size[n // 2] if n % 2 else np.float32(np.float64(size[n // 2 - 1] + size[n // 2]) / 2)
+    # The median of |d| as np.median finds it: the middle one, or the mean of the middle two
+    # (float32), found by quickselect (np.sort or np.partition takes 4-15 s to compile).
+    size = np.abs(d)
+    lo, hi, k = 0, n - 1, n // 2
+    while lo < hi:
+        pivot = size[(lo + hi) // 2]
+        i, j = lo, hi
+        while i <= j:
+            while size[i] < pivot:
+                i += 1
+            while size[j] > pivot:
+                j -= 1
+            if i <= j:
+                size[i], size[j] = size[j], size[i]
+                i, j = i + 1, j - 1
+        if k <= j:
+            hi = j
+        elif k >= i:
+            lo = i
+        else:
+            break
+    mid = size[k]
+    if n % 2 == 0:  # every value before the k-th is at most it: the largest is the other
+        below = size[0]
+        for i in range(1, k):
+            below = max(below, size[i])
+        mid = np.float32(np.float64(below + mid) / 2)
     # Squares as products: Python's ** 2 (libm's pow) is a last bit off for about 0.1 % of
     # values, which moves the float32 bound only where it lies on a float32 rounding boundary.
     bound = CLIP * max(1.4826 * np.float64(mid), 1.0)

@@ -114,7 +114,7 @@ def test_the_compiled_loops_compute_what_numpy_did() -> None:
     for nth in (1, COARSE):
         want = _numpy_residuals(meter, seen, shifts, nth, clip2)
         got = steadiness._residuals(
-            meter.bank, meter.planes, meter.rows, meter.cols, meter.h, meter.w, seen,
+            meter.bank, meter.planes, meter.rows, meter.cols, meter.h, meter.w, seen, 0, 0,
             np.array(shifts, dtype=np.intp), nth, clip2, *meter.plans[nth], True,
         )  # fmt: skip
         for a, b in zip(got, (want[0], want[2]), strict=True):
