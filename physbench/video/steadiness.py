@@ -151,9 +151,9 @@ class ShiftMeter:
 
     def measure(self, image: np.ndarray, light: Light) -> Shift | None:
         """Called by the tracker once per frame, after the frame's light is measured: the shift
-        of ``image`` against the background (``None`` where the background has too little
-        texture to tell). Bodies need not be left out: their few samples are clipped, and
-        clipped alike at every shift."""
+        of ``image`` (``(H, W, 3)`` uint8, as the background) against the background (``None``
+        where the background has too little texture to tell). Bodies need not be left out:
+        their few samples are clipped, and clipped alike at every shift."""
         if not self.usable:
             return None
         seen = _box_means(image.reshape(-1), self.at, len(self.flat))
@@ -405,7 +405,7 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
     exactly zero pivot, which LAPACK calls singular, finds nothing."""
     n = len(d)
     # The median of |d| as np.median finds it: the middle one, or the mean of the middle two
-    # (float32), found by quickselect (np.sort or np.partition takes 4-15 s to compile).
+    # (float32), by quickselect: np.partition added 14 s to this loop's compile.
     size = np.abs(d)
     lo, hi, k = 0, n - 1, n // 2
     while lo < hi:
@@ -435,10 +435,6 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
     # values, which moves the float32 bound only where it lies on a float32 rounding boundary.
     bound = CLIP * max(1.4826 * np.float64(mid), 1.0)
     keep = np.float32(min(np.float64(clip2), bound * bound))
-    m = np.zeros((4, 4))
-    rhs = np.zeros(4)
-    a = np.ones(4)
-    uu = uv = vv = 0.0
 
     def half(bits):  # type: ignore[no-untyped-def]
         """The float16 of ``bits`` as a float32."""
@@ -470,17 +466,20 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
             q = min(max(rows[i] - dv, 0), h - 1) * w + min(max(cols[i] - du, 0), w - 1)
             for p in range(3):
                 values[t, p] = half(planes[p, q])
+    # The normal equations of the columns (e, 1, -gu, -gv), each sum in sample order; the
+    # matrix is symmetric (as NumPy's a.T @ a came out), and gu @ gu, gu @ gv and gv @ gv are
+    # three of its sums.
+    ee = e1 = eu = ev = u1 = v1 = uu = uv = vv = es = s1 = us = vs = 0.0
     for t in range(count):
-        a[0] = values[t, 0]
-        a[2], a[3] = -np.float64(values[t, 1]), -np.float64(values[t, 2])
-        uu += a[2] * a[2]
-        uv += a[2] * a[3]
-        vv += a[3] * a[3]
+        e, u, v = np.float64(values[t, 0]), -np.float64(values[t, 1]), -np.float64(values[t, 2])
         s = np.float64(seen[kept[t]])
-        for p in range(4):
-            rhs[p] += a[p] * s
-            for r in range(4):
-                m[p, r] += a[p] * a[r]
+        ee, e1, eu, ev = ee + e * e, e1 + e, eu + e * u, ev + e * v
+        u1, v1, uu, uv, vv = u1 + u, v1 + v, uu + u * u, uv + u * v, vv + v * v
+        es, s1, us, vs = es + e * s, s1 + s, us + u * s, vs + v * s
+    m = np.array(
+        [[ee, e1, eu, ev], [e1, np.float64(count), u1, v1], [eu, u1, uu, uv], [ev, v1, uv, vv]]
+    )
+    rhs = np.array([es, s1, us, vs])
     if not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
         return False, 0.0, 0.0  # edges of one direction only
     # LU with partial pivoting as OpenBLAS's dgetf2 (column by column, each entry less one dot
