@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from physbench.video.compiled import jit
 from physbench.video.photometry import Light
 
 #: Side (px) of the box a sample averages.
@@ -76,6 +77,9 @@ MIN_SAMPLES = 20
 #: than its best frame in frames where nothing moved, so the search runs in about half of them.
 COARSE = 4
 FEW = 3
+#: The background's values at each sample are kept for every shift up to this (px, each axis):
+#: the search's and its walks' first steps. Read in a row each, not scattered over the picture.
+BANK = SEARCH + 1
 
 
 @dataclass(frozen=True)
@@ -105,10 +109,13 @@ class ShiftMeter:
         for k in range(3):
             grey += ndimage.uniform_filter(background[..., k].astype(np.float32), BOX)
         grey /= np.float32(3.0)
-        self.grey = grey.ravel().astype(np.float16)
+        # The compiled loops read float16 by its bits (numba has no float16): one array of them.
+        self.planes = np.empty((3, h * w), np.uint16)
+        self.grey, self.gu, self.gv = (plane.view(np.float16) for plane in self.planes)
+        self.grey[:] = grey.ravel().astype(np.float16)
         gv, gu = np.gradient(grey)
         del grey
-        self.gu, self.gv = gu.astype(np.float16).ravel(), gv.astype(np.float16).ravel()
+        self.gu[:], self.gv[:] = gu.astype(np.float16).ravel(), gv.astype(np.float16).ravel()
         steep = np.hypot(gu, gv)
         del gu, gv
         rows, cols = [], []
@@ -125,6 +132,14 @@ class ShiftMeter:
         box = np.arange(BOX) - BOX // 2
         box = (box[:, None] * w + box[None, :]).ravel()
         self.at = 3 * (self.flat[:, None] + box[None]).ravel()  # each box's pixels' red bytes
+        # Each plane's values (float32) at each sample for each shift up to BANK px (row-major
+        # over (dv, du)): (3, (2 BANK + 1)^2, samples), 1452 bytes a sample.
+        reach = np.arange(-BANK, BANK + 1)
+        r = np.clip(self.rows[None, None] - reach[:, None, None], 0, h - 1)
+        c = np.clip(self.cols[None, None] - reach[None, :, None], 0, w - 1)
+        where = (r * w + c).reshape(len(reach) ** 2, -1)
+        self.bank = np.stack([a[where].astype(np.float32) for a in (self.grey, self.gu, self.gv)])
+        self.plans = {nth: _plan(len(self.rows[::nth])) for nth in (1, COARSE)}  # NumPy's sums
         self.best = np.inf  # the best agreement of a frame so far
         self.last = (0, 0)  # the last frame's whole-pixel shift: the walk starts there
         self.noise = np.inf  # the least noise of a frame so far (grey levels)
@@ -136,14 +151,12 @@ class ShiftMeter:
 
     def measure(self, image: np.ndarray, light: Light) -> Shift | None:
         """Called by the tracker once per frame, after the frame's light is measured: the shift
-        of ``image`` against the background (``None`` where the background has too little
-        texture to tell). Bodies need not be left out: their few samples are clipped, and
-        clipped alike at every shift."""
+        of ``image`` (``(H, W, 3)`` uint8, as the background) against the background (``None``
+        where the background has too little texture to tell). Bodies need not be left out:
+        their few samples are clipped, and clipped alike at every shift."""
         if not self.usable:
             return None
-        flat = image.reshape(-1)
-        seen = sum(flat.take(self.at + k).astype(np.float32) for k in range(3))
-        seen = seen.reshape(len(self.flat), -1).mean(axis=1) / np.float32(3.0)
+        seen = _box_means(image.reshape(-1), self.at, len(self.flat))
         # The frame's noise as the light meter measured it is inflated where the picture moved
         # (every edge disagrees): the least of the clip's frames is its noise.
         if light.samples:
@@ -151,47 +164,41 @@ class ShiftMeter:
         noise = light.sigma if np.isinf(self.noise) else self.noise
         clip2 = np.float32(CLIP * max(noise, 2.0)) ** 2
 
-        def residuals(shifts: list[tuple[int, int]], nth: int = 1) -> tuple[np.ndarray, np.ndarray]:
-            """Per whole-pixel shift, the background's samples there (every ``nth``) in the
-            frame's light (a gain and an offset fitted at that shift: the light meter's, fitted
-            at none, is off where the picture moved) less the frame's (a picture moved by +du
-            shows at u what was at u - du), and where they are read."""
-            du = np.array([s[0] for s in shifts])[:, None]
-            dv = np.array([s[1] for s in shifts])[:, None]
-            rows, cols = self.rows[None, ::nth], self.cols[None, ::nth]
-            where = (rows - dv) * self.w + (cols - du)
-            if np.abs(du).max() >= BOX or np.abs(dv).max() >= BOX:  # may leave the picture
-                r = np.minimum(np.maximum(rows - dv, 0), self.h - 1)
-                c = np.minimum(np.maximum(cols - du, 0), self.w - 1)
-                where = r * self.w + c
-            e = self.grey.take(where).astype(np.float32)
-            mine = seen[::nth]
-            return _in_light(e, mine) - mine, where
+        def residuals(
+            centre: tuple[int, int], around: np.ndarray, nth: int = 1, full: bool = False
+        ) -> tuple[np.ndarray, np.ndarray]:
+            """Per whole-pixel shift (``centre`` plus each of ``around``), the background's
+            samples there (every ``nth``) in the frame's light (a gain and an offset fitted at
+            that shift: the light meter's, fitted at none, is off where the picture moved) less
+            the frame's (a picture moved by +du shows at u what was at u - du), where ``full``
+            (else none), and the clipped mean squared disagreement."""
+            return _residuals(
+                self.bank, self.planes, self.rows, self.cols, self.h, self.w, seen, *centre,
+                around, nth, clip2, *self.plans[nth], full,
+            )  # fmt: skip
 
-        def cost(shifts: list[tuple[int, int]], nth: int = 1) -> np.ndarray:
+        def cost(centre: tuple[int, int], around: np.ndarray, nth: int = 1) -> np.ndarray:
             """The clipped mean squared disagreement at each shift (on every ``nth`` sample)."""
-            d = residuals(shifts, nth)[0]
-            return np.minimum(d * d, clip2).mean(axis=1)
+            return residuals(centre, around, nth)[1]
 
         centre = self.last
-        at_last = residuals([centre])
-        here = float(np.minimum(at_last[0] ** 2, clip2).mean())
+        at_last = residuals(centre, _HERE, full=True)
+        here = float(at_last[1][0])
         if not np.isfinite(self.best) or here > WORSE * self.best:  # off the last frame's shift
             centre, here = self._walk(centre, cost)
         if np.isfinite(self.best) and here > WORSE * self.best:
-            every = _around((0, 0), SEARCH)
-            few = [every[k] for k in np.argsort(cost(every, COARSE), kind="stable")[:FEW]]
-            agree = cost(few)
+            few = _SEARCH[np.argsort(cost((0, 0), _SEARCH, COARSE), kind="stable")[:FEW]]
+            agree = cost((0, 0), few)
             k = int(np.argmin(agree))
             if agree[k] < BETTER * here:
-                centre, here = self._walk(few[k], cost)
+                centre, here = self._walk((int(few[k, 0]), int(few[k, 1])), cost)
         self.best = min(self.best, here)
         # A step of over half a pixel moves to the next whole pixel and steps again from there;
         # back at a pixel already stepped from, it ends at the shortest step taken.
         steps: dict[tuple[int, int], tuple[float, float]] = {}
         while centre not in steps and len(steps) < 3:
-            d, where = at_last if centre == self.last else residuals([centre])
-            got = self._between(d[0], where[0], seen, clip2)
+            d = (at_last if centre == self.last else residuals(centre, _HERE, full=True))[0]
+            got = self._between(d[0], centre, seen, clip2)
             steps[centre] = (0.0, 0.0) if got is None else got
             if got is None or (abs(got[0]) <= 0.5 and abs(got[1]) <= 0.5):
                 break
@@ -201,66 +208,319 @@ class ShiftMeter:
         return Shift(centre[0] + steps[centre][0], centre[1] + steps[centre][1])
 
     def _between(
-        self, d: np.ndarray, where: np.ndarray, seen: np.ndarray, clip2: np.float32
+        self, d: np.ndarray, shift: tuple[int, int], seen: np.ndarray, clip2: np.float32
     ) -> tuple[float, float] | None:
-        """The shift between whole pixels from the residuals ``d`` at a whole-pixel shift, read
-        at ``where``: a Lucas-Kanade step with the light fitted with it (frame = gain
+        """The shift between whole pixels from the residuals ``d`` at whole-pixel ``shift``: a
+        Lucas-Kanade step with the light fitted with it (frame = gain
         background(u - s) + offset, linear in the gain, the offset and gain times s), on the
         samples that agree (clipped ones left out), each axis within a pixel; ``None`` where
         the samples' edges run one way only."""
-        spread = 1.4826 * float(np.median(np.abs(d)))  # what is left of the noise, and any body
-        ok = d * d < min(float(clip2), (CLIP * max(spread, 1.0)) ** 2)
-        if ok.sum() < MIN_SAMPLES:
-            return None
-        where = where[ok]
-        e = self.grey.take(where).astype(np.float64)
-        gu = self.gu.take(where).astype(np.float64)
-        gv = self.gv.take(where).astype(np.float64)
-        uu, uv, vv = float(gu @ gu), float(gu @ gv), float(gv @ gv)
-        if not uu * vv - uv * uv > 1e-6 * (uu + vv) ** 2:
-            return None  # edges of one direction only
-        a = np.column_stack([e, np.ones_like(e), -gu, -gv])
-        try:
-            gain, _, pu, pv = np.linalg.solve(a.T @ a, a.T @ seen[ok].astype(np.float64))
-        except np.linalg.LinAlgError:
-            return None
-        if not gain > 0.1:
-            return None
-        return min(max(pu / gain, -1.0), 1.0), min(max(pv / gain, -1.0), 1.0)
+        ok, su, sv = _lucas_kanade(
+            d, *shift, self.bank, self.planes, self.rows, self.cols, self.h, self.w, seen, clip2
+        )
+        return (su, sv) if ok else None
 
     @staticmethod
     def _walk(
-        centre: tuple[int, int], cost: Callable[[list[tuple[int, int]]], np.ndarray]
+        centre: tuple[int, int], cost: Callable[[tuple[int, int], np.ndarray], np.ndarray]
     ) -> tuple[tuple[int, int], float]:
         """Downhill from ``centre`` over whole-pixel shifts, a 3 x 3 neighbourhood at a time, to
         where no neighbour agrees better by :data:`STEEP`; that shift and its cost."""
         costs = np.zeros(9)
         for _ in range(STEPS):
-            costs = cost(_around(centre, 1))
+            costs = cost(centre, _NEAR)
             k = int(np.argmin(costs))
             if k == 4 or costs[k] > STEEP * costs[4]:
                 break
             centre = (centre[0] + k % 3 - 1, centre[1] + k // 3 - 1)
         else:
-            costs = cost(_around(centre, 1))
+            costs = cost(centre, _NEAR)
         return centre, float(costs[4])
 
 
-def _around(centre: tuple[int, int], radius: int) -> list[tuple[int, int]]:
-    """The whole-pixel shifts within ``radius`` of ``centre``, row-major over (dv, du)."""
-    return [
-        (centre[0] + du, centre[1] + dv)
-        for dv in range(-radius, radius + 1)
-        for du in range(-radius, radius + 1)
-    ]
+def _around(radius: int) -> np.ndarray:
+    """The whole-pixel shifts ``(du, dv)`` within ``radius`` of none, row-major over (dv, du)."""
+    span = 2 * radius + 1
+    return np.column_stack(np.divmod(np.arange(span * span), span)[::-1]) - radius
 
 
-def _in_light(e: np.ndarray, seen: np.ndarray) -> np.ndarray:
-    """Each row of background samples ``e`` ``(K, n)`` in the light that fits ``seen`` ``(n,)``
-    best: ``gain e + offset`` by least squares, per row."""
-    em, sm = e.mean(axis=1, keepdims=True), seen.mean()
-    de = e - em
-    gain = (de * (seen - sm)).sum(axis=1, keepdims=True) / np.maximum(
-        (de * de).sum(axis=1, keepdims=True), 1e-6
+_HERE, _NEAR, _SEARCH = _around(0), _around(1), _around(SEARCH)
+
+
+#: A float16's scale by its exponent bits: its 11-bit significand (10 bits and the leading 1,
+#: none where the exponent is 0) times this.
+_SCALE = np.array([2.0 ** (max(e, 1) - 25) for e in range(32)], np.float32)
+
+
+def _plan(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """How NumPy sums ``n`` float32 values along a row, pairwise: halves split at a multiple of
+    8 down to blocks of at most 128, each summed by 8 accumulators. The blocks ``(start,
+    count)`` and the order to add them in (postfix: a block's index, or -1 to add the last two
+    sums)."""
+    blocks: list[tuple[int, int]] = []
+    order: list[int] = []
+    parts = [(0, n)]  # depth first, left before right; (-1, 0) adds the two sums before it
+    while parts:
+        start, count = parts.pop()
+        if start < 0:
+            order.append(-1)
+        elif count <= 128:
+            order.append(len(blocks))
+            blocks.append((start, count))
+        else:
+            half = count // 2 - count // 2 % 8
+            parts += [(-1, 0), (start + half, count - half), (start, half)]
+    return np.array(blocks, dtype=np.intp).reshape(-1, 2), np.array(order, dtype=np.intp)
+
+
+@jit
+def _box_means(flat, at, n):  # type: ignore[no-untyped-def]
+    """The frame's grey over each sample's box: ``flat`` the frame's bytes, ``at`` each box's
+    pixels' red bytes ``(n * BOX * BOX,)``, row by row; float32 as ``ShiftMeter.measure`` had
+    it in NumPy (the channels summed, the mean of each box, a third of it). The sums are of
+    whole numbers, so exact in any order: summed as integers, a box's row (``3 BOX`` bytes) at
+    a time, each row's first byte read in a pass of their own, whose reads (mostly cache misses
+    in the tracker) overlap."""
+    first = np.empty(len(at) // BOX, np.int32)
+    for j in range(len(first)):
+        first[j] = flat[at[j * BOX]]
+    seen = np.empty(n, np.float32)
+    per = len(first) // n
+    for i in range(n):
+        total = 0
+        for j in range(i * per, (i + 1) * per):
+            total += first[j]
+            for t in range(1, 3 * BOX):
+                total += np.int32(flat[at[j * BOX] + t])
+        seen[i] = np.float32(np.float32(np.float64(total) / (per * BOX)) / np.float32(3.0))
+    return seen
+
+
+@jit
+def _residuals(  # type: ignore[no-untyped-def]
+    bank, planes, rows, cols, h, w, seen, cu, cv, around, nth, clip2, blocks, order, full
+):
+    """``residuals`` of :meth:`ShiftMeter.measure` at ``(cu, cv)`` plus each of ``around``
+    ``(K, 2)``, on every ``nth`` of the samples at ``rows``, ``cols`` (``seen`` the frame's grey
+    there): the residuals ``(K, m)`` where ``full`` (else none) and each shift's clipped mean
+    squared residual. The background is read from ``bank`` (``ShiftMeter.bank``) where it holds the
+    shift, else from ``planes`` at the sample less the shift, clamped to the picture.
+
+    Each row of background samples ``e`` is fitted to the frame's ``s`` by least squares (``gain
+    (e - mean e) + mean s``, gain ``sum((e - mean e)(s - mean s)) / max(sum((e - mean e)^2),
+    1e-6)``), as NumPy computed it in float32, each sum NumPy's pairwise one (``blocks``,
+    ``order``: :func:`_plan` of ``m``): the results are the same to the bit."""
+    m = (len(rows) + nth - 1) // nth
+    k = len(around)
+    d = np.empty((k if full else 0, m), np.float32)
+    cost = np.empty(k, np.float32)
+    mine, off = np.empty(m, np.float32), np.empty(m, np.float32)
+    de, a, b = np.empty(m, np.float32), np.empty(m, np.float32), np.empty(m, np.float32)
+    sums = np.empty(len(order), np.float32)
+
+    def total(x):  # type: ignore[no-untyped-def]
+        """NumPy's sum of the float32 values ``x`` (``0 +`` its pairwise sum)."""
+        top = 0
+        for step in order:
+            if step < 0:
+                top -= 1
+                sums[top - 1] = sums[top - 1] + sums[top]
+                continue
+            lo, count = blocks[step, 0], blocks[step, 1]
+            if count < 8:
+                res = np.float32(0.0)
+                for i in range(lo, lo + count):
+                    res += x[i]
+            else:
+                r0, r1, r2, r3 = x[lo], x[lo + 1], x[lo + 2], x[lo + 3]
+                r4, r5, r6, r7 = x[lo + 4], x[lo + 5], x[lo + 6], x[lo + 7]
+                for i in range(lo + 8, lo + count - count % 8, 8):
+                    r0, r1, r2, r3 = r0 + x[i], r1 + x[i + 1], r2 + x[i + 2], r3 + x[i + 3]
+                    r4, r5, r6, r7 = r4 + x[i + 4], r5 + x[i + 5], r6 + x[i + 6], r7 + x[i + 7]
+                res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+                for i in range(lo + count - count % 8, lo + count):
+                    res += x[i]
+            sums[top] = res
+            top += 1
+        return np.float32(0.0) + sums[0]
+
+    def half(bits):  # type: ignore[no-untyped-def]
+        """The float16 of ``bits`` as a float32."""
+        e = (bits >> 10) & 31
+        if e == 31:
+            v = np.float32(np.inf) if bits & 1023 == 0 else np.float32(np.nan)
+        else:
+            v = np.float32((bits & 1023) + (1024 if e else 0)) * _SCALE[e]
+        return -v if bits & 32768 else v
+
+    for i in range(m):
+        mine[i] = seen[i * nth]
+    sm = np.float32(np.float64(total(mine)) / m)
+    for i in range(m):
+        off[i] = mine[i] - sm
+    floor = np.float32(1e-6)
+    got = np.empty(4, np.float32)
+    for j in range(k):
+        du, dv = cu + around[j, 0], cv + around[j, 1]
+        if abs(du) <= BANK and abs(dv) <= BANK:
+            row = bank[0, (dv + BANK) * (2 * BANK + 1) + du + BANK]
+            for i in range(m):
+                de[i] = row[i * nth]
+        else:
+            for i in range(m):
+                r = min(max(rows[i * nth] - dv, 0), h - 1)
+                c = min(max(cols[i * nth] - du, 0), w - 1)
+                de[i] = half(planes[0, r * w + c])
+        # The shift's four sums (of e; of (e - mean e)(s - mean s) and (e - mean e)^2; of the
+        # clipped squared residuals) at one call of `total`: numba copies a closure into each
+        # place it is called from, and each copy added about 1.1 s to the compile (8.0 s with
+        # five, 4.6 s with two).
+        for q in range(4):
+            if q == 1:
+                em = np.float32(np.float64(got[0]) / m)
+                for i in range(m):
+                    de[i] = de[i] - em
+                    a[i] = de[i] * off[i]
+                    b[i] = de[i] * de[i]
+            elif q == 3:
+                gain = got[1] / max(got[2], floor)
+                for i in range(m):
+                    res = (gain * de[i] + sm) - mine[i]
+                    if full:
+                        d[j, i] = res
+                    a[i] = min(res * res, clip2)
+            got[q] = total(de if q == 0 else b if q == 2 else a)
+        cost[j] = np.float32(np.float64(got[3]) / m)
+    return d, cost
+
+
+@jit
+def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # type: ignore[no-untyped-def]
+    """:meth:`ShiftMeter._between` as ``(found, du, dv)`` from the residuals ``d`` at whole-pixel
+    shift ``(du, dv)`` (the background read as :func:`_residuals` reads it). The median and the
+    mask are NumPy's float32 ones. The normal equations are summed in sample order (their
+    products, of float16 and float32 values, are exact in float64) and solved as OpenBLAS's
+    ``dgesv`` solves them for ``np.linalg.solve``: the same to the bit on the machine measured
+    (OpenBLAS 0.3.31, AMD EPYC), where BLAS's sums came out the same; elsewhere to rounding. An
+    exactly zero pivot, which LAPACK calls singular, finds nothing."""
+    n = len(d)
+    # The median of |d| as np.median finds it: the middle one, or the mean of the middle two
+    # (float32), by quickselect: np.partition added 14 s to this loop's compile.
+    size = np.abs(d)
+    lo, hi, k = 0, n - 1, n // 2
+    while lo < hi:
+        pivot = size[(lo + hi) // 2]
+        i, j = lo, hi
+        while i <= j:
+            while size[i] < pivot:
+                i += 1
+            while size[j] > pivot:
+                j -= 1
+            if i <= j:
+                size[i], size[j] = size[j], size[i]
+                i, j = i + 1, j - 1
+        if k <= j:
+            hi = j
+        elif k >= i:
+            lo = i
+        else:
+            break
+    mid = size[k]
+    if n % 2 == 0:  # every value before the k-th is at most it: the largest is the other
+        below = size[0]
+        for i in range(1, k):
+            below = max(below, size[i])
+        mid = np.float32(np.float64(below + mid) / 2)
+    # Squares as products: Python's ** 2 (libm's pow) is a last bit off for about 0.1 % of
+    # values, which moves the float32 bound only where it lies on a float32 rounding boundary.
+    bound = CLIP * max(1.4826 * np.float64(mid), 1.0)
+    keep = np.float32(min(np.float64(clip2), bound * bound))
+
+    def half(bits):  # type: ignore[no-untyped-def]
+        """The float16 of ``bits`` as a float32."""
+        e = (bits >> 10) & 31
+        if e == 31:
+            v = np.float32(np.inf) if bits & 1023 == 0 else np.float32(np.nan)
+        else:
+            v = np.float32((bits & 1023) + (1024 if e else 0)) * _SCALE[e]
+        return -v if bits & 32768 else v
+
+    # The samples that agree, read first (each read independent of the sums), then summed.
+    kept = np.empty(n, np.intp)
+    count = 0
+    for i in range(n):
+        if d[i] * d[i] < keep:
+            kept[count] = i
+            count += 1
+    if count < MIN_SAMPLES:
+        return False, 0.0, 0.0
+    values = np.empty((count, 3), np.float32)
+    if abs(du) <= BANK and abs(dv) <= BANK:
+        row = (dv + BANK) * (2 * BANK + 1) + du + BANK
+        for t in range(count):
+            for p in range(3):
+                values[t, p] = bank[p, row, kept[t]]
+    else:
+        for t in range(count):
+            i = kept[t]
+            q = min(max(rows[i] - dv, 0), h - 1) * w + min(max(cols[i] - du, 0), w - 1)
+            for p in range(3):
+                values[t, p] = half(planes[p, q])
+    # The normal equations of the columns (e, 1, -gu, -gv), each sum in sample order; the
+    # matrix is symmetric (as NumPy's a.T @ a came out), and gu @ gu, gu @ gv and gv @ gv are
+    # three of its sums.
+    ee = e1 = eu = ev = u1 = v1 = uu = uv = vv = es = s1 = us = vs = 0.0
+    for t in range(count):
+        e, u, v = np.float64(values[t, 0]), -np.float64(values[t, 1]), -np.float64(values[t, 2])
+        s = np.float64(seen[kept[t]])
+        ee, e1, eu, ev = ee + e * e, e1 + e, eu + e * u, ev + e * v
+        u1, v1, uu, uv, vv = u1 + u, v1 + v, uu + u * u, uv + u * v, vv + v * v
+        es, s1, us, vs = es + e * s, s1 + s, us + u * s, vs + v * s
+    m = np.array(
+        [[ee, e1, eu, ev], [e1, np.float64(count), u1, v1], [eu, u1, uu, uv], [ev, v1, uv, vv]]
     )
-    return gain * de + sm
+    rhs = np.array([es, s1, us, vs])
+    if not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
+        return False, 0.0, 0.0  # edges of one direction only
+    # LU with partial pivoting as OpenBLAS's dgetf2 (column by column, each entry less one dot
+    # product; the multipliers scaled by the pivot's reciprocal), then its dgetrs (updates
+    # column by column, dividing by the diagonal). Of 100 systems from shaken walls, textbook
+    # elimination matched np.linalg.solve to the bit in 3; this in all.
+    for j in range(4):
+        for i in range(1, j):
+            dot = 0.0
+            for t in range(i):
+                dot += m[i, t] * m[t, j]
+            m[i, j] -= dot
+        for i in range(j, 4):
+            dot = 0.0
+            for t in range(j):
+                dot += m[i, t] * m[t, j]
+            m[i, j] -= dot
+        p = j
+        for i in range(j + 1, 4):
+            if abs(m[i, j]) > abs(m[p, j]):
+                p = i
+        if m[p, j] == 0.0:
+            return False, 0.0, 0.0  # singular: np.linalg.solve's LinAlgError
+        for t in range(4):
+            m[j, t], m[p, t] = m[p, t], m[j, t]
+        rhs[j], rhs[p] = rhs[p], rhs[j]
+        scale = 1.0 / m[j, j]
+        for i in range(j + 1, 4):
+            m[i, j] *= scale
+    x = rhs
+    for j in range(4):
+        for i in range(j + 1, 4):
+            x[i] += -x[j] * m[i, j]
+    for j in range(3, -1, -1):
+        x[j] /= m[j, j]
+        for i in range(j):
+            x[i] += -x[j] * m[i, j]
+    gain = x[0]
+    if not gain > 0.1:
+        return False, 0.0, 0.0
+    su, sv = x[2] / gain, x[3] / gain
+    su, sv = -1.0 if su < -1.0 else su, -1.0 if sv < -1.0 else sv  # Python's max(s, -1.0)
+    su, sv = 1.0 if su > 1.0 else su, 1.0 if sv > 1.0 else sv  # and min(s, 1.0)
+    return True, su, sv

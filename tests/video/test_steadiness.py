@@ -14,9 +14,10 @@ from physbench.errors import PhysbenchWarning
 from physbench.scene import Body, Circle, Scene
 from physbench.simulators.pymunk_sim import PymunkSimulator
 from physbench.testing.field_camera import FieldCamera
+from physbench.video import steadiness
 from physbench.video.photometry import LightMeter
 from physbench.video.spheres import expose, wall
-from physbench.video.steadiness import ShiftMeter
+from physbench.video.steadiness import COARSE, SEARCH, ShiftMeter
 from physbench.video.track import BodyNotFoundError, TrackLostError, track_video
 from physbench.video.writer import write_video
 
@@ -42,6 +43,95 @@ def test_a_plain_wall_shows_no_shift_and_needs_none() -> None:
     meter = ShiftMeter(background)
     assert not meter.usable
     assert meter.measure(background, LightMeter(background).measure(background)) is None
+
+
+def _numpy_residuals(  # type: ignore[no-untyped-def]
+    meter: ShiftMeter, seen: np.ndarray, shifts, nth: int, clip2: np.float32
+):
+    """The residuals at ``shifts``, where they are read and each shift's cost, as
+    :meth:`ShiftMeter.measure` computed them in NumPy before its loops were compiled."""
+    du = np.array([s[0] for s in shifts])[:, None]
+    dv = np.array([s[1] for s in shifts])[:, None]
+    rows, cols = meter.rows[None, ::nth], meter.cols[None, ::nth]
+    r = np.minimum(np.maximum(rows - dv, 0), meter.h - 1)
+    c = np.minimum(np.maximum(cols - du, 0), meter.w - 1)
+    where = r * meter.w + c
+    e = meter.grey.take(where).astype(np.float32)
+    mine = seen[::nth]
+    em, sm = e.mean(axis=1, keepdims=True), mine.mean()
+    de = e - em
+    gain = (de * (mine - sm)).sum(axis=1, keepdims=True) / np.maximum(
+        (de * de).sum(axis=1, keepdims=True), 1e-6
+    )
+    d = gain * de + sm - mine
+    return d, where, np.minimum(d * d, clip2).mean(axis=1)
+
+
+def _numpy_step(  # type: ignore[no-untyped-def]
+    meter: ShiftMeter, d: np.ndarray, where: np.ndarray, seen: np.ndarray, clip2: np.float32
+):
+    """:meth:`ShiftMeter._between` as it was in NumPy."""
+    spread = 1.4826 * float(np.median(np.abs(d)))
+    ok = d * d < min(float(clip2), (3.0 * max(spread, 1.0)) ** 2)
+    if ok.sum() < 20:
+        return None
+    where = where[ok]
+    e = meter.grey.take(where).astype(np.float64)
+    gu = meter.gu.take(where).astype(np.float64)
+    gv = meter.gv.take(where).astype(np.float64)
+    uu, uv, vv = float(gu @ gu), float(gu @ gv), float(gv @ gv)
+    if not uu * vv - uv * uv > 1e-6 * (uu + vv) ** 2:
+        return None
+    a = np.column_stack([e, np.ones_like(e), -gu, -gv])
+    try:
+        gain, _, pu, pv = np.linalg.solve(a.T @ a, a.T @ seen[ok].astype(np.float64))
+    except np.linalg.LinAlgError:
+        return None
+    if not gain > 0.1:
+        return None
+    return min(max(pu / gain, -1.0), 1.0), min(max(pv / gain, -1.0), 1.0)
+
+
+def test_the_compiled_loops_compute_what_numpy_did() -> None:
+    """On a wall moved by a fraction of a pixel: the frame's box means, the residuals and the
+    costs (every shift within SEARCH px, read from the meter's bank, and one beyond it, on all
+    samples and on every COARSE-th) are NumPy's to the bit; each shift's Lucas-Kanade step
+    within 1e-9 px of NumPy's (to the bit where BLAS sums as the loop does)."""
+    rng = np.random.default_rng(4)
+    plate = wall((240, 320), 4)
+    background = expose(plate.astype(np.float64), rng, noise=0.0)
+    moved = ndimage.shift(plate, (-0.3, 0.4, 0), order=1, mode="nearest")
+    frame = expose(moved, rng, gain=[1.06, 1.04, 0.98], noise=0.01)
+    meter = ShiftMeter(background)
+    flat = frame.reshape(-1)
+    seen = sum(flat.take(meter.at + k).astype(np.float32) for k in range(3))
+    seen = seen.reshape(len(meter.flat), -1).mean(axis=1) / np.float32(3.0)
+    got = steadiness._box_means(flat, meter.at, len(meter.flat))
+    assert got.dtype == np.float32 and np.array_equal(got, seen)
+    clip2 = np.float32(3.0 * 2.5) ** 2
+    shifts = [(du, dv) for dv in range(-SEARCH, SEARCH + 1) for du in range(-SEARCH, SEARCH + 1)]
+    shifts.append((9, -7))
+    for nth in (1, COARSE):
+        want = _numpy_residuals(meter, seen, shifts, nth, clip2)
+        got = steadiness._residuals(
+            meter.bank, meter.planes, meter.rows, meter.cols, meter.h, meter.w, seen, 0, 0,
+            np.array(shifts, dtype=np.intp), nth, clip2, *meter.plans[nth], True,
+        )  # fmt: skip
+        for a, b in zip(got, (want[0], want[2]), strict=True):
+            assert a.dtype == b.dtype and np.array_equal(a, b)
+    found = 0
+    residuals = _numpy_residuals(meter, seen, shifts, 1, clip2)
+    for shift, d, where in zip(shifts, *residuals[:2], strict=True):
+        want = _numpy_step(meter, d, where, seen, clip2)
+        ok, su, sv = steadiness._lucas_kanade(
+            d, *shift, meter.bank, meter.planes, meter.rows, meter.cols, meter.h, meter.w, seen,
+            clip2,
+        )  # fmt: skip
+        assert ok == (want is not None)
+        if want is not None:
+            found += 1
+            assert abs(su - want[0]) <= 1e-9 and abs(sv - want[1]) <= 1e-9, ((su, sv), want)
+    assert found > 10
 
 
 def _toss(knock: tuple[float, float] | None, tmp_path, name: str):  # type: ignore[no-untyped-def]
