@@ -182,26 +182,17 @@ def _ray_edges(flat, base, shape, origin, discs, directions, low):  # type: igno
     """Each disc's rays (``discs`` rows: centre u, v, radius, reach, ray count, inner depth in
     samples, window) sampled on its window's difference (``flat``: the windows' differences
     laid end to end, each from ``base``, ``shape`` ``(h, w)``, top-left pixel ``origin``) and the
-    edge each finds: :class:`Edges`' arrays, for the rays inside their window that find one.
-
-    Along a ray, samples every :data:`STEP` px from 70 % of the radius less :data:`INNER` to
-    the reach, read bilinearly (clamped to the window). The outermost run of :data:`RUN`
-    samples at or above ``low`` ends at the edge: a speck of the wall's texture the light does
-    not quite match, a pixel or so past the rim, is not it. The edge's inner level is where the
-    profile stops falling steeply, walking in from its steepest point near the threshold
-    crossing: the rim's own brightness, not the shading further in (a lit sphere brightens
-    inwards from a limb as dark as the wall). An edge whose inner level is under ``low`` over
-    the outside is placed by the threshold, not by its half-way point: it adds nothing."""
+    edge each finds (:func:`_edge`): :class:`Edges`' arrays, for the rays inside their window
+    that find one. Along a ray, samples every :data:`STEP` px from 70 % of the radius less
+    :data:`INNER` to the reach (:func:`_profile`)."""
     n = 0
     for d in range(len(discs)):
         n += int(discs[d, 4])
-    radius = np.empty(n)
     start = np.empty(n)
     owner = np.empty(n, np.intp)
     ray = 0
     for d in range(len(discs)):
         for _ in range(int(discs[d, 4])):
-            radius[ray] = discs[d, 2]
             start[ray] = max(0.0, 0.7 * discs[d, 2] - INNER)
             owner[ray] = d
             ray += 1
@@ -213,10 +204,7 @@ def _ray_edges(flat, base, shape, origin, discs, directions, low):  # type: igno
     theta, contrast, width, reach = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     halo = np.empty(n, np.bool_)
     kept = np.empty(n, np.intp)
-    p = np.empty(m)
-    s = np.empty(m, np.float32)
-    near = np.empty(m + 2)
-    outer = max(1, round(2.0 / STEP))
+    p, s, near = np.empty(m), np.empty(m, np.float32), np.empty(m + 2)
     count = 0
     for j in range(n):
         d = owner[j]
@@ -224,83 +212,105 @@ def _ray_edges(flat, base, shape, origin, discs, directions, low):  # type: igno
         h, w = shape[win, 0], shape[win, 1]
         cu, cv = discs[d, 0] - origin[win, 1], discs[d, 1] - origin[win, 0]
         du, dv = directions[j, 1], directions[j, 2]
-        length = discs[d, 3] - start[j]
-        steps = min(int(np.floor(length / STEP)) + 1, m)
+        steps = min(int(np.floor((discs[d, 3] - start[j]) / STEP)) + 1, m)
         # Rays are straight: inside the window where both their ends are.
         inside = True
         for far in (start[j], start[j] + STEP * (steps - 1)):
             eu, ev = cu + du * far, cv + dv * far
             inside &= eu >= 0 and eu <= w - 1 and ev >= 0 and ev <= h - 1
-        top_row, top_col = np.float32(h - 1.001), np.float32(w - 1.001)
-        fu, fv, fdu, fdv = np.float32(cu), np.float32(cv), np.float32(du), np.float32(dv)
-        b = base[win]
-        for i in range(m):
-            s[i] = np.float32(start[j] + STEP * i)
-            r = min(max(fv + fdv * s[i], np.float32(0.0)), top_row)
-            c = min(max(fu + fdu * s[i], np.float32(0.0)), top_col)
-            r0, c0 = int(r), int(c)
-            fr, fc = np.float64(r) - r0, np.float64(c) - c0
-            q = r0 * w + c0 + b
-            a0, a1 = np.float32(flat[q]), np.float32(flat[q + 1])
-            upper = np.float64(a0) + np.float64(a1 - a0) * fc
-            a0, a1 = np.float32(flat[q + w]), np.float32(flat[q + w + 1])
-            lower = np.float64(a0) + np.float64(a1 - a0) * fc
-            p[i] = upper + (lower - upper) * fr
-        last = -1
-        for i in range(min(steps, m) - 1, RUN - 2, -1):
-            run = True
-            for q in range(i - RUN + 1, i + 1):
-                run &= p[q] >= low
-            if run:
-                last = i
-                break
-        good = inside and last >= 0 and last < steps - 1
-        if last < 0:
-            last = m - 1
-        k = int(discs[d, 5])
-        for t in range(k + 2):  # inside out
-            near[t] = p[min(max(last - k + t, 0), m - 1)]
-        # The steepest fall over one step out of the last `outer` (the first of equals).
-        first = k + 1 - outer
-        lo = max(first, 0)
-        at = lo
-        for t in range(lo + 1, k + 1):
-            if near[t] - near[t + 1] > near[at] - near[at + 1]:
-                at = t
-        steep = first + at - lo  # below 0 (an inner depth under `outer`): counted from the end
-        top = near[steep % (k + 1)] - near[steep % (k + 1) + 1]
-        shoulder = 0
-        for t in range(min(steep, k + 1) - 1, -1, -1):
-            if near[t] - near[t + 1] < 0.3 * top:
-                shoulder = t
-                break
-        inner, outside = near[shoulder], near[k + 1]
-        good &= inner - outside >= low
-        level = 0.5 * (inner + outside)
-        # The outermost sample at or above the level, and the next one out (below it).
-        jj = k
-        for t in range(k, -1, -1):
-            if near[t] >= level:
-                jj = t
-                break
-        frac = (near[jj] - level) / max(near[jj] - near[jj + 1], 1e-6)
-        dist = np.float64(s[min(max(last - k + jj, 0), m - 1)]) + STEP * min(max(frac, 0.0), 1.0)
-        if not good:
+        _profile(flat, base[win], h, w, cu, cv, du, dv, start[j], p, s)
+        good, dist, rise, wide, faint = _edge(p, s, steps, int(discs[d, 5]), low, near)
+        if not (inside and good):
             continue
-        peak = near[0]
-        for t in range(1, k + 2):
-            peak = max(peak, near[t])
         uv[count, 0] = discs[d, 0] + du * dist
         uv[count, 1] = discs[d, 1] + dv * dist
-        theta[count] = directions[j, 0]
-        contrast[count] = inner - outside
-        width[count] = np.float64(s[last] + np.float32(0.5 * STEP)) - dist
-        reach[count] = dist
-        kept[count] = d
-        halo[count] = inner - outside < HALO * (peak - outside)
+        theta[count], contrast[count], width[count] = directions[j, 0], rise, wide
+        reach[count], kept[count], halo[count] = dist, d, faint
         count += 1
     return (uv[:count], theta[:count], contrast[:count], width[:count], reach[:count],
             kept[:count], halo[:count])  # fmt: skip
+
+
+@jit
+def _profile(flat, b, h, w, cu, cv, du, dv, start, p, s):  # type: ignore[no-untyped-def]
+    """A ray's profile: the samples ``p`` of a window's difference (``flat[b:]``, ``h`` x
+    ``w``) at distances ``s`` (float32) from ``(cu, cv)`` along ``(du, dv)``, every :data:`STEP`
+    px from ``start``, read bilinearly and clamped to the window (in NumPy's float types: the
+    positions in float32, the values in float64)."""
+    top_row, top_col = np.float32(h - 1.001), np.float32(w - 1.001)
+    fu, fv, fdu, fdv = np.float32(cu), np.float32(cv), np.float32(du), np.float32(dv)
+    for i in range(len(p)):
+        s[i] = np.float32(start + STEP * i)
+        r = min(max(fv + fdv * s[i], np.float32(0.0)), top_row)
+        c = min(max(fu + fdu * s[i], np.float32(0.0)), top_col)
+        r0, c0 = int(r), int(c)
+        fr, fc = np.float64(r) - r0, np.float64(c) - c0
+        q = r0 * w + c0 + b
+        a0, a1 = np.float32(flat[q]), np.float32(flat[q + 1])
+        upper = np.float64(a0) + np.float64(a1 - a0) * fc
+        a0, a1 = np.float32(flat[q + w]), np.float32(flat[q + w + 1])
+        lower = np.float64(a0) + np.float64(a1 - a0) * fc
+        p[i] = upper + (lower - upper) * fr
+
+
+@jit
+def _edge(p, s, steps, k, low, near):  # type: ignore[no-untyped-def]
+    """The edge on a ray's profile ``p`` (at distances ``s``, its first ``steps`` samples its
+    own, its inner level searched ``k`` samples inside; ``near``: room for ``k + 2``): whether
+    it has one, its distance, contrast, width and whether it may be a halo (:class:`Edges`).
+
+    The outermost run of :data:`RUN` samples at or above ``low`` ends at the edge: a speck of
+    the wall's texture the light does not quite match, a pixel or so past the rim, is not it.
+    The edge's inner level is where the profile stops falling steeply, walking in from its
+    steepest point near the threshold crossing: the rim's own brightness, not the shading
+    further in (a lit sphere brightens inwards from a limb as dark as the wall). An edge whose
+    inner level is under ``low`` over the outside is placed by the threshold, not by its
+    half-way point: it adds nothing."""
+    m = len(p)
+    last = -1
+    for i in range(min(steps, m) - 1, RUN - 2, -1):
+        run = True
+        for q in range(i - RUN + 1, i + 1):
+            run &= p[q] >= low
+        if run:
+            last = i
+            break
+    good = last >= 0 and last < steps - 1
+    if last < 0:
+        last = m - 1
+    for t in range(k + 2):  # inside out
+        near[t] = p[min(max(last - k + t, 0), m - 1)]
+    # The steepest fall over one step out of the last `outer` (the first of equals).
+    outer = max(1, round(2.0 / STEP))
+    first = k + 1 - outer
+    lo = max(first, 0)
+    at = lo
+    for t in range(lo + 1, k + 1):
+        if near[t] - near[t + 1] > near[at] - near[at + 1]:
+            at = t
+    steep = first + at - lo  # below 0 (an inner depth under `outer`): counted from the end
+    top = near[steep % (k + 1)] - near[steep % (k + 1) + 1]
+    shoulder = 0
+    for t in range(min(steep, k + 1) - 1, -1, -1):
+        if near[t] - near[t + 1] < 0.3 * top:
+            shoulder = t
+            break
+    inner, outside = near[shoulder], near[k + 1]
+    good &= inner - outside >= low
+    level = 0.5 * (inner + outside)
+    # The outermost sample at or above the level, and the next one out (below it).
+    jj = k
+    for t in range(k, -1, -1):
+        if near[t] >= level:
+            jj = t
+            break
+    frac = (near[jj] - level) / max(near[jj] - near[jj + 1], 1e-6)
+    dist = np.float64(s[min(max(last - k + jj, 0), m - 1)]) + STEP * min(max(frac, 0.0), 1.0)
+    peak = near[0]
+    for t in range(1, k + 2):
+        peak = max(peak, near[t])
+    width = np.float64(s[last] + np.float32(0.5 * STEP)) - dist
+    return good, dist, inner - outside, width, inner - outside < HALO * (peak - outside)
 
 
 #: The directions (unit vectors over half a turn, :data:`TURNS` of them) a smear is fitted along
