@@ -331,28 +331,12 @@ def _circle_fits(  # type: ignore[no-untyped-def]
     :func:`_circle_of_radius`), and each disc's edge count and first edge.
 
     As the NumPy expressions it replaces, to the bit: the normal equations are summed as
-    ``np.add.reduceat`` sums them (pairwise) and solved as OpenBLAS's LAPACK ``dgesv`` solves
-    them (left-looking LU, partial pivoting, the pivot's reciprocal scaling its column, no
-    fused products)."""
+    ``np.add.reduceat`` sums them (pairwise, :func:`_reduceat`) and solved as OpenBLAS's LAPACK
+    ``dgesv`` solves them (:func:`_lu_factor`, :func:`_lu_solve`)."""
     count, n = len(radius), len(chosen)
-    own, theta = np.empty(n, np.intp), np.empty(n)
-    contrast, width = np.empty(n), np.empty(n)
-    for i in range(n):
-        own[i], theta[i] = owner[chosen[i]], angle[chosen[i]]
-        contrast[i], width[i] = strength[chosen[i]], spread[chosen[i]]
-    sizes, starts = np.empty(count, np.intp), np.empty(count, np.intp)
-    for d in range(count):
-        sizes[d], starts[d] = 0, 0
-    for i in range(n):
-        sizes[own[i]] += 1
-    for d in range(1, count):
-        starts[d] = starts[d - 1] + sizes[d - 1]
-    top = np.empty(count)
-    for d in range(count):
-        top[d] = 0.0
-    for i in range(n):
-        if contrast[i] > top[own[i]] or contrast[i] != contrast[i]:
-            top[own[i]] = contrast[i]
+    own, theta, contrast, width = _gathered(chosen, owner, angle, strength, spread)
+    sizes, starts = _runs(own, count)
+    top = _strongest(own, contrast, count)
     weight, w, keys, dist, res = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     order = np.empty(n, np.intp)
     trim, keep = np.empty(n, np.bool_), np.empty(n, np.bool_)
@@ -370,185 +354,321 @@ def _circle_fits(  # type: ignore[no-untyped-def]
             for i in range(n):
                 keys[i] = width[i]
         elif stage == 2:
-            for i in range(n):
-                d = own[i]
-                keys[i] = abs(math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1]) - r[d])
-                if keys[i] != keys[i]:
-                    keys[i] = math.inf
+            _off_circle(xy, own, centre, r, keys)
         elif stage == 3:
-            for i in range(n):
-                d = own[i]
-                dist[i] = math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1])
-                res[i] = dist[i] - r[d]
-                keys[i] = abs(res[i]) if trim[i] else math.inf
-        if stage != 1:  # each disc's points ranked by their keys, stably, NaN last (np.lexsort)
-            for i in range(n):
-                order[i] = i
-            for d in range(count):
-                for k in range(starts[d] + 1, starts[d] + sizes[d]):
-                    i, q = order[k], k - 1
-                    while q >= starts[d]:
-                        other = keys[order[q]]
-                        if not (other > keys[i] or (other != other and keys[i] == keys[i])):
-                            break
-                        order[q + 1] = order[q]
-                        q -= 1
-                    order[q + 1] = i
-        if stage == 0:  # weights: contrast against the disc's strongest, sharpness its median's
-            for i in range(n):
-                d = own[i]
-                floor = width[i] if width[i] >= 1e-3 or width[i] != width[i] else 1e-3
-                sharp = keys[order[starts[d] + (sizes[d] - 1) // 2]] / floor
-                if top[d] != 0.0:
-                    share = contrast[i] / (0.5 * top[d])
-                else:
-                    share = (
-                        math.inf if contrast[i] > 0 else -math.inf if contrast[i] < 0 else math.nan
-                    )
-                share = (1.0 if share >= 1.0 else share) * (1.0 if sharp >= 1.0 else sharp)
-                weight[i] = share * share
-                terms[0, i], terms[1, i] = xy[i, 0], xy[i, 1]
+            _residuals(xy, own, centre, r, trim, dist, res, keys)
+        if stage != 1:
+            _rank(keys, starts, sizes, order)
+        if stage == 0:
+            _weights(xy, own, width, contrast, top, keys, order, starts, sizes, weight, terms)
         elif stage == 1:
             for i in range(n):
                 w[i] = weight[i]
         elif stage == 2:
-            for d in range(count):
-                for k in range(sizes[d]):
-                    trim[order[starts[d] + k]] = k < max(6, 3 * sizes[d] // 4)
-            for i in range(n):
-                w[i] = weight[i] * (1.0 if trim[i] else 0.0)
+            _trimmed(weight, order, starts, sizes, trim, w)
         else:
-            for i in range(n):
-                d = own[i]
-                scale = 1.4826 * keys[order[starts[d] + (sizes[d] - 1) // 2]]
-                bound, least = 3.0 * scale, radius[d] * mpp[d]
-                if not (bound >= 0.75 * mpp[d] or bound != bound):
-                    bound = 0.75 * mpp[d]
-                if r[d] >= least or r[d] != r[d]:
-                    least = r[d]
-                keep[i] = abs(res[i]) <= bound and dist[i] >= 0.7 * least
-                w[i] = weight[i] * (1.0 if keep[i] else 0.0)
+            _kept(own, weight, keys, order, starts, sizes, res, dist, r, radius, mpp, keep, w)
         if stage:
-            for i in range(n):
-                for j in range(3):  # the products a_j w a_k (j < 3, k < 4)
-                    aw = a[i, j] * w[i]
-                    for k in range(4):
-                        terms[4 * j + k, i] = aw * a[i, k]
-        # Each disc's sums of the terms as np.add.reduceat sums: the first term, then the rest
-        # by NumPy's pairwise summation (runs of up to 128 summed in eight lanes; a longer run
-        # split in two, the first a multiple of 8, and the halves' sums added).
+            _products(a, w, terms)
         for d in range(count):
             for col in range(2 if stage == 0 else 12):
                 if sizes[d] == 0:
                     continue
-                todo[0, 0], todo[0, 1], todo[0, 2] = starts[d] + 1, sizes[d] - 1, 0
-                top_, depth = 1, 0
-                while top_ > 0:
-                    top_ -= 1
-                    lo, m = todo[top_, 0], todo[top_, 1]
-                    if todo[top_, 2]:  # both halves summed
-                        depth -= 1
-                        part[depth - 1] += part[depth]
-                    elif m > 128:
-                        half = m // 2 - (m // 2) % 8
-                        todo[top_, 0], todo[top_, 1], todo[top_, 2] = 0, 0, 1
-                        todo[top_ + 1, 0], todo[top_ + 1, 1], todo[top_ + 1, 2] = (
-                            lo + half,
-                            m - half,
-                            0,
-                        )
-                        todo[top_ + 2, 0], todo[top_ + 2, 1], todo[top_ + 2, 2] = lo, half, 0
-                        top_ += 3
-                    else:
-                        s = 0.0
-                        if m < 8:
-                            for i in range(lo, lo + m):
-                                s += terms[col, i]
-                        else:
-                            for k in range(8):
-                                lanes[k] = terms[col, lo + k]
-                            k = 8
-                            while k < m - m % 8:
-                                for j in range(8):
-                                    lanes[j] += terms[col, lo + k + j]
-                                k += 8
-                            s = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + (
-                                (lanes[4] + lanes[5]) + (lanes[6] + lanes[7])
-                            )
-                            for i in range(lo + k, lo + m):
-                                s += terms[col, i]
-                        part[depth] = s
-                        depth += 1
-                sums[d, col] = (
-                    terms[col, starts[d]] + part[0] if sizes[d] > 1 else terms[col, starts[d]]
-                )
+                sums[d, col] = _reduceat(terms, col, starts[d], sizes[d], todo, part, lanes)
         if stage == 0:
-            for d in range(count):
-                if sizes[d]:
-                    mean[d, 0], mean[d, 1] = sums[d, 0] / sizes[d], sums[d, 1] / sizes[d]
-            for i in range(n):
-                a[i, 0], a[i, 1] = xy[i, 0] - mean[own[i], 0], xy[i, 1] - mean[own[i], 1]
-                a[i, 2], a[i, 3] = 1.0, a[i, 0] * a[i, 0] + a[i, 1] * a[i, 1]
+            _centred(xy, own, sums, sizes, mean, a)
             continue
-        for d in range(count):  # the circle: (2 centre, r^2 - |centre|^2) by the normal equations
-            centre[d, 0], centre[d, 1], r[d] = math.nan, math.nan, math.nan
-            weighted = 0
-            for i in range(starts[d], starts[d] + sizes[d]):
-                if w[i] > 0:
-                    weighted += 1
-            if weighted < 3:
-                continue
-            eps = 1e-12 * ((sums[d, 0] + sums[d, 5]) + sums[d, 10])
-            for j in range(3):
-                rhs[j] = sums[d, 4 * j + 3]
-                for k in range(3):
-                    lu[j, k] = sums[d, 4 * j + k] + eps * (1.0 if j == k else 0.0)
-            singular = False
-            for j in range(3):
-                for i in range(j):  # this column's rows interchanged as the earlier ones were
-                    if piv[i] != i:
-                        lu[i, j], lu[piv[i], j] = lu[piv[i], j], lu[i, j]
-                for i in range(1, 3):  # less the products of the rows above: U above, L below
-                    if min(i, j):
-                        dot = 0.0
-                        for q in range(min(i, j)):
-                            dot += lu[i, q] * lu[q, j]
-                        lu[i, j] -= dot
-                p = j
-                for i in range(j + 1, 3):
-                    if abs(lu[i, j]) > abs(lu[p, j]):
-                        p = i
-                piv[j] = p
-                if lu[p, j] == 0.0:
-                    singular = True  # where NumPy raises
+        for d in range(count):
+            centre[d, 0], centre[d, 1], r[d] = _circle(
+                sums, d, w, starts[d], sizes[d], mean, lu, rhs, piv
+            )
+    kept, gaps = _arcs(keep, own, theta, count)
+    short = np.zeros(count, np.bool_)  # to be fitted with their known radius
+    for d in range(count):
+        short[d] = gaps[d] > MAX_ARC_GAP and kept[d] >= 6 and has_known[d]
+        short[d] &= gaps[d] <= 2 * math.pi - MIN_ARC
+    return centre, r, weight, keep, kept, gaps, np.nonzero(short)[0], sizes, starts
+
+
+@jit
+def _gathered(chosen, owner, angle, strength, spread):  # type: ignore[no-untyped-def]
+    """The ``chosen`` edges' owners, angles, contrasts and widths (:func:`_circle_fits`'
+    ``owner``, ``angle``, ``strength`` and ``spread`` at ``chosen``)."""
+    n = len(chosen)
+    own, theta = np.empty(n, np.intp), np.empty(n)
+    contrast, width = np.empty(n), np.empty(n)
+    for i in range(n):
+        own[i], theta[i] = owner[chosen[i]], angle[chosen[i]]
+        contrast[i], width[i] = strength[chosen[i]], spread[chosen[i]]
+    return own, theta, contrast, width
+
+
+@jit
+def _runs(own, count):  # type: ignore[no-untyped-def]
+    """Each of ``count`` discs' edge count and first edge, from the edges' owners ``own``
+    (increasing)."""
+    sizes, starts = np.empty(count, np.intp), np.empty(count, np.intp)
+    for d in range(count):
+        sizes[d], starts[d] = 0, 0
+    for i in range(len(own)):
+        sizes[own[i]] += 1
+    for d in range(1, count):
+        starts[d] = starts[d - 1] + sizes[d - 1]
+    return sizes, starts
+
+
+@jit
+def _strongest(own, contrast, count):  # type: ignore[no-untyped-def]
+    """Each of ``count`` discs' largest edge ``contrast``, at least 0 (NaN where any is NaN)."""
+    top = np.empty(count)
+    for d in range(count):
+        top[d] = 0.0
+    for i in range(len(own)):
+        if contrast[i] > top[own[i]] or contrast[i] != contrast[i]:
+            top[own[i]] = contrast[i]
+    return top
+
+
+@jit
+def _off_circle(xy, own, centre, r, keys):  # type: ignore[no-untyped-def]
+    """Into ``keys``: each point's distance from its disc's circle (infinite where NaN)."""
+    for i in range(len(own)):
+        d = own[i]
+        keys[i] = abs(math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1]) - r[d])
+        if keys[i] != keys[i]:
+            keys[i] = math.inf
+
+
+@jit
+def _residuals(xy, own, centre, r, trim, dist, res, keys):  # type: ignore[no-untyped-def]
+    """Into ``dist`` and ``res``: each point's distance from its disc's centre and from its
+    circle; into ``keys``: the latter's size where ``trim``, else infinite."""
+    for i in range(len(own)):
+        d = own[i]
+        dist[i] = math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1])
+        res[i] = dist[i] - r[d]
+        keys[i] = abs(res[i]) if trim[i] else math.inf
+
+
+@jit
+def _rank(keys, starts, sizes, order):  # type: ignore[no-untyped-def]
+    """Into ``order``: the points' indices, each disc's ranked by their ``keys``, stably, NaN
+    last (``np.lexsort``)."""
+    for i in range(len(order)):
+        order[i] = i
+    for d in range(len(sizes)):
+        for k in range(starts[d] + 1, starts[d] + sizes[d]):
+            i, q = order[k], k - 1
+            while q >= starts[d]:
+                other = keys[order[q]]
+                if not (other > keys[i] or (other != other and keys[i] == keys[i])):
                     break
-                inverse = 1.0 / lu[p, j]
-                if p != j:
-                    for q in range(j + 1):
-                        lu[j, q], lu[p, q] = lu[p, q], lu[j, q]
-                for i in range(j + 1, 3):
-                    lu[i, j] *= inverse
-            if singular:
-                continue
-            for i in range(3):
-                if piv[i] != i:
-                    rhs[i], rhs[piv[i]] = rhs[piv[i]], rhs[i]
-            for i in range(3):
-                for q in range(i + 1, 3):
-                    rhs[q] += -rhs[i] * lu[q, i]
-            for i in range(2, -1, -1):
-                rhs[i] /= lu[i, i]
-                for q in range(i):
-                    rhs[q] += -rhs[i] * lu[q, i]
-            cu, cv = rhs[0] / 2, rhs[1] / 2
-            q = rhs[2] + (cu * cu + cv * cv)
-            r[d] = math.sqrt(q if q >= 0.0 or q != q else 0.0)
-            centre[d, 0], centre[d, 1] = cu + mean[d, 0], cv + mean[d, 1]
+                order[q + 1] = order[q]
+                q -= 1
+            order[q + 1] = i
+
+
+@jit
+def _weights(  # type: ignore[no-untyped-def]
+    xy, own, width, contrast, top, keys, order, starts, sizes, weight, terms
+):
+    """Into ``weight``: each edge's, the square of its contrast over half its disc's strongest
+    (``top``) times its sharpness, its disc's median width (``keys`` ranked by ``order``) over
+    its own (at least 1e-3), each at most 1. Into ``terms``' first two rows: the points'
+    coordinates."""
+    for i in range(len(own)):
+        d = own[i]
+        floor = width[i] if width[i] >= 1e-3 or width[i] != width[i] else 1e-3
+        sharp = keys[order[starts[d] + (sizes[d] - 1) // 2]] / floor
+        if top[d] != 0.0:
+            share = contrast[i] / (0.5 * top[d])
+        else:
+            share = math.inf if contrast[i] > 0 else -math.inf if contrast[i] < 0 else math.nan
+        share = (1.0 if share >= 1.0 else share) * (1.0 if sharp >= 1.0 else sharp)
+        weight[i] = share * share
+        terms[0, i], terms[1, i] = xy[i, 0], xy[i, 1]
+
+
+@jit
+def _trimmed(weight, order, starts, sizes, trim, w):  # type: ignore[no-untyped-def]
+    """Into ``trim``: whether each point is among the first three quarters (at least 6) of its
+    disc's as ranked by ``order``; into ``w``: its weight where it is, else 0."""
+    for d in range(len(sizes)):
+        for k in range(sizes[d]):
+            trim[order[starts[d] + k]] = k < max(6, 3 * sizes[d] // 4)
+    for i in range(len(weight)):
+        w[i] = weight[i] * (1.0 if trim[i] else 0.0)
+
+
+@jit
+def _kept(  # type: ignore[no-untyped-def]
+    own, weight, keys, order, starts, sizes, res, dist, r, radius, mpp, keep, w
+):
+    """Into ``keep``: whether each point lies within 3 robust deviations (1.4826 times the
+    median of its disc's ``keys`` ranked by ``order``; at least 0.75 px) of its circle
+    (``res``) and not inside 70 % of the larger of the fitted radius ``r`` and the disc's
+    ``radius`` px (``dist``); into ``w``: its weight where kept, else 0."""
+    for i in range(len(own)):
+        d = own[i]
+        scale = 1.4826 * keys[order[starts[d] + (sizes[d] - 1) // 2]]
+        bound, least = 3.0 * scale, radius[d] * mpp[d]
+        if not (bound >= 0.75 * mpp[d] or bound != bound):
+            bound = 0.75 * mpp[d]
+        if r[d] >= least or r[d] != r[d]:
+            least = r[d]
+        keep[i] = abs(res[i]) <= bound and dist[i] >= 0.7 * least
+        w[i] = weight[i] * (1.0 if keep[i] else 0.0)
+
+
+@jit
+def _products(a, w, terms):  # type: ignore[no-untyped-def]
+    """Into ``terms``: each point's products ``a_j w a_k`` (j < 3, k < 4) of its row of ``a``
+    and weight ``w``, row ``4 j + k``."""
+    for i in range(len(w)):
+        for j in range(3):
+            aw = a[i, j] * w[i]
+            for k in range(4):
+                terms[4 * j + k, i] = aw * a[i, k]
+
+
+@jit
+def _reduceat(terms, col, start, size, todo, part, lanes):  # type: ignore[no-untyped-def]
+    """The sum of row ``col`` of ``terms`` over ``size`` (at least 1) columns from ``start`` as
+    ``np.add.reduceat`` sums it: the first term, then the rest by NumPy's pairwise summation
+    (runs of up to 128 summed in eight lanes; a longer run split in two, the first a multiple
+    of 8, and the halves' sums added). ``todo``, ``part`` and ``lanes``: room to work in."""
+    todo[0, 0], todo[0, 1], todo[0, 2] = start + 1, size - 1, 0
+    top_, depth = 1, 0
+    while top_ > 0:
+        top_ -= 1
+        lo, m = todo[top_, 0], todo[top_, 1]
+        if todo[top_, 2]:  # both halves summed
+            depth -= 1
+            part[depth - 1] += part[depth]
+        elif m > 128:
+            half = m // 2 - (m // 2) % 8
+            todo[top_, 0], todo[top_, 1], todo[top_, 2] = 0, 0, 1
+            todo[top_ + 1, 0], todo[top_ + 1, 1], todo[top_ + 1, 2] = lo + half, m - half, 0
+            todo[top_ + 2, 0], todo[top_ + 2, 1], todo[top_ + 2, 2] = lo, half, 0
+            top_ += 3
+        else:
+            s = 0.0
+            if m < 8:
+                for i in range(lo, lo + m):
+                    s += terms[col, i]
+            else:
+                for k in range(8):
+                    lanes[k] = terms[col, lo + k]
+                k = 8
+                while k < m - m % 8:
+                    for j in range(8):
+                        lanes[j] += terms[col, lo + k + j]
+                    k += 8
+                s = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + (
+                    (lanes[4] + lanes[5]) + (lanes[6] + lanes[7])
+                )
+                for i in range(lo + k, lo + m):
+                    s += terms[col, i]
+            part[depth] = s
+            depth += 1
+    return terms[col, start] + part[0] if size > 1 else terms[col, start]
+
+
+@jit
+def _centred(xy, own, sums, sizes, mean, a):  # type: ignore[no-untyped-def]
+    """Into ``mean``: each disc's mean point (``sums``' first two columns over its ``sizes``
+    points; left where it has none); into ``a``: each point's design row about its disc's mean
+    (u, v, 1, u^2 + v^2)."""
+    for d in range(len(sizes)):
+        if sizes[d]:
+            mean[d, 0], mean[d, 1] = sums[d, 0] / sizes[d], sums[d, 1] / sizes[d]
+    for i in range(len(own)):
+        a[i, 0], a[i, 1] = xy[i, 0] - mean[own[i], 0], xy[i, 1] - mean[own[i], 1]
+        a[i, 2], a[i, 3] = 1.0, a[i, 0] * a[i, 0] + a[i, 1] * a[i, 1]
+
+
+@jit
+def _circle(sums, d, w, start, size, mean, lu, rhs, piv):  # type: ignore[no-untyped-def]
+    """Disc ``d``'s circle, its centre u, v and radius, from its row of ``sums`` (the normal
+    equations' terms) by the normal equations for (2 centre, r^2 - |centre|^2) about its mean;
+    NaN where fewer than 3 of its ``size`` edges from ``start`` weigh (``w``) anything, or the
+    equations are singular. ``lu``, ``rhs`` and ``piv``: room to work in."""
+    weighted = 0
+    for i in range(start, start + size):
+        if w[i] > 0:
+            weighted += 1
+    if weighted < 3:
+        return math.nan, math.nan, math.nan
+    eps = 1e-12 * ((sums[d, 0] + sums[d, 5]) + sums[d, 10])
+    for j in range(3):
+        rhs[j] = sums[d, 4 * j + 3]
+        for k in range(3):
+            lu[j, k] = sums[d, 4 * j + k] + eps * (1.0 if j == k else 0.0)
+    if _lu_factor(lu, piv):
+        return math.nan, math.nan, math.nan
+    _lu_solve(lu, piv, rhs)
+    cu, cv = rhs[0] / 2, rhs[1] / 2
+    q = rhs[2] + (cu * cu + cv * cv)
+    return cu + mean[d, 0], cv + mean[d, 1], math.sqrt(q if q >= 0.0 or q != q else 0.0)
+
+
+@jit
+def _lu_factor(lu, piv):  # type: ignore[no-untyped-def]
+    """``lu`` (3 x 3) factored in place as OpenBLAS's LAPACK ``dgetrf`` factors it (left-looking
+    LU, partial pivoting, the pivot's reciprocal scaling its column, no fused products), the
+    pivots into ``piv``. Whether it is singular (a zero pivot: where NumPy raises)."""
+    for j in range(3):
+        for i in range(j):  # this column's rows interchanged as the earlier ones were
+            if piv[i] != i:
+                lu[i, j], lu[piv[i], j] = lu[piv[i], j], lu[i, j]
+        for i in range(1, 3):  # less the products of the rows above: U above, L below
+            if min(i, j):
+                dot = 0.0
+                for q in range(min(i, j)):
+                    dot += lu[i, q] * lu[q, j]
+                lu[i, j] -= dot
+        p = j
+        for i in range(j + 1, 3):
+            if abs(lu[i, j]) > abs(lu[p, j]):
+                p = i
+        piv[j] = p
+        if lu[p, j] == 0.0:
+            return True
+        inverse = 1.0 / lu[p, j]
+        if p != j:
+            for q in range(j + 1):
+                lu[j, q], lu[p, q] = lu[p, q], lu[j, q]
+        for i in range(j + 1, 3):
+            lu[i, j] *= inverse
+    return False
+
+
+@jit
+def _lu_solve(lu, piv, rhs):  # type: ignore[no-untyped-def]
+    """``rhs`` (3) solved in place by :func:`_lu_factor`'s ``lu`` and ``piv``, as ``dgetrs``
+    solves it."""
+    for i in range(3):
+        if piv[i] != i:
+            rhs[i], rhs[piv[i]] = rhs[piv[i]], rhs[i]
+    for i in range(3):
+        for q in range(i + 1, 3):
+            rhs[q] += -rhs[i] * lu[q, i]
+    for i in range(2, -1, -1):
+        rhs[i] /= lu[i, i]
+        for q in range(i):
+            rhs[q] += -rhs[i] * lu[q, i]
+
+
+@jit
+def _arcs(keep, own, theta, count):  # type: ignore[no-untyped-def]
+    """Each of ``count`` discs' number of ``keep`` edges and the largest angle between
+    neighbouring kept rays (``theta``, increasing in each disc's; a full turn where fewer than
+    two are kept)."""
     kept = np.zeros(count)
     first, last = np.empty(count, np.intp), np.empty(count, np.intp)
     for d in range(count):
         first[d], last[d] = -1, -1
-    for i in range(n):
+    for i in range(len(own)):
         if keep[i]:
             kept[own[i]] += 1.0
             if first[own[i]] < 0:
@@ -561,18 +681,14 @@ def _circle_fits(  # type: ignore[no-untyped-def]
         if last[d] > first[d]:
             gaps[d] = theta[first[d]] + 2 * math.pi - theta[last[d]]
     before = -1
-    for i in range(n):
+    for i in range(len(own)):
         if keep[i]:
             if before >= 0 and own[before] == own[i]:
                 gap = theta[i] - theta[before]
                 if not (gaps[own[i]] >= gap or gaps[own[i]] != gaps[own[i]]):
                     gaps[own[i]] = gap
             before = i
-    short = np.zeros(count, np.bool_)  # to be fitted with their known radius
-    for d in range(count):
-        short[d] = gaps[d] > MAX_ARC_GAP and kept[d] >= 6 and has_known[d]
-        short[d] &= gaps[d] <= 2 * math.pi - MIN_ARC
-    return centre, r, weight, keep, kept, gaps, np.nonzero(short)[0], sizes, starts
+    return kept, gaps
 
 
 @jit
@@ -597,9 +713,9 @@ def _stadium_fits(  # type: ignore[no-untyped-def]
     in place of ``centre``, ``r`` and ``kept``, where a disc's circle leaves :data:`STADIUM_RMS`
     and it is ``moving`` (``along``: its direction), the stadium along it, or where that fits
     worse than the circle (a bounce has turned it since), along the best of ``turned``, if any
-    fits better than the circle. Returns the RMS distances, the discs left to :func:`_smear`
-    (those whose equations were ill-conditioned) and those whose fits are good (as
-    :func:`_good`).
+    fits better than the circle (:func:`_stadium_fit`). Returns the RMS distances, the discs
+    left to :func:`_smear` (those whose equations were ill-conditioned) and those whose fits
+    are good (as :func:`_good`).
 
     The stadium's centre, half length and radius by weighted Gauss-Newton on the edges'
     distances to it, twice, dropping edges off it by more than 3 robust deviations. The NumPy
@@ -610,6 +726,27 @@ def _stadium_fits(  # type: ignore[no-untyped-def]
     (edges at one end of the smear only, at neither, or along one side only): there the two
     solvers' rounding, amplified by 1e12, moved centres by up to 0.003 px; such a disc (a pivot
     under 1e-7 of the largest) is left to :func:`_smear`, which fits it as NumPy did."""
+    rms = _circle_rms(xy, keep, starts, sizes, centre, r, kept, mpp)
+    lu, rhs, res, ranked = np.empty((4, 4)), np.empty(4), np.empty(len(xy)), np.empty(len(xy))
+    inner, best = np.empty(len(xy), np.bool_), np.empty(len(xy), np.bool_)
+    redo = np.zeros(len(r), np.bool_)
+    for d in range(len(r)):
+        if not moving[d] or fixed[d] or kept[d] < 6 or rms[d] < STADIUM_RMS:
+            continue
+        redo[d] = _stadium_fit(
+            d, xy, weight, starts, sizes, centre, r, kept, rms, mpp, along, turned,
+            inner, best, res, ranked, lu, rhs,
+        )  # fmt: skip
+    good = np.empty(len(r), np.bool_)
+    for d in range(len(r)):
+        good[d] = kept[d] >= 6 and (gaps[d] <= MAX_ARC_GAP or fixed[d]) and abs(r[d]) < math.inf
+        good[d] &= 0.5 * radius[d] * mpp[d] <= r[d] and r[d] <= 2.5 * radius[d] * mpp[d]
+    return rms, np.nonzero(redo)[0], np.nonzero(good)[0]
+
+
+@jit
+def _circle_rms(xy, keep, starts, sizes, centre, r, kept, mpp):  # type: ignore[no-untyped-def]
+    """Each disc's circle's RMS distance (px) from its ``keep`` edges (``kept`` of them)."""
     rms = np.zeros(len(r))
     for d in range(len(r)):
         for i in range(starts[d], starts[d] + sizes[d]):
@@ -617,127 +754,180 @@ def _stadium_fits(  # type: ignore[no-untyped-def]
                 q = math.hypot(xy[i, 0] - centre[d, 0], xy[i, 1] - centre[d, 1]) - r[d]
                 rms[d] += q * q
         rms[d] = math.sqrt(rms[d] / max(kept[d], 1.0)) / mpp[d]
-    lu, rhs, res, ranked = np.empty((4, 4)), np.empty(4), np.empty(len(xy)), np.empty(len(xy))
-    inner, best = np.empty(len(xy), np.bool_), np.empty(len(xy), np.bool_)
-    redo = np.zeros(len(r), np.bool_)
-    for d in range(len(r)):
-        if not moving[d] or fixed[d] or kept[d] < 6 or rms[d] < STADIUM_RMS:
-            continue
-        lo, m = starts[d], sizes[d]
-        spread, bu, bv, br = math.inf, 0.0, 0.0, 0.0
-        for turn in range(len(turned) + 1):
-            way = along[d] if turn == 0 else turned[turn - 1]
-            cu, cv, h, rr = centre[d, 0], centre[d, 1], 0.25 * r[d], r[d]
+    return rms
+
+
+@jit
+def _stadium_fit(  # type: ignore[no-untyped-def]
+    d, xy, weight, starts, sizes, centre, r, kept, rms, mpp, along, turned,
+    inner, best, res, ranked, lu, rhs,
+):  # fmt: skip
+    """:func:`_stadium_fits` for disc ``d``: the stadium along ``along[d]``, or where that
+    fits worse than the circle (``rms`` px), along each of ``turned`` (:func:`_stadium_along`);
+    the best, where it fits better than the circle, into ``centre``, ``r``, ``rms`` and
+    ``kept``. Whether its equations were ill-conditioned (then nothing is changed). ``inner``,
+    ``best``, ``res``, ``ranked``, ``lu`` and ``rhs``: room to work in."""
+    lo, m = starts[d], sizes[d]
+    spread, bu, bv, br = math.inf, 0.0, 0.0, 0.0
+    for turn in range(len(turned) + 1):
+        way = along[d] if turn == 0 else turned[turn - 1]
+        cu, cv, rr, other, ill = _stadium_along(
+            xy, weight, lo, m, way, centre[d, 0], centre[d, 1], r[d], inner, res, ranked, lu, rhs
+        )
+        if ill:
+            return True
+        if turn == 0 or other < spread:
+            spread, bu, bv, br = other, cu, cv, rr
             for i in range(m):
-                inner[i] = True
-            for round_ in range(2):
-                for _ in range(8):
-                    for p in range(4):
-                        rhs[p] = 0.0
-                        for q in range(4):
-                            lu[p, q] = 0.0
-                    for i in range(m):
-                        t = (xy[lo + i, 0] - cu) * way[0] + (xy[lo + i, 1] - cv) * way[1]
-                        ts = t if t != t or t > -h else -h  # np.clip(t, -h, h)
-                        ts = ts if ts != ts or ts < h else h
-                        ou, ov = (
-                            xy[lo + i, 0] - (cu + ts * way[0]),
-                            xy[lo + i, 1] - (cv + ts * way[1]),
-                        )
-                        gap = math.hypot(ou, ov)
-                        gap = gap if gap >= 1e-12 or gap != gap else 1e-12
-                        uu, uv = ou / gap, ov / gap
-                        ends = (
-                            (1.0 if t < 0 else -1.0) * (uu * way[0] + uv * way[1])
-                            if abs(t) > h
-                            else 0.0
-                        )
-                        jac = (-uu, -uv, ends, -1.0)
-                        res[i] = gap - rr
-                        wk = weight[lo + i] * (1.0 if inner[i] else 0.0)
-                        for p in range(4):
-                            for q in range(4):
-                                lu[p, q] += jac[p] * wk * jac[q]
-                            rhs[p] -= jac[p] * wk * res[i]
-                    least, most = math.inf, 0.0
-                    for j in range(4):  # Gaussian elimination, partial pivoting
-                        lu[j, j] += 1e-12
-                    for j in range(4):
-                        p = j
-                        for i in range(j + 1, 4):
-                            if abs(lu[i, j]) > abs(lu[p, j]):
-                                p = i
-                        least, most = min(least, abs(lu[p, j])), max(most, abs(lu[p, j]))
-                        if not least >= 1e-7 * most:
-                            break
-                        for q in range(4):
-                            lu[j, q], lu[p, q] = lu[p, q], lu[j, q]
-                        rhs[j], rhs[p] = rhs[p], rhs[j]
-                        for i in range(j + 1, 4):
-                            f = lu[i, j] / lu[j, j]
-                            for q in range(j + 1, 4):
-                                lu[i, q] -= f * lu[j, q]
-                            rhs[i] -= f * rhs[j]
-                    if not least >= 1e-7 * most:
-                        redo[d] = True
-                        break
-                    for i in range(3, -1, -1):
-                        for q in range(i + 1, 4):
-                            rhs[i] -= lu[i, q] * rhs[q]
-                        rhs[i] /= lu[i, i]
-                    cu, cv, h, rr = cu + rhs[0], cv + rhs[1], h + rhs[2], rr + rhs[3]
-                    if h < 0.0:
-                        h = 0.0
-                    small = True
-                    for p in range(4):
-                        small &= abs(rhs[p]) < 1e-6 * r[d]
-                    if small:
-                        break
-                if redo[d]:
-                    break
-                if round_ == 0:  # np.median of the distances: the middle two's mean; NaN if any
-                    for i in range(m):
-                        q = i - 1
-                        while q >= 0 and (ranked[q] > abs(res[i]) or ranked[q] != ranked[q]):
-                            ranked[q + 1] = ranked[q]
-                            q -= 1
-                        ranked[q + 1] = abs(res[i])
-                    if ranked[m - 1] != ranked[m - 1]:
-                        middle = math.nan
-                    elif m % 2:
-                        middle = ranked[m // 2]
-                    else:
-                        middle = (ranked[m // 2 - 1] + ranked[m // 2]) / 2.0
-                    bound = 3.0 * (1.4826 * middle)
-                    if bound < 1e-9:
-                        bound = 1e-9
-                    for i in range(m):
-                        inner[i] = abs(res[i]) <= bound
-            if redo[d]:
-                break
-            total, k = 0.0, 0
+                best[i] = inner[i]
+        if turn == 0 and not spread / mpp[d] >= rms[d]:
+            break
+    if spread / mpp[d] >= rms[d]:
+        return False
+    centre[d, 0], centre[d, 1], r[d], rms[d] = bu, bv, br, spread / mpp[d]
+    kept[d] = 0.0
+    for i in range(m):
+        kept[d] += 1.0 if best[i] else 0.0
+    return False
+
+
+@jit
+def _stadium_along(  # type: ignore[no-untyped-def]
+    xy, weight, lo, m, way, cu, cv, r, inner, res, ranked, lu, rhs
+):
+    """The stadium along the unit vector ``way`` fitted to the ``m`` edges from ``lo`` of a disc
+    whose circle has centre ``cu``, ``cv`` and radius ``r``: its centre, half length and radius
+    by weighted Gauss-Newton on the edges' distances to it (:func:`_stadium_steps`), twice, the
+    edges off it by more than 3 robust deviations (:func:`_stadium_bound`) dropped in between.
+    Returns its centre, radius, the RMS distance of the edges kept (``inner``) from it, and
+    whether its equations were ill-conditioned (then the rest is meaningless)."""
+    h, rr = 0.25 * r, r
+    for i in range(m):
+        inner[i] = True
+    for round_ in range(2):
+        cu, cv, h, rr, ill = _stadium_steps(
+            xy, weight, lo, m, way, cu, cv, h, rr, r, inner, res, lu, rhs
+        )
+        if ill:
+            return cu, cv, rr, math.nan, True
+        if round_ == 0:
+            bound = _stadium_bound(res, m, ranked)
             for i in range(m):
-                if inner[i]:
-                    total += res[i] * res[i]
-                    k += 1
-            other = math.sqrt(total / k) if k else math.nan
-            if turn == 0 or other < spread:
-                spread, bu, bv, br = other, cu, cv, rr
-                for i in range(m):
-                    best[i] = inner[i]
-            if turn == 0 and not spread / mpp[d] >= rms[d]:
-                break
-        if redo[d] or spread / mpp[d] >= rms[d]:
-            continue
-        centre[d, 0], centre[d, 1], r[d], rms[d] = bu, bv, br, spread / mpp[d]
-        kept[d] = 0.0
-        for i in range(m):
-            kept[d] += 1.0 if best[i] else 0.0
-    good = np.empty(len(r), np.bool_)
-    for d in range(len(r)):
-        good[d] = kept[d] >= 6 and (gaps[d] <= MAX_ARC_GAP or fixed[d]) and abs(r[d]) < math.inf
-        good[d] &= 0.5 * radius[d] * mpp[d] <= r[d] and r[d] <= 2.5 * radius[d] * mpp[d]
-    return rms, np.nonzero(redo)[0], np.nonzero(good)[0]
+                inner[i] = abs(res[i]) <= bound
+    total, k = 0.0, 0
+    for i in range(m):
+        if inner[i]:
+            total += res[i] * res[i]
+            k += 1
+    return cu, cv, rr, math.sqrt(total / k) if k else math.nan, False
+
+
+@jit
+def _stadium_steps(  # type: ignore[no-untyped-def]
+    xy, weight, lo, m, way, cu, cv, h, rr, r, inner, res, lu, rhs
+):
+    """Up to 8 Gauss-Newton steps of a stadium's centre ``cu``, ``cv``, half length ``h`` and
+    radius ``rr`` (:func:`_stadium_equations`), until each moves less than 1e-6 of ``r``; each
+    edge's distance from the stadium the last step started from left in ``res``. Returns the
+    new ones, and whether the equations were ill-conditioned (a pivot under 1e-7 of the
+    largest: then where that step started)."""
+    for _ in range(8):
+        _stadium_equations(xy, weight, lo, m, way, cu, cv, h, rr, inner, res, lu, rhs)
+        if not _eliminate(lu, rhs):
+            return cu, cv, h, rr, True
+        for i in range(3, -1, -1):
+            for q in range(i + 1, 4):
+                rhs[i] -= lu[i, q] * rhs[q]
+            rhs[i] /= lu[i, i]
+        cu, cv, h, rr = cu + rhs[0], cv + rhs[1], h + rhs[2], rr + rhs[3]
+        if h < 0.0:
+            h = 0.0
+        small = True
+        for p in range(4):
+            small &= abs(rhs[p]) < 1e-6 * r
+        if small:
+            break
+    return cu, cv, h, rr, False
+
+
+@jit
+def _stadium_equations(  # type: ignore[no-untyped-def]
+    xy, weight, lo, m, way, cu, cv, h, rr, inner, res, lu, rhs
+):
+    """Into ``lu`` and ``rhs``: the 4 x 4 normal equations of a Gauss-Newton step of the stadium
+    (centre ``cu``, ``cv``, half length ``h``, radius ``rr``, along ``way``) on the ``m`` edges
+    from ``lo`` that are ``inner``, each weighted by its ``weight``, summed in order; into
+    ``res``: each edge's distance from the stadium."""
+    for p in range(4):
+        rhs[p] = 0.0
+        for q in range(4):
+            lu[p, q] = 0.0
+    for i in range(m):
+        t = (xy[lo + i, 0] - cu) * way[0] + (xy[lo + i, 1] - cv) * way[1]
+        ts = t if t != t or t > -h else -h  # np.clip(t, -h, h)
+        ts = ts if ts != ts or ts < h else h
+        ou, ov = xy[lo + i, 0] - (cu + ts * way[0]), xy[lo + i, 1] - (cv + ts * way[1])
+        gap = math.hypot(ou, ov)
+        gap = gap if gap >= 1e-12 or gap != gap else 1e-12
+        uu, uv = ou / gap, ov / gap
+        ends = (1.0 if t < 0 else -1.0) * (uu * way[0] + uv * way[1]) if abs(t) > h else 0.0
+        jac = (-uu, -uv, ends, -1.0)
+        res[i] = gap - rr
+        wk = weight[lo + i] * (1.0 if inner[i] else 0.0)
+        for p in range(4):
+            for q in range(4):
+                lu[p, q] += jac[p] * wk * jac[q]
+            rhs[p] -= jac[p] * wk * res[i]
+
+
+@jit
+def _eliminate(lu, rhs):  # type: ignore[no-untyped-def]
+    """``lu`` plus 1e-12 on its diagonal (4 x 4), and ``rhs``, reduced in place to an upper
+    triangle by Gaussian elimination with partial pivoting. Whether it is well-conditioned
+    (every pivot at least 1e-7 of the largest so far; else it stops there)."""
+    least, most = math.inf, 0.0
+    for j in range(4):
+        lu[j, j] += 1e-12
+    for j in range(4):
+        p = j
+        for i in range(j + 1, 4):
+            if abs(lu[i, j]) > abs(lu[p, j]):
+                p = i
+        least, most = min(least, abs(lu[p, j])), max(most, abs(lu[p, j]))
+        if not least >= 1e-7 * most:
+            break
+        for q in range(4):
+            lu[j, q], lu[p, q] = lu[p, q], lu[j, q]
+        rhs[j], rhs[p] = rhs[p], rhs[j]
+        for i in range(j + 1, 4):
+            f = lu[i, j] / lu[j, j]
+            for q in range(j + 1, 4):
+                lu[i, q] -= f * lu[j, q]
+            rhs[i] -= f * rhs[j]
+    return least >= 1e-7 * most
+
+
+@jit
+def _stadium_bound(res, m, ranked):  # type: ignore[no-untyped-def]
+    """3 robust deviations (1.4826 times the median, at least 1e-9) of the sizes of the first
+    ``m`` of ``res``: ``np.median``, the middle two's mean; NaN if any is. ``ranked``: room to
+    sort them in."""
+    for i in range(m):
+        q = i - 1
+        while q >= 0 and (ranked[q] > abs(res[i]) or ranked[q] != ranked[q]):
+            ranked[q + 1] = ranked[q]
+            q -= 1
+        ranked[q + 1] = abs(res[i])
+    if ranked[m - 1] != ranked[m - 1]:
+        middle = math.nan
+    elif m % 2:
+        middle = ranked[m // 2]
+    else:
+        middle = (ranked[m // 2 - 1] + ranked[m // 2]) / 2.0
+    bound = 3.0 * (1.4826 * middle)
+    if bound < 1e-9:
+        bound = 1e-9
+    return bound
 
 
 def _good(
