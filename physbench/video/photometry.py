@@ -139,10 +139,47 @@ def _light(pixels, flat, u, v, bg, usable, bodies):  # type: ignore[no-untyped-d
 
     Per channel, ``frame ≈ gain * background + offset`` by iteratively reweighted least
     squares with Tukey's biweight from the median ratio (the scale from its residuals):
-    foreground the meter did not know of (a hand, a shadow) gets weight 0. The loop repeats
-    the NumPy expressions it replaced operation for operation; their sums added in index
+    foreground the meter did not know of (a hand, a shadow) gets weight 0. The loops repeat
+    the NumPy expressions they replaced operation for operation; their sums added in index
     order (``.sum(axis=1)`` of ``(3, kept)`` arrays laid out pixel by pixel, so not
     pairwise), as these do, and a median of the same values is the same by any method."""
+    x, y, m = _kept(pixels, flat, u, v, bg, usable, bodies)
+    gain, offset = np.ones(3), np.zeros(3)
+    if m < 30:
+        return gain, offset, 0.0, 0, m
+    scale = np.empty(3)
+    spread = np.empty(3, np.bool_)
+    r = np.empty((3, m))
+    w = np.empty((3, m))
+    work = np.empty((3, m))  # a median's values in row 0; the other rows its selection's
+    for c in range(3):  # the gain's start: the median ratio
+        for j in range(m):
+            work[0, j] = y[c, j] / max(x[c, j], 1.0)
+        spread[c] = _spread(x, c, m)
+        gain[c] = _median(work, m)
+    for c in range(3):  # the scale: the median magnitude of the residuals
+        for j in range(m):
+            r[c, j] = y[c, j] - gain[c] * x[c, j]
+            work[0, j] = abs(r[c, j])
+        scale[c] = TUKEY * max(1.4826 * _median(work, m), 0.5)
+    for _ in range(2):
+        for c in range(3):
+            gain[c], offset[c] = _reweighted(x, y, r, w, c, m, scale[c], spread[c])
+    for j in range(m):
+        work[0, j] = max(max(abs(r[0, j]), abs(r[1, j])), abs(r[2, j]))
+    sigma = 1.4826 * _median(work, m)
+    samples = 0
+    for j in range(m):
+        samples += w[0, j] > 0 and w[1, j] > 0 and w[2, j] > 0
+    return gain, offset, sigma, samples, m
+
+
+@jit
+def _kept(pixels, flat, u, v, bg, usable, bodies):  # type: ignore[no-untyped-def]
+    """The grid's pixels :func:`_light` fits on: ``(x, y, m)``, the background ``x`` and the
+    frame ``y`` (both ``(3, n)``) of the first ``m`` columns, in grid order, at the pixels
+    whose background is not clipped, whose frame is under 254 in every channel, and that lie
+    outside every body."""
     n = len(flat)
     x = np.empty((3, n))
     y = np.empty((3, n))
@@ -161,95 +198,84 @@ def _light(pixels, flat, u, v, bg, usable, bodies):  # type: ignore[no-untyped-d
             for c in range(3):
                 x[c, m], y[c, m] = bg[c, i], y[c, i]
             m += 1
-    gain, offset = np.ones(3), np.zeros(3)
-    if m < 30:
-        return gain, offset, 0.0, 0, m
-    scale, sigma = np.empty(3), 0.0
-    spread = np.empty(3, np.bool_)
-    r = np.empty((3, m))
-    w = np.empty((3, m))
-    work = np.empty((3, m))  # a median's values in row 0; the other rows its selection's
-    # Seven medians at one place in the code: per channel the ratio (the gain's start) and
-    # then its residuals' magnitude (their scale); after the fit, the largest channel residual.
-    for job in range(7):
-        c = job % 3
-        if job < 3:
-            for j in range(m):
-                work[0, j] = y[c, j] / max(x[c, j], 1.0)
-            mean = 0.0
-            for j in range(m):
-                mean += x[c, j]
-            mean /= m
-            var = 0.0
-            for j in range(m):
-                d = x[c, j] - mean
-                var += d * d
-            spread[c] = np.sqrt(var / m) >= MIN_SPREAD
-        elif job < 6:
-            for j in range(m):
-                r[c, j] = y[c, j] - gain[c] * x[c, j]
-                work[0, j] = abs(r[c, j])
-        else:
-            for _ in range(2):
-                for ch in range(3):
-                    # Weighted sums of 1, x, y, xx and xy.
-                    sw, sx, sy, sxx, sxy = 0.0, 0.0, 0.0, 0.0, 0.0
-                    for j in range(m):
-                        z = r[ch, j] / scale[ch]
-                        t = max(1 - z * z, 0.0)
-                        w[ch, j] = t * t
-                        wx = w[ch, j] * x[ch, j]
-                        sw += w[ch, j]
-                        sx += wx
-                        sy += w[ch, j] * y[ch, j]
-                        sxx += wx * x[ch, j]
-                        sxy += wx * y[ch, j]
-                    if spread[ch]:
-                        det = sw * sxx - sx * sx
-                        gain[ch] = (sw * sxy - sx * sy) / max(det, 1e-9)
-                        offset[ch] = (sy - gain[ch] * sx) / max(sw, 1e-9)
-                    else:
-                        gain[ch], offset[ch] = sxy / max(sxx, 1e-9), 0.0
-                    for j in range(m):
-                        r[ch, j] = y[ch, j] - gain[ch] * x[ch, j] - offset[ch]
-            for j in range(m):
-                work[0, j] = max(max(abs(r[0, j]), abs(r[1, j])), abs(r[2, j]))
-        # The median of work[0, :m], by quickselect with three-way partitions out of place:
-        # each value is written to both other rows, each write index moved on by a comparison
-        # (no branch on the data, which a branch predictor cannot learn).
-        k, size, cur, below = m // 2, m, 0, -np.inf  # below: the largest value left below
-        while True:
-            lo, hi = (cur + 1) % 3, (cur + 2) % 3
-            p0, p1, p2 = work[cur, 0], work[cur, size // 2], work[cur, size - 1]
-            pivot = max(min(p0, p1), min(max(p0, p1), p2))  # the median of three
-            less = more = 0
-            for j in range(size):
-                value = work[cur, j]
-                work[lo, less] = value
-                less += value < pivot
-                work[hi, more] = value
-                more += value > pivot
-            if k < less:
-                cur, size = lo, less
-            elif k < size - more:  # the pivot
-                break
-            else:
-                cur, size, k, below = hi, more, k - (size - more), pivot
-        middle = pivot
-        if m % 2 == 0:  # the mean of the two middle values
-            if k == less:
-                for j in range(less):
-                    below = max(below, work[lo, j])
-            else:
-                below = pivot
-            middle = (below + middle) / 2
-        if job < 3:
-            gain[c] = middle
-        elif job < 6:
-            scale[c] = TUKEY * max(1.4826 * middle, 0.5)
-        else:
-            sigma = 1.4826 * middle
-    samples = 0
+    return x, y, m
+
+
+@jit
+def _spread(x, c, m):  # type: ignore[no-untyped-def]
+    """Whether the standard deviation of ``x[c, :m]`` (its mean and squared deviations added in
+    index order) is at least :data:`MIN_SPREAD`: else the fit keeps the offset at 0."""
+    mean = 0.0
     for j in range(m):
-        samples += w[0, j] > 0 and w[1, j] > 0 and w[2, j] > 0
-    return gain, offset, sigma, samples, m
+        mean += x[c, j]
+    mean /= m
+    var = 0.0
+    for j in range(m):
+        d = x[c, j] - mean
+        var += d * d
+    return np.sqrt(var / m) >= MIN_SPREAD
+
+
+@jit
+def _reweighted(x, y, r, w, c, m, scale, spread):  # type: ignore[no-untyped-def]
+    """One step of channel ``c``'s fit: Tukey's biweights ``w[c, :m]`` of the residuals
+    ``r[c, :m]`` at ``scale``, the weighted least-squares gain and offset (the offset 0 where
+    the background has no ``spread``), and the residuals ``r[c, :m]`` of that fit; returns
+    the gain and the offset."""
+    # Weighted sums of 1, x, y, xx and xy.
+    sw, sx, sy, sxx, sxy = 0.0, 0.0, 0.0, 0.0, 0.0
+    for j in range(m):
+        z = r[c, j] / scale
+        t = max(1 - z * z, 0.0)
+        w[c, j] = t * t
+        wx = w[c, j] * x[c, j]
+        sw += w[c, j]
+        sx += wx
+        sy += w[c, j] * y[c, j]
+        sxx += wx * x[c, j]
+        sxy += wx * y[c, j]
+    if spread:
+        det = sw * sxx - sx * sx
+        gain = (sw * sxy - sx * sy) / max(det, 1e-9)
+        offset = (sy - gain * sx) / max(sw, 1e-9)
+    else:
+        gain, offset = sxy / max(sxx, 1e-9), 0.0
+    for j in range(m):
+        r[c, j] = y[c, j] - gain * x[c, j] - offset
+    return gain, offset
+
+
+@jit
+def _median(work, m):  # type: ignore[no-untyped-def]
+    """The median of ``work[0, :m]`` (``m`` at least 1), the mean of the two middle values where
+    ``m`` is even; ``work`` ``(3, m)`` is overwritten."""
+    # Quickselect with three-way partitions out of place: each value is written to both other
+    # rows, each write index moved on by a comparison (no branch on the data, which a branch
+    # predictor cannot learn).
+    k, size, cur, below = m // 2, m, 0, -np.inf  # below: the largest value left below
+    while True:
+        lo, hi = (cur + 1) % 3, (cur + 2) % 3
+        p0, p1, p2 = work[cur, 0], work[cur, size // 2], work[cur, size - 1]
+        pivot = max(min(p0, p1), min(max(p0, p1), p2))  # the median of three
+        less = more = 0
+        for j in range(size):
+            value = work[cur, j]
+            work[lo, less] = value
+            less += value < pivot
+            work[hi, more] = value
+            more += value > pivot
+        if k < less:
+            cur, size = lo, less
+        elif k < size - more:  # the pivot
+            break
+        else:
+            cur, size, k, below = hi, more, k - (size - more), pivot
+    middle = pivot
+    if m % 2 == 0:  # the mean of the two middle values
+        if k == less:
+            for j in range(less):
+                below = max(below, work[lo, j])
+        else:
+            below = pivot
+        middle = (below + middle) / 2
+    return middle

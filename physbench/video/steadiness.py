@@ -403,9 +403,36 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
     ``dgesv`` solves them for ``np.linalg.solve``: the same to the bit on the machine measured
     (OpenBLAS 0.3.31, AMD EPYC), where BLAS's sums came out the same; elsewhere to rounding. An
     exactly zero pivot, which LAPACK calls singular, finds nothing."""
+    mid = _median_abs(d)
+    # Squares as products: Python's ** 2 (libm's pow) is a last bit off for about 0.1 % of
+    # values, which moves the float32 bound only where it lies on a float32 rounding boundary.
+    bound = CLIP * max(1.4826 * np.float64(mid), 1.0)
+    keep = np.float32(min(np.float64(clip2), bound * bound))
+    kept, count = _agreeing(d, keep)
+    if count < MIN_SAMPLES:
+        return False, 0.0, 0.0
+    values = _background(kept, count, du, dv, bank, planes, rows, cols, h, w)
+    m, rhs = _normal_equations(values, kept, count, seen)
+    uu, uv, vv = m[2, 2], m[2, 3], m[3, 3]
+    if not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
+        return False, 0.0, 0.0  # edges of one direction only
+    if not _solve(m, rhs):
+        return False, 0.0, 0.0  # singular: np.linalg.solve's LinAlgError
+    gain = rhs[0]
+    if not gain > 0.1:
+        return False, 0.0, 0.0
+    su, sv = rhs[2] / gain, rhs[3] / gain
+    su, sv = -1.0 if su < -1.0 else su, -1.0 if sv < -1.0 else sv  # Python's max(s, -1.0)
+    su, sv = 1.0 if su > 1.0 else su, 1.0 if sv > 1.0 else sv  # and min(s, 1.0)
+    return True, su, sv
+
+
+@jit
+def _median_abs(d):  # type: ignore[no-untyped-def]
+    """The median of ``|d|`` (float32) as np.median finds it: the middle one, or the mean of the
+    middle two (float32)."""
+    # By quickselect: np.partition added 14 s to the compile of the loop that called it.
     n = len(d)
-    # The median of |d| as np.median finds it: the middle one, or the mean of the middle two
-    # (float32), by quickselect: np.partition added 14 s to this loop's compile.
     size = np.abs(d)
     lo, hi, k = 0, n - 1, n // 2
     while lo < hi:
@@ -431,29 +458,39 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
         for i in range(1, k):
             below = max(below, size[i])
         mid = np.float32(np.float64(below + mid) / 2)
-    # Squares as products: Python's ** 2 (libm's pow) is a last bit off for about 0.1 % of
-    # values, which moves the float32 bound only where it lies on a float32 rounding boundary.
-    bound = CLIP * max(1.4826 * np.float64(mid), 1.0)
-    keep = np.float32(min(np.float64(clip2), bound * bound))
+    return mid
 
-    def half(bits):  # type: ignore[no-untyped-def]
-        """The float16 of ``bits`` as a float32."""
-        e = (bits >> 10) & 31
-        if e == 31:
-            v = np.float32(np.inf) if bits & 1023 == 0 else np.float32(np.nan)
-        else:
-            v = np.float32((bits & 1023) + (1024 if e else 0)) * _SCALE[e]
-        return -v if bits & 32768 else v
 
-    # The samples that agree, read first (each read independent of the sums), then summed.
-    kept = np.empty(n, np.intp)
+@jit
+def _agreeing(d, keep):  # type: ignore[no-untyped-def]
+    """The samples that agree, ``d * d < keep``: their indices (the first ``count`` of the
+    array) and ``count``."""
+    kept = np.empty(len(d), np.intp)
     count = 0
-    for i in range(n):
+    for i in range(len(d)):
         if d[i] * d[i] < keep:
             kept[count] = i
             count += 1
-    if count < MIN_SAMPLES:
-        return False, 0.0, 0.0
+    return kept, count
+
+
+@jit
+def _half(bits):  # type: ignore[no-untyped-def]
+    """The float16 of ``bits`` as a float32."""
+    e = (bits >> 10) & 31
+    if e == 31:
+        v = np.float32(np.inf) if bits & 1023 == 0 else np.float32(np.nan)
+    else:
+        v = np.float32((bits & 1023) + (1024 if e else 0)) * _SCALE[e]
+    return -v if bits & 32768 else v
+
+
+@jit
+def _background(kept, count, du, dv, bank, planes, rows, cols, h, w):  # type: ignore[no-untyped-def]
+    """The background's grey and its gradients ``(count, 3)`` float32 at the first ``count``
+    samples of ``kept``, shifted by ``(du, dv)``: read from ``bank`` where it holds the shift,
+    else from ``planes`` at the sample less the shift, clamped to the picture. Read before any
+    sum: each read is independent of the others."""
     values = np.empty((count, 3), np.float32)
     if abs(du) <= BANK and abs(dv) <= BANK:
         row = (dv + BANK) * (2 * BANK + 1) + du + BANK
@@ -465,10 +502,16 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
             i = kept[t]
             q = min(max(rows[i] - dv, 0), h - 1) * w + min(max(cols[i] - du, 0), w - 1)
             for p in range(3):
-                values[t, p] = half(planes[p, q])
-    # The normal equations of the columns (e, 1, -gu, -gv), each sum in sample order; the
-    # matrix is symmetric (as NumPy's a.T @ a came out), and gu @ gu, gu @ gv and gv @ gv are
-    # three of its sums.
+                values[t, p] = _half(planes[p, q])
+    return values
+
+
+@jit
+def _normal_equations(values, kept, count, seen):  # type: ignore[no-untyped-def]
+    """The normal equations ``(m, rhs)`` of the columns (e, 1, -gu, -gv) of ``values`` against
+    the frame's grey ``seen`` at the first ``count`` samples of ``kept``, each sum in sample
+    order in float64. The matrix is symmetric (as NumPy's a.T @ a came out), and gu @ gu,
+    gu @ gv and gv @ gv are three of its sums."""
     ee = e1 = eu = ev = u1 = v1 = uu = uv = vv = es = s1 = us = vs = 0.0
     for t in range(count):
         e, u, v = np.float64(values[t, 0]), -np.float64(values[t, 1]), -np.float64(values[t, 2])
@@ -480,8 +523,14 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
         [[ee, e1, eu, ev], [e1, np.float64(count), u1, v1], [eu, u1, uu, uv], [ev, v1, uv, vv]]
     )
     rhs = np.array([es, s1, us, vs])
-    if not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
-        return False, 0.0, 0.0  # edges of one direction only
+    return m, rhs
+
+
+@jit
+def _solve(m, rhs):  # type: ignore[no-untyped-def]
+    """Solves ``m x = rhs`` (4 x 4) in place, ``x`` in ``rhs`` (``m`` its LU factors), as
+    OpenBLAS's ``dgesv`` does; ``False`` (``rhs`` part way) at an exactly zero pivot, where
+    LAPACK calls ``m`` singular."""
     # LU with partial pivoting as OpenBLAS's dgetf2 (column by column, each entry less one dot
     # product; the multipliers scaled by the pivot's reciprocal), then its dgetrs (updates
     # column by column, dividing by the diagonal). Of 100 systems from shaken walls, textbook
@@ -502,7 +551,7 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
             if abs(m[i, j]) > abs(m[p, j]):
                 p = i
         if m[p, j] == 0.0:
-            return False, 0.0, 0.0  # singular: np.linalg.solve's LinAlgError
+            return False
         for t in range(4):
             m[j, t], m[p, t] = m[p, t], m[j, t]
         rhs[j], rhs[p] = rhs[p], rhs[j]
@@ -517,10 +566,4 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
         x[j] /= m[j, j]
         for i in range(j):
             x[i] += -x[j] * m[i, j]
-    gain = x[0]
-    if not gain > 0.1:
-        return False, 0.0, 0.0
-    su, sv = x[2] / gain, x[3] / gain
-    su, sv = -1.0 if su < -1.0 else su, -1.0 if sv < -1.0 else sv  # Python's max(s, -1.0)
-    su, sv = 1.0 if su > 1.0 else su, 1.0 if sv > 1.0 else sv  # and min(s, 1.0)
-    return True, su, sv
+    return True
