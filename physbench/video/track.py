@@ -70,7 +70,7 @@ from physbench.video.detect import (
 from physbench.video.faint import SHUTTER, SIGNIFICANCE, Faint, find_faint, look_elsewhere
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
-from physbench.video.photometry import DEVIATIONS, Light, LightMeter, plate_index
+from physbench.video.photometry import DEVIATIONS, Light, LightMeter
 from physbench.video.silhouette import (
     DiscFit,
     Rays,
@@ -338,7 +338,6 @@ class Tracker:
         self.scene, self.cal, self.bg = scene, calibration, background
         self.subsampled = subsampled  # colour at a lower resolution: discs fitted without halos
         self.linear = Decoder(transfer)  # pixel values to linear light, for the unmixing
-        self.bg_index = plate_index(background)  # once: each window's difference reads it
         self.h, self.w = background.shape[:2]
         self.g = np.asarray(scene.gravity, dtype=float)
         self.motion = Motion(scene)
@@ -452,7 +451,7 @@ class Tracker:
             iu, iv = (round(c) for c in self.pred_uv[i])
             if r <= iu < self.w - r and r <= iv < self.h - r:
                 box = (slice(iv - r, iv + r + 1), slice(iu - r, iu + r + 1))
-                patch = self.light.difference(image[box], self.bg[box], self.bg_index[box])
+                patch = self.light.difference(image[box], self.bg[box])
                 mid, s.contrast = (float(q) for q in np.percentile(patch, [50, 90]))
                 values.append(s.contrast)
                 # A disc of a few pixels has no inside to take a median over (its box is
@@ -474,7 +473,7 @@ class Tracker:
         brick wall at CRF 27: 4.3 deviations, against a puck whose median is 6.3)."""
         if self.light.sigma <= 0:
             return DEVIATIONS
-        diff = self.light.difference(image, self.bg, self.bg_index)
+        diff = self.light.difference(image, self.bg)
         vv, uu = np.ogrid[: self.h, : self.w]
         away = np.ones((self.h, self.w), dtype=bool)
         for (u, v), r in zip(self.pred_uv, reach, strict=True):
@@ -639,7 +638,7 @@ class Tracker:
             r0, r1 = max(0, int(v) - reach), min(self.h, int(v) + reach + 1)
             c0, c1 = max(0, int(u) - reach), min(self.w, int(u) + reach + 1)
             crop = (slice(r0, r1), slice(c0, c1))
-            diff = self.light.difference(image[crop], self.bg[crop], self.bg_index[crop])
+            diff = self.light.difference(image[crop], self.bg[crop])
             blobs = find_blobs(diff, self.low, self.high, offset=(r0, c0), min_area=2.0)
             near = [
                 b
@@ -913,7 +912,7 @@ class Tracker:
         for group, (r0, r1, c0, c1) in self._windows(ids, reach):
             crop = (slice(r0, r1), slice(c0, c1))
             window = (
-                self.light.difference(image[crop], self.bg[crop], self.bg_index[crop]),
+                self.light.difference(image[crop], self.bg[crop]),
                 (r0, c0),
             )
             small = min(self.states[i].area for i in group)
@@ -1276,7 +1275,7 @@ class Tracker:
             if r1 - r0 < 3 or c1 - c0 < 3:
                 continue
             box = (slice(r0, r1), slice(c0, c1))
-            diff = self.light.difference(image[box], self.bg[box], self.bg_index[box])
+            diff = self.light.difference(image[box], self.bg[box])
             crops.append((diff, (r0, c0), [rays]))
             fitted.append(k)
         fits: list[DiscFit | None] = [None] * len(plans)
