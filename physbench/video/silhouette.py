@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.video.compiled import jit
+from physbench.video.compiled import jit, solve
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -332,7 +332,7 @@ def _circle_fits(  # type: ignore[no-untyped-def]
 
     As the NumPy expressions it replaces, to the bit: the normal equations are summed as
     ``np.add.reduceat`` sums them (pairwise, :func:`_reduceat`) and solved as OpenBLAS's LAPACK
-    ``dgesv`` solves them (:func:`_lu_factor`, :func:`_lu_solve`)."""
+    ``dgesv`` solves them (:func:`~physbench.video.compiled.solve`)."""
     count, n = len(radius), len(chosen)
     own, theta, contrast, width = _gathered(chosen, owner, angle, strength, spread)
     sizes, starts = _runs(own, count)
@@ -343,7 +343,7 @@ def _circle_fits(  # type: ignore[no-untyped-def]
     a, terms, sums = np.empty((n, 4)), np.empty((12, n)), np.empty((count, 12))
     mean, centre, r = np.zeros((count, 2)), np.empty((count, 2)), np.empty(count)
     todo, part, lanes = np.empty((64, 3), np.intp), np.empty(64), np.empty(8)
-    lu, rhs, piv = np.empty((3, 3)), np.empty(3), np.empty(3, np.intp)
+    lu, rhs = np.empty((3, 3)), np.empty(3)
     # Stage 0: each disc's mean and median edge width. Then its circle through all its edges;
     # through the three quarters nearest that circle (least trimmed squares: a highlight's rim
     # is a tight cluster of edges inside the outline, which a fit to all of them leans to); and
@@ -380,7 +380,7 @@ def _circle_fits(  # type: ignore[no-untyped-def]
             continue
         for d in range(count):
             centre[d, 0], centre[d, 1], r[d] = _circle(
-                sums, d, w, starts[d], sizes[d], mean, lu, rhs, piv
+                sums, d, w, starts[d], sizes[d], mean, lu, rhs
             )
     kept, gaps = _arcs(keep, own, theta, count)
     short = np.zeros(count, np.bool_)  # to be fitted with their known radius
@@ -588,11 +588,11 @@ def _centred(xy, own, sums, sizes, mean, a):  # type: ignore[no-untyped-def]
 
 
 @jit
-def _circle(sums, d, w, start, size, mean, lu, rhs, piv):  # type: ignore[no-untyped-def]
+def _circle(sums, d, w, start, size, mean, lu, rhs):  # type: ignore[no-untyped-def]
     """Disc ``d``'s circle, its centre u, v and radius, from its row of ``sums`` (the normal
     equations' terms) by the normal equations for (2 centre, r^2 - |centre|^2) about its mean;
     NaN where fewer than 3 of its ``size`` edges from ``start`` weigh (``w``) anything, or the
-    equations are singular. ``lu``, ``rhs`` and ``piv``: room to work in."""
+    equations are singular. ``lu`` and ``rhs``: room to work in."""
     weighted = 0
     for i in range(start, start + size):
         if w[i] > 0:
@@ -604,59 +604,11 @@ def _circle(sums, d, w, start, size, mean, lu, rhs, piv):  # type: ignore[no-unt
         rhs[j] = sums[d, 4 * j + 3]
         for k in range(3):
             lu[j, k] = sums[d, 4 * j + k] + eps * (1.0 if j == k else 0.0)
-    if _lu_factor(lu, piv):
+    if not solve(lu, rhs):
         return math.nan, math.nan, math.nan
-    _lu_solve(lu, piv, rhs)
     cu, cv = rhs[0] / 2, rhs[1] / 2
     q = rhs[2] + (cu * cu + cv * cv)
     return cu + mean[d, 0], cv + mean[d, 1], math.sqrt(q if q >= 0.0 or q != q else 0.0)
-
-
-@jit
-def _lu_factor(lu, piv):  # type: ignore[no-untyped-def]
-    """``lu`` (3 x 3) factored in place as OpenBLAS's LAPACK ``dgetrf`` factors it (left-looking
-    LU, partial pivoting, the pivot's reciprocal scaling its column, no fused products), the
-    pivots into ``piv``. Whether it is singular (a zero pivot: where NumPy raises)."""
-    for j in range(3):
-        for i in range(j):  # this column's rows interchanged as the earlier ones were
-            if piv[i] != i:
-                lu[i, j], lu[piv[i], j] = lu[piv[i], j], lu[i, j]
-        for i in range(1, 3):  # less the products of the rows above: U above, L below
-            if min(i, j):
-                dot = 0.0
-                for q in range(min(i, j)):
-                    dot += lu[i, q] * lu[q, j]
-                lu[i, j] -= dot
-        p = j
-        for i in range(j + 1, 3):
-            if abs(lu[i, j]) > abs(lu[p, j]):
-                p = i
-        piv[j] = p
-        if lu[p, j] == 0.0:
-            return True
-        inverse = 1.0 / lu[p, j]
-        if p != j:
-            for q in range(j + 1):
-                lu[j, q], lu[p, q] = lu[p, q], lu[j, q]
-        for i in range(j + 1, 3):
-            lu[i, j] *= inverse
-    return False
-
-
-@jit
-def _lu_solve(lu, piv, rhs):  # type: ignore[no-untyped-def]
-    """``rhs`` (3) solved in place by :func:`_lu_factor`'s ``lu`` and ``piv``, as ``dgetrs``
-    solves it."""
-    for i in range(3):
-        if piv[i] != i:
-            rhs[i], rhs[piv[i]] = rhs[piv[i]], rhs[i]
-    for i in range(3):
-        for q in range(i + 1, 3):
-            rhs[q] += -rhs[i] * lu[q, i]
-    for i in range(2, -1, -1):
-        rhs[i] /= lu[i, i]
-        for q in range(i):
-            rhs[q] += -rhs[i] * lu[q, i]
 
 
 @jit

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physbench.video.compiled import jit
+from physbench.video.compiled import jit, solve
 from physbench.video.photometry import Light
 
 #: Side (px) of the box a sample averages.
@@ -344,15 +344,6 @@ def _residuals(  # type: ignore[no-untyped-def]
             top += 1
         return np.float32(0.0) + sums[0]
 
-    def half(bits):  # type: ignore[no-untyped-def]
-        """The float16 of ``bits`` as a float32."""
-        e = (bits >> 10) & 31
-        if e == 31:
-            v = np.float32(np.inf) if bits & 1023 == 0 else np.float32(np.nan)
-        else:
-            v = np.float32((bits & 1023) + (1024 if e else 0)) * _SCALE[e]
-        return -v if bits & 32768 else v
-
     for i in range(m):
         mine[i] = seen[i * nth]
     sm = np.float32(np.float64(total(mine)) / m)
@@ -370,7 +361,7 @@ def _residuals(  # type: ignore[no-untyped-def]
             for i in range(m):
                 r = min(max(rows[i * nth] - dv, 0), h - 1)
                 c = min(max(cols[i * nth] - du, 0), w - 1)
-                de[i] = half(planes[0, r * w + c])
+                de[i] = _half(planes[0, r * w + c])
         # The shift's four sums (of e; of (e - mean e)(s - mean s) and (e - mean e)^2; of the
         # clipped squared residuals) at one call of `total`: numba copies a closure into each
         # place it is called from, and each copy added about 1.1 s to the compile (8.0 s with
@@ -416,7 +407,7 @@ def _lucas_kanade(d, du, dv, bank, planes, rows, cols, h, w, seen, clip2):  # ty
     uu, uv, vv = m[2, 2], m[2, 3], m[3, 3]
     if not uu * vv - uv * uv > 1e-6 * ((uu + vv) * (uu + vv)):
         return False, 0.0, 0.0  # edges of one direction only
-    if not _solve(m, rhs):
+    if not solve(m, rhs):
         return False, 0.0, 0.0  # singular: np.linalg.solve's LinAlgError
     gain = rhs[0]
     if not gain > 0.1:
@@ -524,46 +515,3 @@ def _normal_equations(values, kept, count, seen):  # type: ignore[no-untyped-def
     )
     rhs = np.array([es, s1, us, vs])
     return m, rhs
-
-
-@jit
-def _solve(m, rhs):  # type: ignore[no-untyped-def]
-    """Solves ``m x = rhs`` (4 x 4) in place, ``x`` in ``rhs`` (``m`` its LU factors), as
-    OpenBLAS's ``dgesv`` does; ``False`` (``rhs`` part way) at an exactly zero pivot, where
-    LAPACK calls ``m`` singular."""
-    # LU with partial pivoting as OpenBLAS's dgetf2 (column by column, each entry less one dot
-    # product; the multipliers scaled by the pivot's reciprocal), then its dgetrs (updates
-    # column by column, dividing by the diagonal). Of 100 systems from shaken walls, textbook
-    # elimination matched np.linalg.solve to the bit in 3; this in all.
-    for j in range(4):
-        for i in range(1, j):
-            dot = 0.0
-            for t in range(i):
-                dot += m[i, t] * m[t, j]
-            m[i, j] -= dot
-        for i in range(j, 4):
-            dot = 0.0
-            for t in range(j):
-                dot += m[i, t] * m[t, j]
-            m[i, j] -= dot
-        p = j
-        for i in range(j + 1, 4):
-            if abs(m[i, j]) > abs(m[p, j]):
-                p = i
-        if m[p, j] == 0.0:
-            return False
-        for t in range(4):
-            m[j, t], m[p, t] = m[p, t], m[j, t]
-        rhs[j], rhs[p] = rhs[p], rhs[j]
-        scale = 1.0 / m[j, j]
-        for i in range(j + 1, 4):
-            m[i, j] *= scale
-    x = rhs
-    for j in range(4):
-        for i in range(j + 1, 4):
-            x[i] += -x[j] * m[i, j]
-    for j in range(3, -1, -1):
-        x[j] /= m[j, j]
-        for i in range(j):
-            x[i] += -x[j] * m[i, j]
-    return True

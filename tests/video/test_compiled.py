@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from physbench.video.compiled import CompiledError, jit, pairwise_sum
+from physbench.video.compiled import CompiledError, jit, pairwise_sum, solve
 
 
 def test_a_compiled_function_gives_what_the_python_gives() -> None:
@@ -42,6 +42,22 @@ def test_the_pairwise_sum_is_numpys_to_the_bit(dtype: type) -> None:
         a = (rng.standard_normal(n) * 10 ** rng.uniform(-3, 3, n)).astype(dtype)
         assert pairwise_sum(a, 0, n) == a.sum(), n
         assert pairwise_sum(a, 3, max(n - 5, 0)) == a[3 : max(n - 2, 3)].sum(), n
+
+
+@pytest.mark.parametrize("n", [3, 4])
+def test_the_small_solve_is_numpys(n: int) -> None:
+    # To the bit where OpenBLAS's sums come out as the loop's (the machine measured); the
+    # residual check holds on any BLAS.
+    rng = np.random.default_rng(n)
+    for _ in range(200):
+        a = rng.standard_normal((n, n)) * 10 ** rng.uniform(-2, 2, (n, n))
+        b = rng.standard_normal(n)
+        m, x = a.copy(), b.copy()
+        assert solve(m, x)
+        np.testing.assert_allclose(x, np.linalg.solve(a, b), rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(a @ x, b, rtol=1e-8, atol=1e-8)
+    singular = np.ones((n, n))
+    assert not solve(singular, np.ones(n))  # np.linalg.solve raises LinAlgError
 
 
 @jit
