@@ -14,8 +14,9 @@ where the picture moved): the whole-pixel shift where frame and background agree
 frame's, while it agrees as well as the clip's frames did; else a walk downhill over 3 x 3 shifts,
 and a search of every shift up to :data:`SEARCH` px where the walk ends in a false dip of a
 periodic wall, bricks), then a Lucas-Kanade step between pixels with the light fitted with it. It
-costs 0.15-0.3 ms a 640x480 frame (0.29 on the noisy, flickering rack of the tracking speed
-benchmark, where the search runs in half the frames). Measured on tiled walls in another light:
+costs 0.25 ms a 640x480 frame on the noisy, flickering rack of the tracking speed benchmark,
+where the search runs in half the frames (its loops compiled; 1.1 ms in NumPy, on a machine that
+decodes the clip at 600-700 frames/s). Measured on tiled walls in another light:
 within 0.08 px of shifts up to 4 px; on a toss whose camera shook 0.3 px a frame (2.5 px at most),
 within 0.15 px. A background with no texture shows no shift, and none is needed: moving a plain
 wall changes no pixel.
