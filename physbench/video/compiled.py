@@ -10,22 +10,28 @@ its results are the same to the bit unless its docstring says otherwise.
 :func:`jit` compiles a function on its first call, not on import: ``import physbench.video.track``
 does not load numba (half a second), and a command that tracks nothing never pays for it. The
 machine code is cached on disk (numba's ``cache=True``: beside the module, or in the user's cache
-folder where that is read-only), so only the first call after installing compiles.
+folder where that is read-only), so only the first call after installing compiles; where neither
+is writable, a :class:`CompiledCacheWarning` says so and each process compiles its own.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-from physbench.errors import PhysbenchError
+from physbench.errors import PhysbenchError, PhysbenchWarning
 
 
 class CompiledError(PhysbenchError, ImportError):
     """numba is not installed, so the tracker's compiled loops cannot run."""
+
+
+class CompiledCacheWarning(PhysbenchWarning):
+    """numba has no writable folder to cache the compiled loops in: each process compiles them."""
 
 
 def load_numba() -> Any:
@@ -55,7 +61,11 @@ class _Compiled:
         a compiled function from compiled code only through its dispatcher."""
         if self._machine is None:
             numba = load_numba()
-            self._machine = numba.njit(cache=True, nogil=True, boundscheck=False)(self.fn)
+            try:
+                self._machine = numba.njit(cache=True, nogil=True, boundscheck=False)(self.fn)
+            except RuntimeError as exc:  # numba found no writable folder for its cache
+                _uncached(exc)
+                self._machine = numba.njit(nogil=True, boundscheck=False)(self.fn)
             names = self.fn.__globals__
             names[self.__name__] = self._machine  # a recursive call finds it too
             for name in self.fn.__code__.co_names:
@@ -70,6 +80,22 @@ class _Compiled:
 
 #: Every function made with :func:`jit` in the modules imported so far.
 _ALL: list[_Compiled] = []
+
+_warned: list[bool] = []
+
+
+def _uncached(exc: RuntimeError) -> None:
+    """Called where numba cannot cache a function's machine code (neither the folder beside
+    the module nor the user's cache folder is writable): says so once a process, and how to
+    give it a folder; the loops are compiled for this process alone."""
+    if not _warned:
+        _warned.append(True)
+        warnings.warn(
+            f"the tracker's compiled loops cannot be kept on disk ({exc}): each process "
+            "compiles them again, about a minute; set NUMBA_CACHE_DIR to a writable folder",
+            CompiledCacheWarning,
+            stacklevel=4,
+        )
 
 
 def cached() -> bool:

@@ -9,7 +9,13 @@ import sys
 import numpy as np
 import pytest
 
-from physbench.video.compiled import CompiledError, jit, pairwise_sum, solve
+from physbench.video.compiled import (
+    CompiledCacheWarning,
+    CompiledError,
+    jit,
+    pairwise_sum,
+    solve,
+)
 
 
 def test_a_compiled_function_gives_what_the_python_gives() -> None:
@@ -33,6 +39,25 @@ def test_without_numba_the_error_names_the_extra(monkeypatch: pytest.MonkeyPatch
     monkeypatch.setitem(sys.modules, "numba", None)  # import numba raises ImportError
     with pytest.raises(CompiledError, match=r"pip install 'physbench\[video\]'"):
         jit(lambda x: x)(1.0)
+
+
+def test_without_a_writable_cache_folder_the_loops_compile_with_a_warning(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Neither the folder beside the module nor the user's cache folder writable: numba finds no
+    # place to keep machine code (its locators all decline) and refuses cache=True.
+    from numba.core import caching
+
+    import physbench.video.compiled as compiled
+
+    monkeypatch.setattr(caching.CacheImpl, "_locator_classes", [])
+    monkeypatch.setattr(compiled, "_warned", [])
+
+    def cube(x):  # type: ignore[no-untyped-def]
+        return x * x * x
+
+    with pytest.warns(CompiledCacheWarning, match="NUMBA_CACHE_DIR"):
+        assert jit(cube)(3.0) == 27.0
 
 
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
