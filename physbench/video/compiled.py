@@ -125,8 +125,9 @@ def pairwise_sum(a: Any, start: int, n: int) -> Any:
         return _block_sum(a, start, n)
     # Post-order over the halving tree: each entry a range and how far it has got (0: neither
     # half summed, 1: the first, 2: both), its halves' sums on a stack of values.
-    lo, size, state = np.empty(64, np.int64), np.empty(64, np.int64), np.empty(64, np.int64)
-    values = np.zeros(64, a.dtype)
+    ranges = np.empty((3, 64), np.int64)  # lo, size, state
+    lo, size, state = ranges[0], ranges[1], ranges[2]
+    values = np.empty(64, a.dtype)
     lo[0], size[0], state[0] = start, n, 0
     depth, held = 1, 0
     while depth:

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.video.compiled import jit, solve
+from physbench.video.compiled import jit, pairwise_sum, solve
 
 if TYPE_CHECKING:
     from physbench.calibration import Calibration
@@ -331,7 +331,8 @@ def _circle_fits(  # type: ignore[no-untyped-def]
     :func:`_circle_of_radius`), and each disc's edge count and first edge.
 
     As the NumPy expressions it replaces, to the bit: the normal equations are summed as
-    ``np.add.reduceat`` sums them (pairwise, :func:`_reduceat`) and solved as OpenBLAS's LAPACK
+    ``np.add.reduceat`` sums them (the first term, then the rest pairwise:
+    :func:`~physbench.video.compiled.pairwise_sum`) and solved as OpenBLAS's LAPACK
     ``dgesv`` solves them (:func:`~physbench.video.compiled.solve`)."""
     count, n = len(radius), len(chosen)
     own, theta, contrast, width = _gathered(chosen, owner, angle, strength, spread)
@@ -342,7 +343,6 @@ def _circle_fits(  # type: ignore[no-untyped-def]
     trim, keep = np.empty(n, np.bool_), np.empty(n, np.bool_)
     a, terms, sums = np.empty((n, 4)), np.empty((12, n)), np.empty((count, 12))
     mean, centre, r = np.zeros((count, 2)), np.empty((count, 2)), np.empty(count)
-    todo, part, lanes = np.empty((64, 3), np.intp), np.empty(64), np.empty(8)
     lu, rhs = np.empty((3, 3)), np.empty(3)
     # Stage 0: each disc's mean and median edge width. Then its circle through all its edges;
     # through the three quarters nearest that circle (least trimmed squares: a highlight's rim
@@ -370,11 +370,14 @@ def _circle_fits(  # type: ignore[no-untyped-def]
             _kept(own, weight, keys, order, starts, sizes, res, dist, r, radius, mpp, keep, w)
         if stage:
             _products(a, w, terms)
-        for d in range(count):
+        for d in range(count):  # as np.add.reduceat sums: the first term, then the rest
             for col in range(2 if stage == 0 else 12):
                 if sizes[d] == 0:
                     continue
-                sums[d, col] = _reduceat(terms, col, starts[d], sizes[d], todo, part, lanes)
+                row, lo = terms[col], starts[d]
+                sums[d, col] = row[lo]
+                if sizes[d] > 1:
+                    sums[d, col] += pairwise_sum(row, lo + 1, sizes[d] - 1)
         if stage == 0:
             _centred(xy, own, sums, sizes, mean, a)
             continue
@@ -529,49 +532,6 @@ def _products(a, w, terms):  # type: ignore[no-untyped-def]
             aw = a[i, j] * w[i]
             for k in range(4):
                 terms[4 * j + k, i] = aw * a[i, k]
-
-
-@jit
-def _reduceat(terms, col, start, size, todo, part, lanes):  # type: ignore[no-untyped-def]
-    """The sum of row ``col`` of ``terms`` over ``size`` (at least 1) columns from ``start`` as
-    ``np.add.reduceat`` sums it: the first term, then the rest by NumPy's pairwise summation
-    (runs of up to 128 summed in eight lanes; a longer run split in two, the first a multiple
-    of 8, and the halves' sums added). ``todo``, ``part`` and ``lanes``: room to work in."""
-    todo[0, 0], todo[0, 1], todo[0, 2] = start + 1, size - 1, 0
-    top_, depth = 1, 0
-    while top_ > 0:
-        top_ -= 1
-        lo, m = todo[top_, 0], todo[top_, 1]
-        if todo[top_, 2]:  # both halves summed
-            depth -= 1
-            part[depth - 1] += part[depth]
-        elif m > 128:
-            half = m // 2 - (m // 2) % 8
-            todo[top_, 0], todo[top_, 1], todo[top_, 2] = 0, 0, 1
-            todo[top_ + 1, 0], todo[top_ + 1, 1], todo[top_ + 1, 2] = lo + half, m - half, 0
-            todo[top_ + 2, 0], todo[top_ + 2, 1], todo[top_ + 2, 2] = lo, half, 0
-            top_ += 3
-        else:
-            s = 0.0
-            if m < 8:
-                for i in range(lo, lo + m):
-                    s += terms[col, i]
-            else:
-                for k in range(8):
-                    lanes[k] = terms[col, lo + k]
-                k = 8
-                while k < m - m % 8:
-                    for j in range(8):
-                        lanes[j] += terms[col, lo + k + j]
-                    k += 8
-                s = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + (
-                    (lanes[4] + lanes[5]) + (lanes[6] + lanes[7])
-                )
-                for i in range(lo + k, lo + m):
-                    s += terms[col, i]
-            part[depth] = s
-            depth += 1
-    return terms[col, start] + part[0] if size > 1 else terms[col, start]
 
 
 @jit

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physbench.video.compiled import jit, solve
+from physbench.video.compiled import jit, pairwise_sum, solve
 from physbench.video.photometry import Light
 
 #: Side (px) of the box a sample averages.
@@ -140,7 +140,6 @@ class ShiftMeter:
         c = np.clip(self.cols[None, None] - reach[None, :, None], 0, w - 1)
         where = (r * w + c).reshape(len(reach) ** 2, -1)
         self.bank = np.stack([a[where].astype(np.float32) for a in (self.grey, self.gu, self.gv)])
-        self.plans = {nth: _plan(len(self.rows[::nth])) for nth in (1, COARSE)}  # NumPy's sums
         self.best = np.inf  # the best agreement of a frame so far
         self.last = (0, 0)  # the last frame's whole-pixel shift: the walk starts there
         self.noise = np.inf  # the least noise of a frame so far (grey levels)
@@ -175,7 +174,7 @@ class ShiftMeter:
             (else none), and the clipped mean squared disagreement."""
             return _residuals(
                 self.bank, self.planes, self.rows, self.cols, self.h, self.w, seen, *centre,
-                around, nth, clip2, *self.plans[nth], full,
+                around, nth, clip2, full,
             )  # fmt: skip
 
         def cost(centre: tuple[int, int], around: np.ndarray, nth: int = 1) -> np.ndarray:
@@ -253,27 +252,6 @@ _HERE, _NEAR, _SEARCH = _around(0), _around(1), _around(SEARCH)
 _SCALE = np.array([2.0 ** (max(e, 1) - 25) for e in range(32)], np.float32)
 
 
-def _plan(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """How NumPy sums ``n`` float32 values along a row, pairwise: halves split at a multiple of
-    8 down to blocks of at most 128, each summed by 8 accumulators. The blocks ``(start,
-    count)`` and the order to add them in (postfix: a block's index, or -1 to add the last two
-    sums)."""
-    blocks: list[tuple[int, int]] = []
-    order: list[int] = []
-    parts = [(0, n)]  # depth first, left before right; (-1, 0) adds the two sums before it
-    while parts:
-        start, count = parts.pop()
-        if start < 0:
-            order.append(-1)
-        elif count <= 128:
-            order.append(len(blocks))
-            blocks.append((start, count))
-        else:
-            half = count // 2 - count // 2 % 8
-            parts += [(-1, 0), (start + half, count - half), (start, half)]
-    return np.array(blocks, dtype=np.intp).reshape(-1, 2), np.array(order, dtype=np.intp)
-
-
 @jit
 def _box_means(flat, at, n):  # type: ignore[no-untyped-def]
     """The frame's grey over each sample's box: ``flat`` the frame's bytes, ``at`` each box's
@@ -299,7 +277,7 @@ def _box_means(flat, at, n):  # type: ignore[no-untyped-def]
 
 @jit
 def _residuals(  # type: ignore[no-untyped-def]
-    bank, planes, rows, cols, h, w, seen, cu, cv, around, nth, clip2, blocks, order, full
+    bank, planes, rows, cols, h, w, seen, cu, cv, around, nth, clip2, full
 ):
     """``residuals`` of :meth:`ShiftMeter.measure` at ``(cu, cv)`` plus each of ``around``
     ``(K, 2)``, on every ``nth`` of the samples at ``rows``, ``cols`` (``seen`` the frame's grey
@@ -309,45 +287,18 @@ def _residuals(  # type: ignore[no-untyped-def]
 
     Each row of background samples ``e`` is fitted to the frame's ``s`` by least squares (``gain
     (e - mean e) + mean s``, gain ``sum((e - mean e)(s - mean s)) / max(sum((e - mean e)^2),
-    1e-6)``), as NumPy computed it in float32, each sum NumPy's pairwise one (``blocks``,
-    ``order``: :func:`_plan` of ``m``): the results are the same to the bit."""
+    1e-6)``), as NumPy computed it in float32, each sum NumPy's pairwise one (:func:`_total`):
+    the results are the same to the bit."""
     m = (len(rows) + nth - 1) // nth
     k = len(around)
     d = np.empty((k if full else 0, m), np.float32)
     cost = np.empty(k, np.float32)
     mine, off = np.empty(m, np.float32), np.empty(m, np.float32)
     de, a, b = np.empty(m, np.float32), np.empty(m, np.float32), np.empty(m, np.float32)
-    sums = np.empty(len(order), np.float32)
-
-    def total(x):  # type: ignore[no-untyped-def]
-        """NumPy's sum of the float32 values ``x`` (``0 +`` its pairwise sum)."""
-        top = 0
-        for step in order:
-            if step < 0:
-                top -= 1
-                sums[top - 1] = sums[top - 1] + sums[top]
-                continue
-            lo, count = blocks[step, 0], blocks[step, 1]
-            if count < 8:
-                res = np.float32(0.0)
-                for i in range(lo, lo + count):
-                    res += x[i]
-            else:
-                r0, r1, r2, r3 = x[lo], x[lo + 1], x[lo + 2], x[lo + 3]
-                r4, r5, r6, r7 = x[lo + 4], x[lo + 5], x[lo + 6], x[lo + 7]
-                for i in range(lo + 8, lo + count - count % 8, 8):
-                    r0, r1, r2, r3 = r0 + x[i], r1 + x[i + 1], r2 + x[i + 2], r3 + x[i + 3]
-                    r4, r5, r6, r7 = r4 + x[i + 4], r5 + x[i + 5], r6 + x[i + 6], r7 + x[i + 7]
-                res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-                for i in range(lo + count - count % 8, lo + count):
-                    res += x[i]
-            sums[top] = res
-            top += 1
-        return np.float32(0.0) + sums[0]
 
     for i in range(m):
         mine[i] = seen[i * nth]
-    sm = np.float32(np.float64(total(mine)) / m)
+    sm = np.float32(np.float64(_total(mine, m)) / m)
     for i in range(m):
         off[i] = mine[i] - sm
     floor = np.float32(1e-6)
@@ -363,10 +314,8 @@ def _residuals(  # type: ignore[no-untyped-def]
                 r = min(max(rows[i * nth] - dv, 0), h - 1)
                 c = min(max(cols[i * nth] - du, 0), w - 1)
                 de[i] = _half(planes[0, r * w + c])
-        # The shift's four sums (of e; of (e - mean e)(s - mean s) and (e - mean e)^2; of the
-        # clipped squared residuals) at one call of `total`: numba copies a closure into each
-        # place it is called from, and each copy added about 1.1 s to the compile (8.0 s with
-        # five, 4.6 s with two).
+        # The shift's four sums, in turn: of e; of (e - mean e)(s - mean s) and (e - mean e)^2;
+        # of the clipped squared residuals.
         for q in range(4):
             if q == 1:
                 em = np.float32(np.float64(got[0]) / m)
@@ -381,9 +330,15 @@ def _residuals(  # type: ignore[no-untyped-def]
                     if full:
                         d[j, i] = res
                     a[i] = min(res * res, clip2)
-            got[q] = total(de if q == 0 else b if q == 2 else a)
+            got[q] = _total(de if q == 0 else b if q == 2 else a, m)
         cost[j] = np.float32(np.float64(got[3]) / m)
     return d, cost
+
+
+@jit
+def _total(x, m):  # type: ignore[no-untyped-def]
+    """NumPy's ``x[:m].sum()`` of float32 values: ``0 +`` their pairwise sum."""
+    return np.float32(0.0) + pairwise_sum(x, 0, m)
 
 
 @jit

@@ -115,7 +115,7 @@ def test_the_compiled_loops_compute_what_numpy_did() -> None:
         want = _numpy_residuals(meter, seen, shifts, nth, clip2)
         got = steadiness._residuals(
             meter.bank, meter.planes, meter.rows, meter.cols, meter.h, meter.w, seen, 0, 0,
-            np.array(shifts, dtype=np.intp), nth, clip2, *meter.plans[nth], True,
+            np.array(shifts, dtype=np.intp), nth, clip2, True,
         )  # fmt: skip
         for a, b in zip(got, (want[0], want[2]), strict=True):
             assert a.dtype == b.dtype and np.array_equal(a, b)
