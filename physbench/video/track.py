@@ -67,7 +67,16 @@ from physbench.video.detect import (
     plane_pose,
     split_pixels,
 )
-from physbench.video.faint import SHUTTER, SIGNIFICANCE, Faint, find_faint, look_elsewhere
+from physbench.video.faint import (
+    GHOST_FRAMES,
+    SHUTTER,
+    SIGNIFICANCE,
+    Faint,
+    find_faint,
+    ghost_reach,
+    ghosts_of,
+    look_elsewhere,
+)
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import DEVIATIONS, Light, LightMeter
@@ -254,6 +263,7 @@ class _State:
     missed: int = 0  # frames since it was last seen
     seen: int = 0
     last_uv: np.ndarray | None = None
+    trail: list[np.ndarray] = field(default_factory=list)  # the last GHOST_FRAMES places
     contact: np.ndarray | None = None  # normal of the static its prediction touches
     bounce: float = 0.0  # m/s: the speed off a surface it hit, unknown until it is seen again
     look: Appearance | None = None
@@ -685,7 +695,7 @@ class Tracker:
 
         def search(within: float, level: float) -> Faint | None:
             return find_faint(
-                image, self.bg, self.light, pred, within, s.radius, smear, taken, s.last_uv,
+                image, self.bg, self.light, pred, within, s.radius, smear, taken, s.trail,
                 significance=level, rivals=rivals,
             )  # fmt: skip
 
@@ -761,6 +771,7 @@ class Tracker:
         s.missed = 0
         s.seen += 1
         s.xy, s.t, s.last_uv = xy, t, found.uv
+        s.trail = [*s.trail[1 - GHOST_FRAMES :], found.uv]
         s.rows.append((t, float(xy[0]), float(xy[1]), math.nan if angle is None else angle))
         s.uv_rows.append((t, float(found.uv[0]), float(found.uv[1])))
         # A body's looks are learnt only from detections of about the size the scene gives it:
@@ -1004,6 +1015,7 @@ class Tracker:
         preds = self.pred_uv[ids]
         centres = np.array([b[0].centre for b in blobs])
         dist = np.hypot(*(preds[:, None, :] - centres[None]).transpose(2, 0, 1))
+        self._ghosts(ids, centres, dist)
         if len(ids) == 1 and len(blobs) == 1 and dist[0, 0] <= gates[ids[0]]:
             return {0: list(ids)}, dist  # most windows: what the general case gives it
         big = 1e9
@@ -1019,6 +1031,8 @@ class Tracker:
                 continue
             for c in np.argsort(dist[j]):
                 _, u, v, _ = blobs[c]
+                if dist[j, c] == np.inf:
+                    continue  # its ghost
                 if np.hypot(u - preds[j, 0], v - preds[j, 1]).min() > gates[i]:
                     continue  # the prediction is not on this blob
                 taken = owner.get(int(c), [])
@@ -1028,6 +1042,19 @@ class Tracker:
                     break
         self._by_colour(ids, blobs, gates, own, owner, dist)
         return owner, dist
+
+    def _ghosts(self, ids: list[int], centres: np.ndarray, dist: np.ndarray) -> None:
+        """Blobs that are a small disc's ghost (:func:`~physbench.video.faint.ghosts_of`: its
+        imprint where it was seen in its last frames, kept by a lossy codec's skipped blocks,
+        now that its prediction has moved on) are not that disc's: their distance in ``dist``
+        (bodies ``ids`` by blobs, centres ``centres``) becomes infinite. A body that did stay
+        there is unseen, which the summary says, rather than followed at its imprint."""
+        for j, i in enumerate(ids):
+            s = self.states[i]
+            if not s.disc or s.radius >= SMALL_DISC:
+                continue
+            for q in ghosts_of(s.trail, self.pred_uv[i], s.radius):
+                dist[j, np.hypot(*(centres - q).T) <= ghost_reach(s.radius)] = np.inf
 
     def _by_colour(
         self,
@@ -1063,7 +1090,7 @@ class Tracker:
                 continue
             for c in np.argsort(dist[j]):
                 _, u, v, _ = blobs[c]
-                if blobs[c][0].area < COLOUR_PIXELS:
+                if blobs[c][0].area < COLOUR_PIXELS or dist[j, c] == np.inf:
                     continue
                 d2 = (u - self.pred_uv[i, 0]) ** 2 + (v - self.pred_uv[i, 1]) ** 2
                 if d2.min() <= gates[i] ** 2 and held(int(c), i) >= HIDDEN:
