@@ -6,7 +6,8 @@ these tests hold the measured figures and where the misses lie, so that a change
 must update the table and the docs (docs/video.md). ``earlier/`` holds the grid before the arms
 were centred between their ends, with the reruns and the visibility study made against it;
 ``hires_1280/`` the small-ball clips filmed at twice the resolution; ``heldout_3_4/`` seeds 3 and
-4, run once after the tracker changes that seeds 0-2 guided."""
+4, run once after the tracker changes that seeds 0-2 guided; ``rerun_c5024ee/`` the whole grid
+again, on a later machine, with a small disc's codec ghost no longer followed."""
 
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ HIDDEN = [r for r in ROWS if r["effect"]]
 CONTROLS = [r for r in ROWS if not r["effect"]]
 EARLIER_ROWS = json.loads((EARLIER / "results.json").read_text())["rows"]
 HELDOUT = json.loads((FOLDER / "heldout_3_4" / "results.json").read_text())
+RERUN = json.loads((FOLDER / "rerun_c5024ee" / "results.json").read_text())
 TOLERANCE = 0.10
 #: Balls below this radius (px) are below the noise of this camera in many frames.
 TINY = 2.0
@@ -110,8 +112,8 @@ def test_no_control_raises_a_false_alarm() -> None:
     # along the direction before the bounce (the first frame after it 1.7 px off). Its stadium
     # is now kept only where it fits better than a circle, else searched over twelve
     # directions: that frame is 0.9 px off, the next is left out at the wall's bounce, and the
-    # one after, whose exposure may span that bounce, is 1.7 px off (1.3 before). Whether the
-    # alarm is gone for good or by the frames' new balance is not established (docs/video.md).
+    # one after, whose exposure may span that bounce, is 1.7 px off (1.3 before). The alarm is
+    # not gone for good: the same clip coded on a later machine names lens_distortion (below).
     alarms = [r for r in CONTROLS if not right(r) and "filmed_failure" not in r]
     assert alarms == []
     bouncer = next(r for r in CONTROLS if name(r) == "control/bouncer/pymunk/0")
@@ -297,3 +299,47 @@ def test_the_near_search_tracks_two_refused_small_balls_at_twice_the_resolution(
     axis = got["axis_rotation/projectile_kicked/box2d/1"]["filmed"]
     assert axis["causes"][:1] == ["axis_rotation"] and 0.10 < axis["error"] < 0.11
     assert "filmed_failure" in got["control/projectile_kicked/box2d/1"]
+
+
+def _centre_max(row: dict) -> float:
+    return max(st["max"] for st in row["field"]["centre_px"].values())
+
+
+def test_a_small_balls_imprint_is_refused_not_followed_in_the_rerun() -> None:
+    # The grid's two worst tracks followed a 1 px ball's imprint where it had been (kept by the
+    # codec's skipped blocks), 311 and 325 px off, one of them a control counted right. At git
+    # c5024ee (the ghost rule) both clips are refused, and no tracked clip of a ball or puck is
+    # further than 6.6 px off anywhere.
+    by = {name(r): r for r in RERUN["rows"]}
+    assert {name(r) for r in ROWS} == set(by) and RERUN["code"] == "git c5024ee"
+    assert RERUN["environment"]["av"] and RERUN["environment"]["ffmpeg"]
+    for case in ("control/projectile/box2d/1", "table_tilt/two_projectiles/pymunk/0"):
+        grid = next(r for r in ROWS if name(r) == case)
+        assert _centre_max(grid) > 300 and "filmed_failure" not in grid
+        assert "filmed_failure" in by[case]
+    flights = [r for r in by.values() if "pendulum" not in r["scene"] and r["field"]["centre_px"]]
+    assert max(_centre_max(r) for r in flights) < 7.0
+    tiny = [r for r in by.values() if r["body_px"] < TINY]
+    assert (sum("filmed_failure" in r for r in tiny), sum(right(r) for r in tiny)) == (51, 16)
+
+
+def test_the_rerun_on_another_machine_moves_big_balls_verdicts_at_the_line() -> None:
+    # The same code codes other clips on another machine or PyAV build: git 4a62f1e, run here,
+    # tracks the bouncing-ball control 1.03 px off at the 95th percentile (0.83 in the grid) and
+    # names lens_distortion; two bouncers name a second cause after the right one. Bodies of 2
+    # px or more: 198 of 200 right (199 in the grid), none refused.
+    rows = RERUN["rows"]
+    big = [r for r in rows if r["body_px"] >= TINY]
+    assert (len(big), sum(right(r) for r in big)) == (200, 198)
+    assert not any("filmed_failure" in r for r in big)
+    alarms = [
+        (name(r), r["filmed"]["causes"])
+        for r in rows
+        if r["effect"] is None and not right(r) and "filmed_failure" not in r
+    ]
+    assert alarms == [("control/bouncer/pymunk/0", ["lens_distortion"])]
+    extra = sorted(name(r) for r in big if r["effect"] and len(r["filmed"]["causes"] or []) > 1)
+    assert extra == [
+        "velocity_dependent_restitution/bouncer/box2d/0",
+        "velocity_dependent_restitution/bouncer/pymunk/1",
+    ]
