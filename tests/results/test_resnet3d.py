@@ -60,7 +60,9 @@ def test_every_table1_row_ran_on_at_least_ten_held_out_seeds_without_failures(
 
 
 @pytest.mark.parametrize(
-    "row", sorted(PAPER, key=str), ids=lambda r: f"{r[0]}-{'+'.join(sorted(r[1]))}"
+    "row",
+    sorted(PAPER, key=lambda r: (r[0], sorted(r[1]))),
+    ids=lambda r: f"{r[0]}-{'+'.join(sorted(r[1]))}",
 )
 def test_resnet3d_is_at_or_below_the_papers_nn_after_11_iterations(
     results: pd.DataFrame, row: tuple
