@@ -67,6 +67,11 @@ class Motion:
         self.rho = np.array([c[2] for c in caps], dtype=float)
         self.lo = np.minimum(self.a, self.b) - self.rho[:, None]
         self.hi = np.maximum(self.a, self.b) + self.rho[:, None]
+        # The statics' boxes and gravity as Python floats: the tracker asks of every body in
+        # every frame, and NumPy's dispatch on arrays of two values costs more than the work.
+        self._boxes = list(zip(*self.lo.T.tolist(), *self.hi.T.tolist(), strict=True))
+        self._g = self.g.tolist()
+        self._last: dict[str, tuple[float, float, Kick]] = {}
 
     # ----------------------------------------------------------------- known accelerations
 
@@ -75,8 +80,12 @@ class Motion:
         (s, scene time) from gravity and the scene's forces on it (none for a jointed body)."""
         if not self.free.get(body, False) or dt <= 0:
             return Kick(np.zeros(2), np.zeros(2))
-        dx = 0.5 * self.g * dt * dt
-        dv = self.g * dt
+        last = self._last.get(body)
+        if last is not None and last[0] == t0 and last[1] == dt:
+            return last[2]  # the tracker's prediction and its acceptance ask the same
+        gx, gy = self._g
+        dx = np.array([0.5 * gx * dt * dt, 0.5 * gy * dt * dt])
+        dv = np.array([gx * dt, gy * dt])
         for acc, start, end, kind in self.forces.get(body, ()):
             if kind == "impulse":
                 if t0 <= start < t0 + dt:  # an impulse (N s / kg = m/s) at `start`
@@ -89,7 +98,9 @@ class Motion:
             on = b - a  # seconds the force acts, then coasts until t0 + dt
             dv = dv + acc * on
             dx = dx + acc * (0.5 * on * on + on * (t0 + dt - b))
-        return Kick(dx, dv)
+        kick = Kick(dx, dv)
+        self._last[body] = (t0, dt, kick)
+        return kick
 
     # ----------------------------------------------------------------- static geometry
 
@@ -102,11 +113,14 @@ class Motion:
         if not self.free.get(body.name, False) or not len(self.rho):
             return start + move, None
         extent = body.shape.extent()
-        lo = np.minimum(start, start + move) - extent
-        hi = np.maximum(start, start + move) + extent
-        near = ((self.lo <= hi) & (self.hi >= lo)).all(axis=1)
-        if not near.any():
-            return start + move, None
+        end = start + move
+        (x0, y0), (x1, y1) = start.tolist(), end.tolist()
+        lx, ly = min(x0, x1) - extent, min(y0, y1) - extent
+        hx, hy = max(x0, x1) + extent, max(y0, y1) + extent
+        near = [ax <= hx and ay <= hy and bx >= lx and by >= ly for ax, ay, bx, by in self._boxes]
+        if not any(near):
+            return end, None
+        near = np.array(near)
         a, b, rho = self.a[near], self.b[near], self.rho[near]
         verts = _vertices(body, angle)
         smallest = body.shape.radius if isinstance(body.shape, Circle) else _half_size(verts)

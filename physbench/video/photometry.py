@@ -97,17 +97,19 @@ def _relit_difference(image, plate, lut):  # type: ignore[no-untyped-def]
     """:meth:`Light.difference` where the light changes levels: each pixel's largest absolute
     difference over the channels between ``image`` and ``lut`` at ``plate``, in one pass: NumPy's
     look-up through an index array and then the difference took 0.54 s of the 20 s speed clip's
-    tracking, this 0.41 s (this machine, best of 3)."""
+    tracking, this 0.41 s (this machine, best of 3). The channels' differences are taken in int32
+    without a branch: 0.19 s over the 2,736 windows of that clip's tracking against 0.24 s with a
+    branch per channel (best of 2)."""
     h, w = image.shape[0], image.shape[1]
     out = np.empty((h, w), np.uint8)
+    l0, l1, l2 = lut[0], lut[1], lut[2]
     for y in range(h):
+        im, pl, row = image[y], plate[y], out[y]
         for x in range(w):
-            most = 0
-            for c in range(3):
-                a, b = image[y, x, c], lut[c, plate[y, x, c]]
-                d = a - b if a > b else b - a
-                most = d if d > most else most
-            out[y, x] = most
+            d0 = np.int32(im[x, 0]) - np.int32(l0[pl[x, 0]])
+            d1 = np.int32(im[x, 1]) - np.int32(l1[pl[x, 1]])
+            d2 = np.int32(im[x, 2]) - np.int32(l2[pl[x, 2]])
+            row[x] = max(abs(d0), max(abs(d1), abs(d2)))
     return out
 
 

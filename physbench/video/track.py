@@ -405,7 +405,7 @@ class Tracker:
             self.pred_xy[i] = xy
         self.pred_uv = self.cal.to_image(self.pred_xy)
 
-    def _in_view(self, s: _State, uv: np.ndarray) -> bool:
+    def _in_view(self, s: _State, uv: Sequence[float]) -> bool:
         """Whether to look for ``s`` at its prediction ``uv``: it is there (its centre at least
         half its radius inside the image), or it was last seen away from the image's edges (a
         prediction may leave the view while the body is hidden in it)."""
@@ -534,10 +534,10 @@ class Tracker:
         t = t - self.t0  # type: ignore[operator]
         self.t_next = t
         self._predict(t)
-        visible = [self._in_view(s, self.pred_uv[i]) for i, s in enumerate(self.states)]
+        uvs = self.pred_uv.tolist()
+        visible = [self._in_view(s, uv) for s, uv in zip(self.states, uvs, strict=True)]
         gates, reach = self._gates(t, first)
-        avoid = [(u, v, r) for (u, v), r in zip(self.pred_uv, reach, strict=True)]
-        self.light = self.meter.measure(image, avoid)
+        self.light = self.meter.measure(image, np.column_stack([self.pred_uv, reach]))
         self._steadiness(image, t)
         if first:
             if not any(visible):
@@ -565,7 +565,8 @@ class Tracker:
                 s.unseen.close()
                 s.out.close()
                 if s.seen >= 2 and s.missed == 0:
-                    e2 = float(np.sum((found[i].uv - self.pred_uv[i]) ** 2))
+                    (fu, fv), (pu, pv) = found[i].uv.tolist(), self.pred_uv[i].tolist()
+                    e2 = (fu - pu) * (fu - pu) + (fv - pv) * (fv - pv)
                     s.error2 = e2 if s.error2 is None else s.error2 + NEAR_RATE * (e2 - s.error2)
                 self._accept(s, found[i], t)
                 continue
@@ -761,12 +762,18 @@ class Tracker:
             hit = float(s.v @ s.contact) if s.contact is not None else 0.0
             # A split measurement's position leans towards its neighbour: the velocity goes on
             # as predicted.
-            s.v = s.v + kick.dv if found.split else (xy - s.xy) / dt + kick.dv - kick.dx / dt
+            if found.split:
+                s.v = s.v + kick.dv
+            else:
+                (x, y), (sx, sy) = xy.tolist(), s.xy.tolist()
+                (vx, vy), (ex, ey) = kick.dv.tolist(), kick.dx.tolist()
+                s.v = np.array([(x - sx) / dt + vx - ex / dt, (y - sy) / dt + vy - ey / dt])
             s.bounce = 0.0
             if s.contact is not None:
                 s.v, s.bounce = _off_surface(s.v, s.contact, hit)
             assert s.last_uv is not None
-            s.step = float(np.hypot(*(found.uv - s.last_uv))) / (s.missed + 1)
+            (fu, fv), (lu, lv) = found.uv.tolist(), s.last_uv.tolist()
+            s.step = float(np.hypot(fu - lu, fv - lv)) / (s.missed + 1)
         angle = self._angle(s, found.pose, t) if s.k else None
         s.missed = 0
         s.seen += 1
@@ -1010,14 +1017,18 @@ class Tracker:
     ) -> tuple[dict[int, list[int]], np.ndarray]:
         """Blobs to bodies ``ids``: each blob's owners, and the distance of each body's prediction
         to each blob's centre (px). ``own``: per blob, the pixels of each body's colour."""
+        if len(ids) == 1 and len(blobs) == 1:  # most windows: as the general case gives it
+            (pu, pv), blob = self.pred_uv[ids[0]].tolist(), blobs[0][0]
+            dist = np.array([[np.hypot(pu - blob.u, pv - blob.v)]])
+            self._ghosts(ids, np.array([[blob.u, blob.v]]), dist)
+            if dist[0, 0] <= gates[ids[0]]:
+                return {0: list(ids)}, dist
         from scipy.optimize import linear_sum_assignment
 
         preds = self.pred_uv[ids]
         centres = np.array([b[0].centre for b in blobs])
         dist = np.hypot(*(preds[:, None, :] - centres[None]).transpose(2, 0, 1))
         self._ghosts(ids, centres, dist)
-        if len(ids) == 1 and len(blobs) == 1 and dist[0, 0] <= gates[ids[0]]:
-            return {0: list(ids)}, dist  # most windows: what the general case gives it
         big = 1e9
         cost = np.where(dist <= gates[ids][:, None], dist, big)
         rows, cols = linear_sum_assignment(cost)
