@@ -66,8 +66,8 @@ class Look:
 
 
 def _direction(c: Sequence[float]) -> tuple[float, float, float]:
-    r, g, b = (x + DARK for x in c)
-    n = _length((r, g, b))
+    r, g, b = c[0] + DARK, c[1] + DARK, c[2] + DARK
+    n = math.sqrt(r * r + g * g + b * b)
     return r / n, g / n, b / n
 
 
@@ -79,7 +79,8 @@ def _length(d: Sequence[float]) -> float:
 
 def _apart(a: Sequence[float], b: Sequence[float]) -> float:
     """The length of ``a - b``."""
-    return _length([x - y for x, y in zip(a, b, strict=True)])
+    x, y, z = a[0] - b[0], a[1] - b[1], a[2] - b[2]
+    return math.sqrt(x * x + y * y + z * z)
 
 
 @dataclass
@@ -99,6 +100,9 @@ class Appearance:
         r, g, b = self.colour.tolist()
         self._unit = _direction((r, g, b))
         self._brightness = r + g + b + 3 * DARK
+        # The last look whose hue was judged, and that hue: the tracker judges a detection
+        # (mismatch) and then learns from it (update), and the hue is the same.
+        self._judged: tuple[Look, float] | None = None
 
     @classmethod
     def first(cls, look: Look) -> Appearance:
@@ -120,6 +124,7 @@ class Appearance:
             return None
         colour = np.asarray(look.colour, dtype=float).tolist()
         hue = _apart(_direction(colour), self._unit)
+        self._judged = (look, hue)
         near = _apart(colour, self.colour.tolist()) < SAME_COLOUR
         if hue > max(HUE_TOLERANCE, 4 * self.hue_spread) and not near:
             return f"another colour (hue {hue:.2f} off)"
@@ -131,7 +136,10 @@ class Appearance:
     def update(self, look: Look) -> None:
         """Called by the tracker with each accepted detection's appearance."""
         colour = np.asarray(look.colour, dtype=float).tolist()
-        hue = _apart(_direction(colour), self._unit)
+        judged = self._judged
+        hue = judged[1] if judged is not None and judged[0] is look else None
+        if hue is None:
+            hue = _apart(_direction(colour), self._unit)
         self.hue_spread += RATE * (hue - self.hue_spread)
         self.size += RATE * (look.size - self.size)
         mine = self.colour.tolist()

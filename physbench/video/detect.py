@@ -138,7 +138,7 @@ def find_blobs(
     r0, r1, c0, c1 = _extent(diff, float(low))
     if r0 == r1:
         return []
-    labels, n = label(diff[r0:r1, c0:c1] > low)
+    labels, n = label_above(diff[r0:r1, c0:c1], float(low))
     scale = np.float32(1.0 / max(high - low, 1e-6))  # as in coverage()
     u, v, w, starts, sums = _blob_pixels(
         labels, n, diff, r0, c0, r0 + offset[0], c0 + offset[1], float(low), scale, float(min_area)
@@ -154,20 +154,27 @@ def find_blobs(
     return out
 
 
-@jit
-def label(mask):  # type: ignore[no-untyped-def]
+def label(mask: np.ndarray) -> tuple[np.ndarray, int]:
     """The 4-connected blobs of ``mask`` (bool ``(H, W)``): int32 labels ``(H, W)`` (0 off the
     blobs) and their count, numbered in the order of their first pixels row by row, as
-    :func:`scipy.ndimage.label` with :data:`CROSS` numbers them. One pass with a union-find
-    over the blobs' provisional labels: scipy's own costs about 45 us a call before any pixel
-    (63-78 us on the tracker's windows' foreground boxes, against 19-24 us)."""
-    h, w = mask.shape
+    :func:`scipy.ndimage.label` with :data:`CROSS` numbers them (:func:`label_above`)."""
+    return label_above(np.ascontiguousarray(mask, dtype=bool).view(np.uint8), 0.0)
+
+
+@jit
+def label_above(values, low):  # type: ignore[no-untyped-def]
+    """The 4-connected blobs of the pixels of ``values`` (``(H, W)``) above ``low``, as
+    :func:`label`'s. One pass with a union-find over the blobs' provisional labels: scipy's own
+    costs about 45 us a call before any pixel (63-78 us on the tracker's windows' foreground
+    boxes, against 19-24 us); the comparison in the same pass saves NumPy's mask (compared in
+    float64, as NumPy compares uint8 with a float)."""
+    h, w = values.shape
     labels = np.zeros((h, w), np.int32)
     parent = np.empty((h * w + 1) // 2 + 2, np.int32)  # at most a checkerboard's
     made = 1
     for i in range(h):
         for j in range(w):
-            if not mask[i, j]:
+            if not values[i, j] > low:
                 continue
             up = labels[i - 1, j] if i else 0
             left = labels[i, j - 1] if j else 0

