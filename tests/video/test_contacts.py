@@ -55,3 +55,29 @@ def test_without_gravity_a_puck_hitting_a_wall_is_marked() -> None:
     x = np.where(t < 0.5, 1.0 * t, 0.5 - 0.9 * (t - 0.5))  # hits a wall at x = 0.5, t = 0.5
     mask = contact_samples(t, np.column_stack([x, 0.2 + 0 * t]), np.zeros(2), 0.001)
     assert np.flatnonzero(mask).tolist() == [15]
+
+
+def _corner(t: np.ndarray, floor: float, wall: float) -> np.ndarray:
+    """A ball falling at 3.6 m/s onto the floor at ``floor`` s (restitution 0.8) while moving at
+    2.3 m/s into a wall it hits at ``wall`` s (restitution 0.9)."""
+    x = np.where(t < wall, 1.8 + 2.3 * (t - wall), 1.8 - 0.9 * 2.3 * (t - wall))
+    after = t >= floor
+    vy = np.where(after, 0.8 * 3.6, -3.6)
+    y = 0.1 + vy * (t - floor) - 4.905 * (t - floor) ** 2
+    return np.column_stack([x, y])
+
+
+def test_a_bounce_into_a_corner_marks_the_floor_and_the_wall() -> None:
+    # The floor at 0.475 s and the wall 1.75 frame intervals later, at 25 fps: each frame is the
+    # mean pose over an exposure of 0.55 of the interval, as a camera records it, so the frames
+    # exposed across either bounce are off too. Their departures make one run, and each bounce
+    # is a sample within an interval of it.
+    fps, floor, wall = 25.0, 0.475, 0.545
+    t = np.arange(0.0, 1.0, 1 / fps)
+    exposure = np.linspace(0.0, 0.55 / fps, 12)
+    xy = np.mean([_corner(t + s, floor, wall) for s in exposure], axis=0)
+    for seed in range(5):
+        noisy = xy + np.random.default_rng(seed).normal(0, 0.001, xy.shape)
+        marked = t[contact_samples(t, noisy, G, 0.002)]
+        assert len(marked) == 2
+        assert abs(marked[0] - floor) <= 1 / fps and abs(marked[1] - wall) <= 1 / fps
