@@ -91,3 +91,25 @@ def test_only_the_field_camera_films_at_another_resolution_or_keeps_gaps(capsys)
     with pytest.raises(SystemExit):
         bench.main(["--camera", "camera", "--allow-gaps", "--out", "unused"])
     assert "--allow-gaps: only --camera field" in capsys.readouterr().err
+
+
+def test_leaving_out_both_frames_of_a_corner_bounce_changes_no_verdict_on_this_camera() -> None:
+    # The 24 bouncers and drops filmed by the camera renderer, tracked on one machine by the
+    # tracker before the corner rule (git 3fd23fc) and with it: every cause and magnitude error
+    # the same (three effect clips name a second cause with either, which this machine's coding
+    # gives: the committed grid names none there).
+    folder = ROOT / "results" / "video_discover" / "corner_bounces"
+    before, after = (
+        {
+            (r["effect"], r["scene"], r["engine"], r["seed"]): r["filmed"]
+            for r in json.loads((folder / which / "results.json").read_text())["rows"]
+        }
+        for which in ("before", "after")
+    )
+    assert len(before) == 24 and before.keys() == after.keys()
+    for key, got in after.items():
+        assert got["causes"] == before[key]["causes"]
+        if got["error"] is not None:
+            assert abs(got["error"] - before[key]["error"]) < 1e-4
+    extra = sorted(k for k, f in after.items() if k[0] and len(f["causes"]) > 1)
+    assert len(extra) == 3

@@ -7,7 +7,9 @@ must update the table and the docs (docs/video.md). ``earlier/`` holds the grid 
 were centred between their ends, with the reruns and the visibility study made against it;
 ``hires_1280/`` the small-ball clips filmed at twice the resolution; ``heldout_3_4/`` seeds 3 and
 4, run once after the tracker changes that seeds 0-2 guided; ``rerun_c5024ee/`` the whole grid
-again, on a later machine, with a small disc's codec ghost no longer followed."""
+again, on a later machine, with a small disc's codec ghost no longer followed;
+``corner_bounces/`` that rerun's bouncers and drops with both frames of a corner bounce left
+out."""
 
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ CONTROLS = [r for r in ROWS if not r["effect"]]
 EARLIER_ROWS = json.loads((EARLIER / "results.json").read_text())["rows"]
 HELDOUT = json.loads((FOLDER / "heldout_3_4" / "results.json").read_text())
 RERUN = json.loads((FOLDER / "rerun_c5024ee" / "results.json").read_text())
+CORNERS = json.loads((FOLDER / "corner_bounces" / "results.json").read_text())
 TOLERANCE = 0.10
 #: Balls below this radius (px) are below the noise of this camera in many frames.
 TINY = 2.0
@@ -343,3 +346,17 @@ def test_the_rerun_on_another_machine_moves_big_balls_verdicts_at_the_line() -> 
         "velocity_dependent_restitution/bouncer/box2d/0",
         "velocity_dependent_restitution/bouncer/pymunk/1",
     ]
+
+
+def test_leaving_out_both_frames_of_a_corner_bounce_quiets_the_bouncer_control() -> None:
+    # The rerun's bouncers and drops (24 clips, same machine), tracked again leaving out both
+    # frames of a bounce into a corner: its false alarm is gone and one of its two second
+    # causes; every other verdict is the rerun's.
+    rows = CORNERS["rows"]
+    assert len(rows) == 24 and {r["scene"] for r in rows} == {"bouncer", "drops"}
+    assert all(right(r) for r in rows) and not any("filmed_failure" in r for r in rows)
+    before = {name(r): r["filmed"]["causes"] for r in RERUN["rows"]}
+    changed = sorted(name(r) for r in rows if r["filmed"]["causes"] != before[name(r)])
+    assert changed == ["control/bouncer/pymunk/0", "velocity_dependent_restitution/bouncer/box2d/0"]
+    extra = [name(r) for r in rows if r["effect"] and len(r["filmed"]["causes"]) > 1]
+    assert extra == ["velocity_dependent_restitution/bouncer/pymunk/1"]
