@@ -38,8 +38,8 @@ def contact_samples(
     apart holds more than one: a ball into a corner hits the floor and then the wall a frame or
     two later (on the field camera, a bounce at 0.475 s and one at 0.574 s made one run of four
     departures, 108, 67, 62 and 41 m/s² over a limit of 29, and the frame exposed across the
-    second, 2.35 px off, was kept). In a run, after its peaks, each sample over the limit two or
-    more from every one marked is marked too, the largest first."""
+    second, 2.35 px off, was kept). In a run that holds a peak, each further sample over the
+    limit and not next to one marked is marked too, the largest first."""
     n = len(t)
     mask = np.zeros(n, dtype=bool)
     if n < 3:
@@ -55,8 +55,13 @@ def contact_samples(
     padded = np.concatenate([[0.0], excess, [0.0]])
     peak = (padded[1:-1] >= padded[:-2]) & (padded[1:-1] >= padded[2:])
     marked = over & peak
+    # Runs of departures over the limit, numbered; a further collision only in a run that holds
+    # one (with gaps in a track the limits differ from sample to sample, and a sample over its
+    # own limit beside a larger departure under a larger one is no collision of its own).
+    run = np.cumsum(np.diff(np.concatenate([[False], over]).astype(int)) == 1)
+    held = set(run[marked].tolist())
     for k in np.argsort(-excess, kind="stable"):
-        if over[k] and not marked[max(k - 1, 0) : k + 2].any():
+        if over[k] and run[k] in held and not marked[max(k - 1, 0) : k + 2].any():
             marked[k] = True
     mask[1:-1] = marked
     return mask
