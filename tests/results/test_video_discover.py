@@ -95,9 +95,9 @@ def test_only_the_field_camera_films_at_another_resolution_or_keeps_gaps(capsys)
 
 def test_leaving_out_both_frames_of_a_corner_bounce_changes_no_verdict_on_this_camera() -> None:
     # The 24 bouncers and drops filmed by the camera renderer, tracked on one machine by the
-    # tracker before the corner rule (git 3fd23fc) and with it (git e92fb0e): every cause and magnitude error
-    # the same (three effect clips name a second cause with either, which this machine's coding
-    # gives: the committed grid names none there).
+    # tracker before the corner rule (git 3fd23fc) and with it (git e92fb0e): every cause and
+    # magnitude error the same (three effect clips name a second cause with either, which this
+    # machine's coding gives: the committed grid names none there).
     folder = ROOT / "results" / "video_discover" / "corner_bounces"
     before, after = (
         {
