@@ -117,10 +117,10 @@ class Motion:
         (x0, y0), (x1, y1) = start.tolist(), end.tolist()
         lx, ly = min(x0, x1) - extent, min(y0, y1) - extent
         hx, hy = max(x0, x1) + extent, max(y0, y1) + extent
-        near = [ax <= hx and ay <= hy and bx >= lx and by >= ly for ax, ay, bx, by in self._boxes]
-        if not any(near):
+        boxed = [ax <= hx and ay <= hy and bx >= lx and by >= ly for ax, ay, bx, by in self._boxes]
+        if not any(boxed):
             return end, None
-        near = np.array(near)
+        near = np.array(boxed)
         a, b, rho = self.a[near], self.b[near], self.rho[near]
         verts = _vertices(body, angle)
         smallest = body.shape.radius if isinstance(body.shape, Circle) else _half_size(verts)

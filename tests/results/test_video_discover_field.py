@@ -349,9 +349,9 @@ def test_the_rerun_on_another_machine_moves_big_balls_verdicts_at_the_line() -> 
 
 
 def test_leaving_out_both_frames_of_a_corner_bounce_quiets_the_bouncer_control() -> None:
-    # The rerun's bouncers and drops (24 clips, same machine), tracked again leaving out both
-    # frames of a bounce into a corner: its false alarm is gone and one of its two second
-    # causes; every other verdict is the rerun's.
+    # The rerun's bouncers and drops (24 clips, its library versions), tracked again leaving
+    # out both frames of a bounce into a corner: its false alarm is gone and one of its two
+    # second causes; every other verdict is the rerun's.
     rows = CORNERS["rows"]
     assert len(rows) == 24 and {r["scene"] for r in rows} == {"bouncer", "drops"}
     assert all(right(r) for r in rows) and not any("filmed_failure" in r for r in rows)
