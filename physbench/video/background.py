@@ -8,7 +8,7 @@ body that never moves as background. :func:`median_background` streams the video
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -52,18 +52,55 @@ def median_background(
     """The per-pixel median of about ``samples`` frames spread over the whole of ``source`` (a
     :class:`~physbench.video.reader.VideoReader` or frames / ``(H, W, 3)`` arrays), streamed: it
     keeps every ``k``-th frame and doubles ``k`` (dropping every other kept frame) whenever more
-    than ``2 samples`` are held, so memory stays flat in the video's length."""
+    than ``2 samples`` are held, so memory stays flat in the video's length. A reader that
+    counts its frames is asked for the same frames by index, and decodes only what they need."""
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise BackgroundError(f"samples = {samples!r}: expected a whole number >= 1")
+    kept = _chosen(source, samples) if hasattr(source, "count") else None
+    if kept is None:  # streamed
+        kept = _kept(source.frames if hasattr(source, "frames") else lambda _: source, samples)
+    if not kept:
+        raise BackgroundError("no frames to take a median background from")
+    shapes = {k.shape for k in kept}
+    if len(shapes) != 1:
+        raise BackgroundError(f"frames of different sizes: {sorted(shapes)}")
+    return _median(np.stack(kept))
+
+
+def _chosen(reader: VideoReader, samples: int) -> list[np.ndarray] | None:
+    """The images :func:`_kept` keeps of ``reader``, chosen from its frame count up front, so
+    that only they and the frames they are decoded from are decoded (``sparse``); ``None``
+    where the count is unknown, or the reader cannot tell which frame is which before decoding
+    (then the frames are streamed)."""
+    from physbench.video.reader import SparseError
+
+    n = reader.count()
+    if not n:
+        return None
+    indices = _kept(lambda _: range(n), samples)  # what streaming n frames would keep
+    wanted = set(int(i) for i in indices)
+    try:
+        frames = list(reader.frames(wanted.__contains__, sparse=True))
+    except SparseError:
+        return None
+    if [f.index for f in frames] != sorted(wanted):  # counted wrong: stream them instead
+        return None
+    return [f.image for f in frames]
+
+
+def _kept(
+    frames: Callable[[Callable[[int], bool]], Iterable[Frame | np.ndarray]], samples: int
+) -> list[np.ndarray]:
+    """Every ``k``-th image of ``frames(wanted)``, ``k`` doubled (every other kept image dropped)
+    whenever more than ``2 samples`` are held, then thinned evenly to about ``samples``."""
     step = 1
 
     def wanted(i: int) -> bool:
         return i % step == 0
 
-    # A reader converts only the frames kept to images (decoding the rest is unavoidable).
-    frames = source.frames(wanted) if hasattr(source, "frames") else source
     kept: list[np.ndarray] = []
-    for i, fr in enumerate(frames):
+    # A reader converts only the frames kept to images (decoding the rest is unavoidable).
+    for i, fr in enumerate(frames(wanted)):
         index = getattr(fr, "index", i)
         if not wanted(index):
             continue
@@ -71,14 +108,9 @@ def median_background(
         if len(kept) > 2 * samples:
             kept = kept[::2]
             step *= 2
-    if not kept:
-        raise BackgroundError("no frames to take a median background from")
-    if len(kept) > samples:  # thin evenly to about `samples`
+    if len(kept) > samples:
         kept = [kept[int(j)] for j in np.linspace(0, len(kept) - 1, samples).round()]
-    shapes = {k.shape for k in kept}
-    if len(shapes) != 1:
-        raise BackgroundError(f"frames of different sizes: {sorted(shapes)}")
-    return _median(np.stack(kept))
+    return kept
 
 
 #: Pixel values a band of the median's selection network takes at a time (the ``N`` rows of a band

@@ -188,11 +188,18 @@ class VideoReader:
 
     # ----------------------------------------------------------------- frames
 
-    def frames(self, select: Callable[[int], bool] | None = None) -> Iterator[Frame]:
+    def frames(
+        self, select: Callable[[int], bool] | None = None, *, sparse: bool = False
+    ) -> Iterator[Frame]:
         """The frames inside ``[start, end]``, decoded one at a time, with their times (s from the
         first frame of the file; real seconds where ``capture_fps`` rescales a slow-motion
         file). ``select(index)``: yield only the frames it accepts (the others are still decoded,
-        as a video's later frames need them, but not converted to images). Raises
+        as a video's later frames need them, but not converted to images). ``sparse``: for a
+        caller that keeps few frames, the refused frames that no other frame is decoded from
+        (H.264's and HEVC's non-reference frames) are not decoded at all. ``select`` is then also
+        asked before a frame is decoded, possibly ahead of earlier frames, and may only narrow
+        its answer later; a file whose frames cannot be told apart by their timestamps before
+        decoding raises :class:`SparseError` instead (read it again without ``sparse``). Raises
         :class:`VideoError` for a file that cannot be decoded, and when no frame lies inside the
         trim."""
         count = 0
@@ -202,7 +209,7 @@ class VideoReader:
             count += 1
             return select is None or select(k)
 
-        yield from self._images(chosen) if self.images else self._decode(chosen)
+        yield from self._images(chosen) if self.images else self._decode(chosen, select, sparse)
         if count == 0:
             span = f" between {self.start:g} and {self.end:g} s" if self.end else ""
             after = f" after {self.start:g} s" if self.start and not self.end else ""
@@ -260,19 +267,25 @@ class VideoReader:
             )
         return rate / self.capture_fps
 
-    def _decode(self, select: Callable[[int], bool]) -> Iterator[Frame]:
+    def _decode(
+        self,
+        select: Callable[[int], bool],
+        ask: Callable[[int], bool] | None = None,
+        sparse: bool = False,
+    ) -> Iterator[Frame]:
         av = load_av()
         with self._open() as container:
             stream = self._stream(container)
             stream.thread_type = "AUTO"
             scale = self._time_scale(stream)
+            order = self._display_order(stream) if sparse else None
             # One conversion context for the clip: a frame's own is made anew for each frame
             # (0.3 ms a 640x480 frame against 0.15).
             rgb = av.video.reformatter.VideoReformatter()
             t0: float | None = None
-            k = 0
+            k, last = 0, -math.inf
             try:
-                for frame in container.decode(stream):
+                for frame in self._decoded(container, stream, order, ask):
                     if frame.pts is None or frame.time_base is None:
                         raise VideoError(
                             f"{str(self.path)!r}: frame {k} carries no timestamp; physbench reads "
@@ -281,6 +294,12 @@ class VideoReader:
                     t_abs = float(frame.pts * frame.time_base)
                     t0 = t_abs if t0 is None else t0
                     t = t_abs - t0
+                    if order is not None:  # the frame's place from its timestamp
+                        place = order.index.get(frame.pts)
+                        first = (t0 == t_abs) == (frame.pts == order.first)
+                        if place is None or place <= last or not first:
+                            raise SparseError(f"{str(self.path)!r}: the frames' order is not known")
+                        k = last = place
                     if t < self.start - 1e-9:
                         continue
                     if self.end is not None and t > self.end + 1e-9:
@@ -293,6 +312,74 @@ class VideoReader:
                 raise VideoError(
                     f"{str(self.path)!r} is damaged after {k} frames ({exc.strerror or exc})"
                 ) from None
+
+    def count(self) -> int | None:
+        """The number of frames inside ``[start, end]``, from the container's timestamps (a pass
+        that reads the file but decodes nothing); ``None`` where a timestamp is missing or
+        repeated. Called by a median background, to choose the frames it keeps up front."""
+        if self.images:
+            assert self.fps is not None
+            seconds = [i / self.fps for i in range(len(self.images))]
+        else:
+            with self._open() as container:
+                stream = self._stream(container)
+                pts = self._packet_times(container, stream)
+                if pts is None:
+                    return None
+                seconds = [float((q - pts[0]) * stream.time_base) for q in pts]
+        end = math.inf if self.end is None else self.end + 1e-9
+        return sum(self.start - 1e-9 <= t <= end for t in seconds)
+
+    @staticmethod
+    def _packet_times(container: Any, stream: Any) -> list[int] | None:
+        """The timestamps of the stream's packets, sorted (display order); ``None`` where one is
+        missing or repeated."""
+        pts = [p.pts for p in container.demux(stream) if p.size]
+        if not pts or None in pts or len(set(pts)) != len(pts):
+            return None
+        return sorted(pts)
+
+    def _display_order(self, stream: Any) -> _Order | None:
+        """The display order of the stream's packets, from their timestamps (a pass that reads
+        but does not decode); ``None`` where a codec's skipping is not known to drop only
+        non-reference frames, or a packet's timestamp is missing or repeated."""
+        if stream.codec_context.name not in ("h264", "hevc"):
+            return None
+        with self._open() as container:
+            pts = self._packet_times(container, container.streams.video[0])
+        return None if pts is None else _Order(pts, self.start, stream.time_base)
+
+    @staticmethod
+    def _decoded(
+        container: Any, stream: Any, order: _Order | None, ask: Callable[[int], bool] | None
+    ) -> Iterator[Any]:
+        """The stream's decoded frames; with ``order``, each packet whose frame ``ask`` refuses
+        is decoded only if other frames need it."""
+        if order is None or ask is None:
+            yield from container.decode(stream)
+            return
+        context = stream.codec_context
+        for packet in container.demux(stream):
+            k = order.index.get(packet.pts)
+            keep = k is None or packet.pts == order.first or (k >= 0 and ask(k))
+            context.skip_frame = "DEFAULT" if keep else "NONREF"
+            yield from stream.decode(packet)
+
+
+class SparseError(VideoError):
+    """A video read with ``sparse`` whose frames' order could not be known before decoding."""
+
+
+class _Order:
+    """The display order of a stream's frames, from its packets' timestamps ``pts`` (sorted):
+    ``index[pts]`` is a frame's index in the trim starting ``start`` s after the first frame
+    (negative before it), ``first`` the first frame's timestamp."""
+
+    def __init__(self, pts: list[int], start: float, time_base: Any) -> None:
+        self.first = pts[0]
+        seconds = [float((q - self.first) * time_base) for q in pts]
+        before = sum(t < start - 1e-9 for t in seconds)
+        self.index = {q: i - before for i, q in enumerate(pts)}
 
 
 def _quarter_turns(path: Path, degrees: float) -> int:

@@ -49,3 +49,35 @@ def test_the_median_is_numpys_median(n: int) -> None:
     got = _median(stack).astype(float)
     # Odd counts exactly; even ones round the middle pair's half up (numpy: to even).
     assert np.abs(got - want).max() <= (0 if n % 2 else 0.5)
+
+
+def test_a_median_read_sparsely_is_the_median_of_the_streamed_frames(tmp_path) -> None:
+    # A reader that counts its frames is asked for the streamed median's frames by index and
+    # decodes only what they need; where a frame counted is missing, or the reader cannot tell which
+    # frame is which before decoding, the frames are streamed as before.
+    pytest.importorskip("av")
+    from physbench.video.reader import SparseError, VideoReader
+    from physbench.video.writer import write_video
+
+    rng = np.random.default_rng(3)
+    frames = [rng.integers(0, 256, (32, 48, 3), dtype=np.uint8) for _ in range(70)]
+    reader = VideoReader(write_video(tmp_path / "c.mp4", frames, fps=30))
+    assert reader.count() == 70
+    streamed = median_background(reader.frames(), samples=9)  # a generator: no count
+    np.testing.assert_array_equal(median_background(reader, samples=9), streamed)
+
+    class Unordered:
+        def __init__(self, count: int) -> None:
+            self.n = count
+
+        def count(self) -> int:
+            return self.n
+
+        def frames(self, select, *, sparse=False):  # type: ignore[no-untyped-def]
+            if sparse and self.n == 70:
+                yield next(reader.frames(select))
+                raise SparseError("order not known")
+            yield from reader.frames(select, sparse=sparse)
+
+    for n in (70, 90):  # the order unknown; frames counted that are not there
+        np.testing.assert_array_equal(median_background(Unordered(n), samples=9), streamed)

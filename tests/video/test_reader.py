@@ -113,6 +113,59 @@ def test_frames_can_be_selected_without_converting_the_others(tmp_path: Path) ->
     assert list(VideoReader(clip).frames(lambda k: False)) == []  # decoded, none wanted: no error
 
 
+def _counting(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """How many frames each read decodes (one entry per read)."""
+    decoded = VideoReader._decoded
+    counts: list[int] = []
+
+    def counted(*args):  # type: ignore[no-untyped-def]
+        counts.append(0)
+        for frame in decoded(*args):
+            counts[-1] += 1
+            yield frame
+
+    monkeypatch.setattr(VideoReader, "_decoded", staticmethod(counted))
+    return counts
+
+
+@pytest.mark.parametrize("start", [0.0, 0.4])
+@pytest.mark.parametrize("keep", [(0, 8, 16, 24, 32), (3, 5, 29)])
+def test_a_sparse_read_leaves_out_unwanted_non_reference_frames_only(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, start: float, keep: tuple[int, ...]
+) -> None:
+    # x264's defaults code B-frames no other frame is decoded from: a median background keeps 1
+    # frame in 8 or fewer and need not decode them. What it does keep is the same to the bit.
+    times = [i / 30 + (0.02 if i > 20 else 0.0) for i in range(40)]  # a dropped-frame gap
+    clip = write_video(tmp_path / "c.mp4", (frame(i % 18) for i in range(40)), fps=30, times=times)
+    counts = _counting(monkeypatch)
+    full = list(VideoReader(clip, start=start).frames(lambda k: k in keep))
+    sparse = list(VideoReader(clip, start=start).frames(lambda k: k in keep, sparse=True))
+    assert [f.index for f in full] == [k for k in keep if k < sum(t > start - 1e-3 for t in times)]
+    assert [(f.index, f.time) for f in sparse] == [(f.index, f.time) for f in full]
+    for a, b in zip(full, sparse, strict=True):
+        np.testing.assert_array_equal(a.image, b.image)
+    assert counts[0] == 40 and counts[1] <= 36, counts  # 7-8 of the B-frames left out here
+
+
+def test_a_sparse_read_of_frames_whose_order_is_unknown_says_so(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from physbench.video.reader import SparseError, _Order
+
+    clip = write_video(tmp_path / "c.mp4", (frame(i) for i in range(12)), fps=30)
+    every = list(VideoReader(clip).frames(sparse=True))  # nothing refused: every frame
+    assert [f.index for f in every] == list(range(12))
+    order = VideoReader._display_order
+
+    def short(self, stream):  # type: ignore[no-untyped-def]
+        o = order(self, stream)
+        return _Order(sorted(o.index)[:-3], 0.0, stream.time_base)  # three frames not listed
+
+    monkeypatch.setattr(VideoReader, "_display_order", short)
+    with pytest.raises(SparseError, match="order is not known"):
+        list(VideoReader(clip).frames(lambda k: k % 4 == 0, sparse=True))
+
+
 def _turned_clip(path: Path, upright: np.ndarray, degrees: float, frames: int = 3) -> None:
     """``upright`` stored as a phone stores a portrait clip: turned against its display rotation
     (``degrees`` counter-clockwise), the rotation written beside it."""
