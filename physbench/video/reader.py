@@ -130,6 +130,8 @@ class VideoReader:
         if not self.path.exists():
             raise VideoError(f"video {str(self.path)!r} does not exist")
         self.images: list[Path] = []
+        self._pts: list[int] | None = None  # the packets' timestamps, once read
+        self._pts_read = False
         if self.path.is_dir():
             self.images = sorted(
                 p for p in self.path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES
@@ -330,14 +332,14 @@ class VideoReader:
         end = math.inf if self.end is None else self.end + 1e-9
         return sum(self.start - 1e-9 <= t <= end for t in seconds)
 
-    @staticmethod
-    def _packet_times(container: Any, stream: Any) -> list[int] | None:
-        """The timestamps of the stream's packets, sorted (display order); ``None`` where one is
-        missing or repeated."""
-        pts = [p.pts for p in container.demux(stream) if p.size]
-        if not pts or None in pts or len(set(pts)) != len(pts):
-            return None
-        return sorted(pts)
+    def _packet_times(self, container: Any, stream: Any) -> list[int] | None:
+        """The timestamps of the stream's packets, sorted (display order), read once per reader;
+        ``None`` where one is missing or repeated."""
+        if not self._pts_read:
+            pts = [p.pts for p in container.demux(stream) if p.size]
+            unusable = not pts or None in pts or len(set(pts)) != len(pts)
+            self._pts, self._pts_read = (None if unusable else sorted(pts)), True
+        return self._pts
 
     def _display_order(self, stream: Any) -> _Order | None:
         """The display order of the stream's packets, from their timestamps (a pass that reads
@@ -345,8 +347,10 @@ class VideoReader:
         non-reference frames, or a packet's timestamp is missing or repeated."""
         if stream.codec_context.name not in ("h264", "hevc"):
             return None
-        with self._open() as container:
-            pts = self._packet_times(container, container.streams.video[0])
+        if not self._pts_read:
+            with self._open() as container:
+                self._packet_times(container, container.streams.video[0])
+        pts = self._pts
         return None if pts is None else _Order(pts, self.start, stream.time_base)
 
     @staticmethod
