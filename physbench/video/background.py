@@ -56,7 +56,8 @@ def median_background(
     counts its frames is asked for the same frames by index, and decodes only what they need."""
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise BackgroundError(f"samples = {samples!r}: expected a whole number >= 1")
-    kept = _chosen(source, samples) if hasattr(source, "count") else None
+    counted = hasattr(source, "frames") and hasattr(source, "count")  # a list has a count too
+    kept = _chosen(source, samples) if counted else None  # type: ignore[arg-type]
     if kept is None:  # streamed
         kept = _kept(source.frames if hasattr(source, "frames") else lambda _: source, samples)
     if not kept:

@@ -81,3 +81,7 @@ def test_a_median_read_sparsely_is_the_median_of_the_streamed_frames(tmp_path) -
 
     for n in (70, 90):  # the order unknown; frames counted that are not there
         np.testing.assert_array_equal(median_background(Unordered(n), samples=9), streamed)
+    as_list = list(VideoReader(reader.path).frames())  # frames in a list: streamed
+    np.testing.assert_array_equal(median_background(as_list, samples=9), streamed)
+    images = [f.image for f in as_list]
+    np.testing.assert_array_equal(median_background(tuple(images), samples=9), streamed)
