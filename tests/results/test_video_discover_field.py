@@ -29,6 +29,7 @@ EARLIER_ROWS = json.loads((EARLIER / "results.json").read_text())["rows"]
 HELDOUT = json.loads((FOLDER / "heldout_3_4" / "results.json").read_text())
 RERUN = json.loads((FOLDER / "rerun_c5024ee" / "results.json").read_text())
 CORNERS = json.loads((FOLDER / "corner_bounces" / "results.json").read_text())
+LATEST = json.loads((FOLDER / "rerun_62408a0" / "results.json").read_text())
 TOLERANCE = 0.10
 #: Balls below this radius (px) are below the noise of this camera in many frames.
 TINY = 2.0
@@ -360,3 +361,19 @@ def test_leaving_out_both_frames_of_a_corner_bounce_quiets_the_bouncer_control()
     assert changed == ["control/bouncer/pymunk/0", "velocity_dependent_restitution/bouncer/box2d/0"]
     extra = [name(r) for r in rows if r["effect"] and len(r["filmed"]["causes"]) > 1]
     assert extra == ["velocity_dependent_restitution/bouncer/pymunk/1"]
+
+
+def test_the_whole_grid_at_62408a0_keeps_every_big_verdict_and_has_no_false_alarm() -> None:
+    # The whole grid again at git 62408a0 (corner bounces left out, the sparse median): 51 of
+    # 270 clips refused as before, all of them balls under 2 px; the bouncer control's false
+    # alarm is gone, so no control names a cause.
+    rows = LATEST["rows"]
+    assert LATEST["code"] == "git 62408a0" and {name(r) for r in rows} == {name(r) for r in ROWS}
+    assert sum("filmed_failure" in r for r in rows) == 51
+    assert all(r["body_px"] < TINY for r in rows if "filmed_failure" in r)
+    alarms = [
+        name(r) for r in rows if r["effect"] is None and not right(r) and "filmed_failure" not in r
+    ]
+    assert alarms == []
+    big = [r for r in rows if r["body_px"] >= TINY]
+    assert (len(big), sum(right(r) for r in big)) == (200, 199)
