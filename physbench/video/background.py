@@ -9,6 +9,7 @@ body that never moves as background. :func:`median_background` streams the video
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -46,6 +47,18 @@ def load_plate(path: str | Path) -> np.ndarray:
         ) from None
 
 
+@dataclass(frozen=True)
+class MedianFrames:
+    """A median background ``image`` and the ``frames`` (``(N, H, W, 3)`` uint8) it is the median
+    of, at ``times`` (s from the source's first frame; NaN where the source gave none): the
+    tracker takes the median again without the bodies it tracked (:mod:`~physbench.video.held`)
+    where it holds one that stayed put."""
+
+    image: np.ndarray
+    frames: np.ndarray
+    times: np.ndarray
+
+
 def median_background(
     source: VideoReader | Iterable[Frame | np.ndarray], *, samples: int = SAMPLES
 ) -> np.ndarray:
@@ -54,6 +67,13 @@ def median_background(
     keeps every ``k``-th frame and doubles ``k`` (dropping every other kept frame) whenever more
     than ``2 samples`` are held, so memory stays flat in the video's length. A reader that
     counts its frames is asked for the same frames by index, and decodes only what they need."""
+    return median_frames(source, samples=samples).image
+
+
+def median_frames(
+    source: VideoReader | Iterable[Frame | np.ndarray], *, samples: int = SAMPLES
+) -> MedianFrames:
+    """:func:`median_background` with the frames it is taken over."""
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise BackgroundError(f"samples = {samples!r}: expected a whole number >= 1")
     counted = hasattr(source, "frames") and hasattr(source, "count")  # a list has a count too
@@ -62,13 +82,15 @@ def median_background(
         kept = _kept(source.frames if hasattr(source, "frames") else lambda _: source, samples)
     if not kept:
         raise BackgroundError("no frames to take a median background from")
-    shapes = {k.shape for k in kept}
+    shapes = {k.shape for k, _ in kept}
     if len(shapes) != 1:
         raise BackgroundError(f"frames of different sizes: {sorted(shapes)}")
-    return _median(np.stack(kept))
+    stack = np.stack([k for k, _ in kept])
+    times = np.array([t for _, t in kept], dtype=float)
+    return MedianFrames(_median(stack), stack, times - times[0])
 
 
-def _chosen(reader: VideoReader, samples: int) -> list[np.ndarray] | None:
+def _chosen(reader: VideoReader, samples: int) -> list[tuple[np.ndarray, float]] | None:
     """The images :func:`_kept` keeps of ``reader``, chosen from its frame count up front, so
     that only they and the frames they are decoded from are decoded (``sparse``); ``None``
     where the count is unknown, or the reader cannot tell which frame is which before decoding
@@ -79,33 +101,34 @@ def _chosen(reader: VideoReader, samples: int) -> list[np.ndarray] | None:
     if not n:
         return None
     indices = _kept(lambda _: range(n), samples)  # what streaming n frames would keep
-    wanted = set(int(i) for i in indices)
+    wanted = set(int(i) for i, _ in indices)
     try:
         frames = list(reader.frames(wanted.__contains__, sparse=True))
     except SparseError:
         return None
     if [f.index for f in frames] != sorted(wanted):  # counted wrong: stream them instead
         return None
-    return [f.image for f in frames]
+    return [(f.image, f.time) for f in frames]
 
 
 def _kept(
     frames: Callable[[Callable[[int], bool]], Iterable[Frame | np.ndarray]], samples: int
-) -> list[np.ndarray]:
-    """Every ``k``-th image of ``frames(wanted)``, ``k`` doubled (every other kept image dropped)
-    whenever more than ``2 samples`` are held, then thinned evenly to about ``samples``."""
+) -> list[tuple[np.ndarray, float]]:
+    """Every ``k``-th image of ``frames(wanted)`` with its time (NaN for a bare array), ``k``
+    doubled (every other kept image dropped) whenever more than ``2 samples`` are held, then
+    thinned evenly to about ``samples``."""
     step = 1
 
     def wanted(i: int) -> bool:
         return i % step == 0
 
-    kept: list[np.ndarray] = []
+    kept: list[tuple[np.ndarray, float]] = []
     # A reader converts only the frames kept to images (decoding the rest is unavoidable).
     for i, fr in enumerate(frames(wanted)):
         index = getattr(fr, "index", i)
         if not wanted(index):
             continue
-        kept.append(np.asarray(getattr(fr, "image", fr)))
+        kept.append((np.asarray(getattr(fr, "image", fr)), float(getattr(fr, "time", np.nan))))
         if len(kept) > 2 * samples:
             kept = kept[::2]
             step *= 2

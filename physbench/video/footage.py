@@ -104,7 +104,7 @@ def video_observation(
     file was filmed at (:func:`~physbench.video.track.track_video`)."""
     from physbench.calibration import load_calibration
     from physbench.observation import Observation
-    from physbench.video.background import load_plate, median_background
+    from physbench.video.background import load_plate
     from physbench.video.photometry import LightMeter
     from physbench.video.reader import VideoReader
     from physbench.video.segment import Segmenter, body_threshold, fill_holes
@@ -131,9 +131,7 @@ def video_observation(
     )
     recording = tracked.measured  # collision frames too: their pixels are split by the poses
     if background is None:
-        background = median_background(
-            VideoReader(path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps)
-        )
+        background = tracked.background  # the clip's median, mended where it held a body
     expected = tuple(renderer.shape(scene))
     seg = Segmenter(
         scene,

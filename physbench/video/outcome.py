@@ -71,6 +71,9 @@ class TrackSummary:
     #: background's (:mod:`~physbench.video.steadiness`), and the largest such shift (px).
     camera_moved: list[tuple[float, float]] = field(default_factory=list)
     camera_shift_px: float = 0.0
+    #: The bodies the clip's median background held where they stayed put, tracked again
+    #: against it mended there (:mod:`~physbench.video.held`).
+    held: list[str] = field(default_factory=list)
 
     def camera_words(self) -> str:
         """``the camera moved by up to 2.5 px against the background, from 0.20 to 0.90 s``, or
@@ -142,6 +145,11 @@ class TrackSummary:
             lines.append(f"  {name:>8}: " + "; ".join(parts))
         if self.camera_moved:
             lines.append(f"  {self.camera_words()}")
+        if self.held:
+            lines.append(
+                f"  the clip's median held {', '.join(self.held)} where they stayed put: tracked "
+                "again against the median of the frames where they were elsewhere"
+            )
         return "\n".join(lines)
 
 

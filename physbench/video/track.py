@@ -93,6 +93,7 @@ if TYPE_CHECKING:
     from physbench.calibration import Calibration
     from physbench.recording import Recording, Track
     from physbench.scene import Body, Scene
+    from physbench.video.background import MedianFrames
     from physbench.video.reader import Frame
 
 #: Ratio of a body's principal second moments above which its long axis gives its angle.
@@ -327,6 +328,9 @@ class TrackResult:
     summary: TrackSummary
     pixels: dict[str, np.ndarray]
     measured: Recording
+    #: The background tracked against (the clip's median mended where it held a body), where
+    #: :func:`track_video` took it from the clip; ``None`` where it was given.
+    background: np.ndarray | None = None
 
 
 class Tracker:
@@ -1535,13 +1539,15 @@ def track_frames(
     progress: bool = False,
     transfer: str = "linear",
     subsampled: bool = False,
+    held: Sequence[str] = (),
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
-    the clip's median), whose pixel values encode light by ``transfer``
-    (:mod:`~physbench.video.transfer`); ``subsampled``: the frames were stored with colour at a
-    lower resolution than brightness (4:2:0 or 4:2:2 video, as nearly every camera's), whose
-    coloured rims bleed outwards (:data:`~physbench.video.silhouette.HALO`). A body lost in more
-    than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view raises
+    the clip's median; ``held``: the bodies it held, mended, :mod:`~physbench.video.held`), whose
+    pixel values encode light by ``transfer`` (:mod:`~physbench.video.transfer`);
+    ``subsampled``: the frames were stored with colour at a lower resolution than brightness
+    (4:2:0 or 4:2:2 video, as nearly every camera's), whose coloured rims bleed outwards
+    (:data:`~physbench.video.silhouette.HALO`). A body lost in more than
+    :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view raises
     :class:`TrackLostError` unless ``allow_gaps``."""
     import sys
 
@@ -1564,9 +1570,13 @@ def track_frames(
         print(file=sys.stderr)
     fps = tracker.frames / max(_time.perf_counter() - tic, 1e-9)
     result = tracker.result(fps=fps)
+    if median:
+        result = replace(result, background=background)
+    if held:
+        result = replace(result, summary=replace(result.summary, held=list(held)))
     failures = result.summary.failures()
     if failures and not allow_gaps:
-        held = (
+        advice = (
             "; the background is the clip's median, which holds a body that stays put for over "
             "half of the clip: film the empty scene and give it as --background"
             if median
@@ -1578,7 +1588,7 @@ def track_frames(
             + (f". {camera[0].upper()}{camera[1:]}: {MOVING}" if camera else "")
             + ". A track with such gaps is not the motion; find why in a "
             "--preview (an occluder, too little contrast, a body leaving the view), or pass "
-            f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{held}"
+            f"--allow-gaps (allow_gaps=True) to keep the recording with its gaps{advice}"
             f"{_tiny(tracker, result.summary.lost_bodies())}",
             result,
         )
@@ -1627,7 +1637,7 @@ def track_video(
     :func:`~physbench.video.transfer.resolve`); ``capture_fps``: the rate a slow-motion file was
     filmed at (:class:`~physbench.video.reader.VideoReader`; a file playing at under half the
     scene's rate without it is warned of)."""
-    from physbench.video.background import load_plate, median_background
+    from physbench.video.background import load_plate, median_frames
     from physbench.video.reader import VideoError, VideoReader
     from physbench.video.transfer import resolve
 
@@ -1645,11 +1655,12 @@ def track_video(
             calibration = bounds_calibration(scene, (info.height, info.width))
         if isinstance(background, str | Path):
             background = load_plate(background)
-        median = background is None
+        kept = None
         if background is None:
-            background = median_background(
+            kept = median_frames(
                 VideoReader(path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps)
             )
+            background = kept.image
         background = np.asarray(background)
         if background.ndim != 3 or background.shape[2] != 3 or background.dtype != np.uint8:
             raise TrackError(
@@ -1662,19 +1673,71 @@ def track_video(
                 f"{str(path)!r} is {info.width}x{info.height} px: give a plate of this camera's "
                 "view"
             )
-        return track_frames(
-            reader.frames(),
+        options = dict(progress=progress, transfer=curve, subsampled=info.subsampled)
+        if kept is None:
+            return track_frames(
+                reader.frames(), scene, calibration, background, allow_gaps=allow_gaps, **options
+            )
+        return _unheld(
+            lambda: VideoReader(
+                path, start=start, end=end, fps=scene.fps, capture_fps=capture_fps
+            ).frames(),
+            kept,
             scene,
             calibration,
-            background,
-            median=median,
             allow_gaps=allow_gaps,
-            progress=progress,
-            transfer=curve,
-            subsampled=info.subsampled,
+            **options,
         )
     except VideoError as exc:
         raise TrackError(str(exc)) from None
+
+
+def _unheld(
+    frames: Callable[[], Iterable[Frame]],
+    kept: MedianFrames,
+    scene: Scene,
+    calibration: Calibration,
+    *,
+    allow_gaps: bool,
+    progress: bool,
+    **options: object,
+) -> TrackResult:
+    """Track ``frames()`` against the median ``kept``; where that held a body
+    (:func:`~physbench.video.held.unheld`), track them again against it mended. The first
+    tracking's warnings and failure stand only where it held none."""
+    import sys
+    import warnings
+
+    from physbench.video.held import unheld
+
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        try:
+            first = track_frames(
+                frames(), scene, calibration, kept.image, median=True, allow_gaps=allow_gaps,
+                progress=progress, **options,  # type: ignore[arg-type]
+            )  # fmt: skip
+            failed = None
+        except TrackLostError as exc:
+            first, failed = exc.result, exc
+    held = unheld(kept, first.pixels, scene, calibration)
+    if held is None:
+        for w in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        if failed is not None:
+            raise failed
+        return first
+    if progress:
+        print(
+            f"  the clip's median holds {', '.join(held.bodies)} where they stayed put: tracking "
+            "again against it mended there",
+            file=sys.stderr,
+            flush=True,
+        )
+    return track_frames(
+        frames(), scene, calibration, held.background, median=True, allow_gaps=allow_gaps,
+        progress=progress, held=held.bodies, **options,  # type: ignore[arg-type]
+    )  # fmt: skip
 
 
 def _check_rate(

@@ -6,7 +6,12 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from physbench.video.background import BackgroundError, load_plate, median_background
+from physbench.video.background import (
+    BackgroundError,
+    load_plate,
+    median_background,
+    median_frames,
+)
 
 
 def test_a_plate_reads_as_rgb_and_bad_files_are_named(tmp_path) -> None:
@@ -85,3 +90,26 @@ def test_a_median_read_sparsely_is_the_median_of_the_streamed_frames(tmp_path) -
     np.testing.assert_array_equal(median_background(as_list, samples=9), streamed)
     images = [f.image for f in as_list]
     np.testing.assert_array_equal(median_background(tuple(images), samples=9), streamed)
+
+
+def test_the_median_keeps_its_frames_and_their_times(tmp_path) -> None:
+    # The tracker takes the median again over the same frames without its bodies
+    # (physbench.video.held), so it needs them and when they were filmed.
+    pytest.importorskip("av")
+    from physbench.video.reader import VideoReader
+    from physbench.video.writer import write_video
+
+    rng = np.random.default_rng(4)
+    frames = [rng.integers(0, 256, (32, 48, 3), dtype=np.uint8) for _ in range(70)]
+    reader = VideoReader(write_video(tmp_path / "c.mp4", frames, fps=20))
+    kept = median_frames(reader, samples=9)
+    decoded = [f.image for f in VideoReader(reader.path).frames()]
+    indices = np.rint(kept.times * 20).astype(int)
+    assert kept.times[0] == 0 and np.all(np.diff(indices) > 0) and len(indices) == len(kept.frames)
+    np.testing.assert_allclose(kept.times, indices / 20, atol=1e-6)
+    for k, i in enumerate(indices):
+        np.testing.assert_array_equal(kept.frames[k], decoded[i])
+    np.testing.assert_array_equal(kept.image, median_background(reader, samples=9))
+    bare = median_frames(iter(decoded), samples=9)  # bare arrays: times unknown
+    assert np.isnan(bare.times).all()
+    np.testing.assert_array_equal(bare.image, kept.image)

@@ -1,0 +1,153 @@
+"""Bodies a median background holds, and the median taken again without them.
+
+The median of a clip is its background only where no body stayed put over half of the frames it
+is taken over: a ball that comes to rest, or creeps along a floor, is part of the median there,
+and a tracker that finds bodies by their difference to the background loses it (measured: the
+6-ball rack of ``benchmarks/track_speed.py``, 5 s, lost a ball creeping along the floor in 64 of
+150 frames and measured it up to 9.3 px off in the others; two balls resting against the walls
+were up to 4.8 px off). After a first tracking, :func:`unheld` takes the median again, leaving
+out of each frame the pixels near where its bodies were tracked (each frame brought to the
+median's light first). Where that differs from the median by more than the frames' noise
+threshold, the median held a body, and the tracker tracks the clip again against the median
+mended there (:func:`~physbench.video.track.track_video`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from physbench.calibration import Calibration
+from physbench.scene import Scene
+from physbench.video.background import MedianFrames
+from physbench.video.photometry import LightMeter
+
+#: Pixels left out around a tracked body's outline (px): blur, a halo of coding, the
+#: track's own error.
+MARGIN = 2.0
+#: A body is held where the median, taken without the bodies, differs from the median on at
+#: least this share of its area (and on 3 px or more). A body that creeps leaves a ghost of only
+#: the part of it that stayed put over half of the frames (measured: 284 px of a 20.7 px ball
+#: creeping 60 px in 17 s, a fifth of its area, and it pulled the ball's centre 4.2 px off).
+HELD_SHARE = 0.05
+
+
+@dataclass(frozen=True)
+class Held:
+    """The median ``background`` mended where it held ``bodies``, and how many ``pixels`` were
+    mended."""
+
+    background: np.ndarray
+    bodies: tuple[str, ...]
+    pixels: int
+
+
+def unheld(
+    median: MedianFrames,
+    tracks: Mapping[str, np.ndarray],
+    scene: Scene,
+    calibration: Calibration,
+) -> Held | None:
+    """Called by :func:`~physbench.video.track.track_video` after tracking against the clip's
+    ``median``, with each body's image track ``(t, u, v)`` (s from the first frame, px): the
+    median mended where it held a body, or ``None`` where it held none (or the frames' times are
+    unknown)."""
+    times = median.times
+    n, h, w = median.frames.shape[:3]
+    if n < 2 or not np.isfinite(times).all():
+        return None
+    dt = 1.0 / scene.fps
+    bodies = [b for b in scene.bodies if b.name in tracks and len(tracks[b.name])]
+    if not bodies:
+        return None
+    covered = np.zeros((n, h, w), bool)
+    stays = np.zeros((len(bodies), h, w), np.int16)  # how many kept frames cover each pixel
+    avoid: list[list[tuple[float, float, float]]] = [[] for _ in range(n)]
+    for i, b in enumerate(bodies):
+        rows = np.asarray(tracks[b.name], dtype=float)
+        for k, tau in enumerate(times):
+            here = np.zeros((h, w), bool)
+            for u, v, r in _places(rows, tau, dt, b.shape.extent(), calibration):
+                _disc(here, u, v, r)
+                avoid[k].append((u, v, r))
+            covered[k] |= here
+            stays[i] += here
+    # The median shows a body only where it was there in over half of the kept frames; a third
+    # leaves room for the median's noise. The rest of the frames' pixels are not looked at.
+    touched = covered.sum(axis=0) * 3 >= n
+    if not touched.any():
+        return None
+    meter = LightMeter(median.image)
+    values = median.frames[:, touched].astype(np.float32)  # (n, m, 3)
+    levels = []
+    for k in range(n):
+        light = meter.measure(median.frames[k], avoid[k])
+        values[k] = (values[k] - light.offset.astype(np.float32)) / light.gain.astype(np.float32)
+        levels.append(light.threshold())
+    values[covered[:, touched]] = np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a pixel every frame covers
+        again = np.nanmedian(values, axis=0)
+    free = np.isfinite(again).all(axis=1)
+    before = median.image[touched].astype(np.float32)
+    off = np.zeros(len(before), bool)
+    off[free] = np.abs(again[free] - before[free]).max(axis=1) > float(np.median(levels))
+    differs = np.zeros((h, w), bool)
+    differs[touched] = off
+    # A flagged pixel is the ghost of the body that covered it in most kept frames: the one
+    # that stayed there, not one that crossed its ghost.
+    owner = np.where(differs & (stays.max(axis=0) > 0), np.argmax(stays, axis=0), -1)
+    held, mend = [], np.zeros((h, w), bool)
+    for i, b in enumerate(bodies):
+        u, v = calibration.to_image(np.asarray(b.position, dtype=float)[None])[0]
+        r = b.shape.extent() / calibration.metres_per_pixel((u, v))
+        mine = owner == i
+        if mine.sum() >= max(3.0, HELD_SHARE * math.pi * r * r):
+            held.append(b.name)
+            mend |= mine
+    if not held:
+        return None
+    mended = median.image.copy()
+    fill = np.zeros((h, w, 3), np.float32)
+    fill[touched] = np.where(free[:, None], again, 0.0)
+    mended[mend] = np.clip(np.rint(fill[mend]), 0, 255).astype(np.uint8)
+    return Held(mended, tuple(held), int(mend.sum()))
+
+
+def _places(
+    rows: np.ndarray, tau: float, dt: float, extent: float, calibration: Calibration
+) -> list[tuple[float, float, float]]:
+    """Discs ``(u, v, r)`` (px) covering where a body of ``extent`` (m) tracked at ``rows`` was
+    over the frame at ``tau`` (s), its exposure and a frame either side: its places
+    interpolated then, and across a gap in its track the straight way between the places either
+    side of it, in steps of half its radius."""
+    t = rows[:, 0]
+    pts = [np.array([np.interp(x, t, rows[:, 1]), np.interp(x, t, rows[:, 2])]) for x in
+           (tau - dt, tau, tau + dt)]  # fmt: skip
+    j = int(np.searchsorted(t, tau))
+    if 0 < j < len(t) and t[j] - t[j - 1] > 1.5 * dt:  # unseen then: anywhere between
+        pts += [rows[j - 1, 1:3], rows[j, 1:3]]
+    out = []
+    for a, b in itertools.pairwise(pts):
+        r = (1.25 * extent / calibration.metres_per_pixel(a)) + MARGIN
+        steps = max(1, math.ceil(float(np.hypot(*(b - a))) / max(0.5 * r, 0.5)))
+        for s in np.linspace(0.0, 1.0, steps + 1):
+            p = a + s * (b - a)
+            out.append((float(p[0]), float(p[1]), r))
+    return out
+
+
+def _disc(mask: np.ndarray, u: float, v: float, r: float) -> None:
+    """Set the pixels of ``mask`` within ``r`` of ``(u, v)``."""
+    h, w = mask.shape
+    r0, r1 = max(0, math.floor(v - r)), min(h, math.ceil(v + r) + 1)
+    c0, c1 = max(0, math.floor(u - r)), min(w, math.ceil(u + r) + 1)
+    if r0 >= r1 or c0 >= c1:
+        return
+    yy, xx = np.ogrid[r0:r1, c0:c1]
+    mask[r0:r1, c0:c1] |= (xx - u) ** 2 + (yy - v) ** 2 <= r * r

@@ -1,0 +1,115 @@
+"""physbench.video.held: the median background is mended where a body stayed put, and only there."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from physbench.calibration import Calibration
+from physbench.scene import Body, Circle, Scene
+from physbench.video.background import MedianFrames
+from physbench.video.held import unheld
+
+H, W, FPS, R = 120, 160, 10.0, 8.0  # px, px, frames/s, ball radius px
+
+
+def _ball(frame: np.ndarray, u: float, v: float, colour: tuple[int, int, int]) -> None:
+    vv, uu = np.mgrid[0:H, 0:W]
+    frame[(uu - u) ** 2 + (vv - v) ** 2 <= R * R] = colour
+
+
+def _clip(rest: bool) -> tuple[MedianFrames, dict[str, np.ndarray], Scene, Calibration, np.ndarray]:
+    """15 frames of a textured wall under light varying by ±5 %: a red ball that rolls in and
+    rests at (100, 50) from the 5th frame on (or, ``rest=False``, rolls on across), a blue one
+    flying along row 90 that crosses the red ball's resting place's column. Tracks are exact."""
+    rng = np.random.default_rng(5)
+    plate = rng.integers(90, 170, size=(H, W, 3)).astype(np.uint8)
+    n = 15
+    red = [(30 + 17.5 * min(k, 4), 50.0) if rest else (30 + 8.0 * k, 50.0) for k in range(n)]
+    blue = [(10 + 10.0 * k, 90.0 - 3.0 * k) for k in range(n)]
+    frames = []
+    for k in range(n):
+        f = plate.astype(float) * (1 + 0.05 * np.sin(k)) + rng.normal(0, 2, (H, W, 3))
+        f = np.clip(np.rint(f), 0, 255).astype(np.uint8)
+        _ball(f, *red[k], (200, 30, 30))
+        _ball(f, *blue[k], (30, 30, 200))
+        frames.append(f)
+    stack = np.stack(frames)
+    times = np.arange(n) / FPS
+    median = MedianFrames(np.median(stack, axis=0).astype(np.uint8), stack, times)
+    tracks = {
+        name: np.column_stack([times, np.array(path)])
+        for name, path in (("red", red), ("blue", blue))
+    }
+    cal = Calibration.from_scale(0.01, (0.0, H - 1.0))
+    bodies = tuple(
+        Body(name, Circle(R / 100), tuple(cal.to_scene(np.array([path[0]]))[0]))
+        for name, path in (("red", red), ("blue", blue))
+    )
+    scene = Scene("s", bodies, bounds=(0.0, 0.0, W / 100, H / 100), fps=FPS, frames=n)
+    return median, tracks, scene.validate(), cal, plate
+
+
+def test_a_resting_ball_is_taken_out_of_the_median_and_only_its_ghost_is_mended() -> None:
+    median, tracks, scene, cal, plate = _clip(rest=True)
+    vv, uu = np.mgrid[0:H, 0:W]
+    ghost = (uu - 100) ** 2 + (vv - 50) ** 2 <= (R - 1) ** 2
+    off = np.abs(median.image.astype(int) - plate).max(axis=2)
+    assert off[ghost].min() > 25  # the median holds the red ball: 40-170 grey levels there
+
+    held = unheld(median, tracks, scene, cal)
+    assert held is not None and held.bodies == ("red",)  # not the blue one crossing its column
+    mended = np.abs(held.background.astype(int) - plate).max(axis=2)
+    assert np.percentile(mended[ghost], 95) <= 12  # the wall again, under the light's drift
+    changed = np.any(held.background != median.image, axis=2)
+    assert changed.sum() == held.pixels and held.pixels >= ghost.sum()
+    near = (uu - 100) ** 2 + (vv - 50) ** 2 <= (R + 4) ** 2
+    assert not changed[~near].any()  # nothing else is touched
+
+
+def test_a_median_that_holds_no_body_is_left_as_it_is() -> None:
+    median, tracks, scene, cal, _ = _clip(rest=False)
+    assert unheld(median, tracks, scene, cal) is None
+    unknown = replace(median, times=np.full(len(median.times), np.nan))  # a list of bare arrays
+    assert unheld(unknown, tracks, scene, cal) is None
+
+
+def test_the_rack_tracked_against_its_median_is_tracked_as_against_its_plate(
+    film, monkeypatch
+) -> None:
+    import physbench.video.held as held
+    from physbench.scenes import bouncing_balls
+    from physbench.video.track import track_video
+
+    # The rack of benchmarks/track_speed.py for 3 s: b3 creeps along the floor and b5 comes to
+    # rest, for over half of the clip, so the median holds them. Before: b3 was lost from 1.47
+    # to 1.53 s and measured up to 7.4 px off. Now the median is mended where they stayed put:
+    # up to 1.1 px, as against the plate (1.0 px).
+    clip = film(replace(bouncing_balls.generate(3, n_balls=6), frames=90))
+    cal = clip.camera.calibration(clip.scene)
+    result = track_video(clip.path, clip.scene, cal, allow_gaps=True)
+    assert set(result.summary.held) >= {"b3", "b5"} and not result.summary.lost
+    assert "held" in result.summary.format()
+    errors, swaps = clip.errors(result.pixels)
+    assert swaps == 0 and errors.max() < 1.5
+
+    monkeypatch.setattr(held, "unheld", lambda *args: None)  # the median as it was
+    before = track_video(clip.path, clip.scene, cal, allow_gaps=True)
+    assert before.summary.held == [] and (
+        before.summary.lost or clip.errors(before.pixels)[0].max() > 4
+    )
+
+
+def test_a_clip_where_nothing_rests_is_tracked_once(film, monkeypatch) -> None:
+    import physbench.video.track as track
+
+    ball = Body("ball", Circle(0.1), (1.0, 1.0), velocity=(2.5, 4.0))
+    scene = Scene("toss", (ball,), bounds=(0.0, 0.0, 4.0, 3.0), fps=30.0, frames=30).validate()
+    clip = film(scene)
+    passes = []
+    real = track.track_frames
+    monkeypatch.setattr(track, "track_frames", lambda *a, **k: passes.append(1) or real(*a, **k))
+    result = track.track_video(clip.path, scene, clip.camera.calibration(scene))
+    assert result.summary.held == [] and len(passes) == 1
+    assert clip.errors(result.pixels)[0].max() < 2.0  # measured 1.43 px: a fast, blurred ball
