@@ -1708,18 +1708,35 @@ def _unheld(
     import sys
     import warnings
 
-    from physbench.video.held import unheld
+    from physbench.video.held import at_start, unheld
+
+    def first_pass(background: np.ndarray) -> tuple[TrackResult, TrackLostError | None]:
+        try:
+            return track_frames(
+                frames(), scene, calibration, background, median=True, allow_gaps=allow_gaps,
+                progress=progress, **options,  # type: ignore[arg-type]
+            ), None  # fmt: skip
+        except TrackLostError as exc:
+            return exc.result, exc
 
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         try:
-            first = track_frames(
-                frames(), scene, calibration, kept.image, median=True, allow_gaps=allow_gaps,
-                progress=progress, **options,  # type: ignore[arg-type]
-            )  # fmt: skip
-            failed = None
-        except TrackLostError as exc:
-            first, failed = exc.result, exc
+            first, failed = first_pass(kept.image)
+        except BodyNotFoundError:
+            # A body the median holds where it starts (it stays put from the start over more
+            # than half of the clip) is not in the first frame's difference to it.
+            start = at_start(kept, scene, calibration)
+            if start is None:
+                raise
+            if progress:
+                print(
+                    f"  the clip's median holds {', '.join(start.bodies)} where they start: "
+                    "looking for them against it mended there",
+                    file=sys.stderr,
+                    flush=True,
+                )
+            first, failed = first_pass(start.background)
     held = unheld(kept, first.pixels, scene, calibration)
     if held is None:
         for w in said:
