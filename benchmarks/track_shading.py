@@ -4,6 +4,7 @@ motion-blurred.
 
     python benchmarks/track_shading.py [--out results/track/shading.json]
     python benchmarks/track_shading.py --gamma 2.2 --out results/track/shading_gamma22.json
+    python benchmarks/track_shading.py --gamma 2.2 --flat --out results/track/flat_gamma22.json
 
 Each case: a sphere painted with numpy (:mod:`physbench.video.spheres`, not the ``camera``
 renderer: Lambert shading with an ambient share, a white Blinn-Phong highlight that may clip)
@@ -13,7 +14,9 @@ over half the frame interval and coded as H.264 at CRF 23, tracked against the w
 it), the *error* the mean distance. The *centroid* columns weigh the blob's pixels by their
 difference to the wall, as the tracker did before its centres came from the outline.
 ``--gamma 2.2`` encodes the painted light by a 1/2.2 power, about as a camera's BT.709 or sRGB
-transfer does (the default keeps it linear, as the painter makes it).
+transfer does (the default keeps it linear, as the painter makes it). ``--flat`` paints the
+same discs unshaded (all ambient light, no highlight): what is left of their bias is not the
+shading's (the *bias* is then taken along the same light's highlight direction).
 """
 
 from __future__ import annotations
@@ -65,12 +68,14 @@ def _clip(
     blur: bool,
     coded: bool,
     gamma: float = 1.0,
+    flat: bool = False,
 ):
     """Frames, plate, true centres ``(T, 2)`` and the sphere of one case (``gamma``: the
-    camera's transfer, :func:`~physbench.video.spheres.expose`)."""
+    camera's transfer, :func:`~physbench.video.spheres.expose`; ``flat``: unshaded)."""
     rng = np.random.default_rng(seed)
     plate = wall(SIZE, seed)
-    sphere = Sphere(radius, colour, light, ambient=0.2, specular=0.7, shininess=25.0)
+    shading = {"ambient": 1.0, "specular": 0.0} if flat else {"ambient": 0.2, "specular": 0.7}
+    sphere = Sphere(radius, colour, light, shininess=25.0, **shading)
     start = np.array([110.0, 110.0]) + rng.uniform(0, 1, 2)
     velocity = np.array([4.3, 1.7]) if blur else np.array([0.37, 0.21])  # px per frame
     offsets = np.linspace(-0.25, 0.25, 9) if blur else np.zeros(1)  # half the frame interval
@@ -112,10 +117,13 @@ def _centroids(frames: np.ndarray, plate: np.ndarray, truth: np.ndarray, radius:
     return np.array(out)
 
 
-def run_case(radius, colour, light, seed, *, blur, coded, gamma: float = 1.0) -> dict:
+def run_case(
+    radius, colour, light, seed, *, blur, coded, gamma: float = 1.0, flat: bool = False
+) -> dict:
     frames, plate, truth, sphere, velocity = _clip(
-        radius, COLOURS[colour], LIGHTS[light], seed, blur=blur, coded=coded, gamma=gamma
-    )
+        radius, COLOURS[colour], LIGHTS[light], seed, blur=blur, coded=coded, gamma=gamma,
+        flat=flat,
+    )  # fmt: skip
     h = SIZE[0]
     cal = Calibration.from_scale(MPP, (0.0, h - 1.0))
     x0, y0 = cal.to_scene(truth[0])
@@ -163,6 +171,8 @@ def summarise(cases: list[dict]) -> list[dict]:
         mine = [c for c in cases if c["radius"] == radius]
         bias = np.abs([c["bias_px"] for c in mine])
         cen = np.abs([c["centroid_bias_px"] for c in mine])
+        raw = np.abs([c["bias_px"] for c in mine if not c["coded"]])
+        coded = np.abs([c["bias_px"] for c in mine if c["coded"]])
         rows.append(
             {
                 "radius": radius,
@@ -172,6 +182,8 @@ def summarise(cases: list[dict]) -> list[dict]:
                 "bias_median_px": round(float(np.median(bias)), 3),
                 "bias_p95_px": round(float(np.percentile(bias, 95)), 3),
                 "bias_max_px": round(float(bias.max()), 3),
+                "bias_p95_raw_px": round(float(np.percentile(raw, 95)), 3),
+                "bias_p95_coded_px": round(float(np.percentile(coded, 95)), 3),
                 "centroid_bias_median_px": round(float(np.median(cen)), 3),
                 "centroid_bias_p95_px": round(float(np.percentile(cen, 95)), 3),
                 "centroid_bias_max_px": round(float(cen.max()), 3),
@@ -206,6 +218,7 @@ def main() -> None:
         choices=(1.0, 2.2, 2.8),
         help="the camera's transfer: the light encoded by a 1/gamma power (default 1: linear)",
     )
+    ap.add_argument("--flat", action="store_true", help="unshaded discs: the coding's own bias")
     args = ap.parse_args()
     cases = []
     grid = itertools.product(
@@ -213,19 +226,34 @@ def main() -> None:
     )
     for radius, colour, light, seed, blur, coded in grid:
         cases.append(
-            run_case(radius, colour, light, seed, blur=blur, coded=coded, gamma=args.gamma)
+            run_case(
+                radius,
+                colour,
+                light,
+                seed,
+                blur=blur,
+                coded=coded,
+                gamma=args.gamma,
+                flat=args.flat,
+            )
         )
         print(json.dumps(cases[-1]), flush=True)
     rows = summarise(cases)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(
-        json.dumps({"gamma": args.gamma, "summary": rows, "cases": cases}, indent=1) + "\n"
+        json.dumps(
+            {"gamma": args.gamma, "flat": args.flat, "summary": rows, "cases": cases}, indent=1
+        )
+        + "\n"
     )
     light = "linear light" if args.gamma == 1.0 else f"light encoded by a 1/{args.gamma:g} power"
-    flag = "" if args.gamma == 1.0 else f" --gamma {args.gamma:g}"
+    flag = ("" if args.gamma == 1.0 else f" --gamma {args.gamma:g}") + (
+        " --flat" if args.flat else ""
+    )
+    what = "unshaded discs" if args.flat else "lit spheres with a highlight"
     out.with_suffix(".md").write_text(
-        "# Centre bias on lit spheres with a highlight (px, |mean error along the highlight|)\n\n"
+        f"# Centre bias on {what} (px, |mean error along the highlight|)\n\n"
         f"`python benchmarks/track_shading.py{flag}` ({light}): the tracker's outline fit "
         "against the weighted centroid it used before; per radius over colours x lights x walls "
         "x (still, blurred) x (raw, H.264 CRF 23).\n\n" + table(rows)

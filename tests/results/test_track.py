@@ -72,6 +72,28 @@ def test_under_a_cameras_transfer_coded_frames_are_over_a_fifth_of_a_pixel() -> 
     assert all(r["centroid_bias_p95_px"] >= 1.5 for r in rows.values() if r["radius"] >= 13)
 
 
+def test_what_coded_frames_add_is_the_codings_not_the_shadings() -> None:
+    # The same discs painted unshaded (track_shading.py --gamma 2.2 --flat: all ambient light,
+    # no highlight). In raw frames they lean 0.04-0.05 px at the 95th percentile at 13-22 px,
+    # the shaded spheres 0.09-0.11: that difference is the shading's own. Coded as H.264 at CRF
+    # 23 they lean 0.29-0.34 px, more than the shaded spheres (0.23-0.25), worst where the disc
+    # is of about the wall's brightness (light grey, steel): the part over the bar is the
+    # coding's, for any disc.
+    flat = json.loads((RESULTS / "flat_gamma22.json").read_text())
+    lit = json.loads((RESULTS / "shading_gamma22.json").read_text())
+    assert flat["flat"] and flat["gamma"] == lit["gamma"] == 2.2
+
+    def p95(data: dict, radius: int, coded: bool) -> float:
+        cases = [c for c in data["cases"] if c["radius"] == radius and c["coded"] == coded]
+        assert len(cases) == 192
+        return float(np.percentile([abs(c["bias_px"]) for c in cases], 95))
+
+    for radius in (13, 17, 22):
+        assert p95(flat, radius, False) <= 0.05 and p95(lit, radius, False) <= 0.12
+        assert p95(lit, radius, False) - p95(flat, radius, False) <= 0.08  # the shading's share
+        assert p95(flat, radius, True) > 0.28 and p95(flat, radius, True) > p95(lit, radius, True)
+
+
 def test_coded_frames_move_a_coloured_rim_outwards_and_the_luma_difference_is_no_cure() -> None:
     # Why coded frames' centres lean (benchmarks/track_edges.py): edge points found from the
     # true centre sit on the rim in raw frames (within 0.04 px, each side's median), and outside
