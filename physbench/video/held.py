@@ -135,11 +135,61 @@ def at_start(median: MedianFrames, scene: Scene, calibration: Calibration) -> He
     like the median over most of its disc, and at least two other kept frames are unlike it
     there and like each other: the wall after the body left. The disc is mended with their
     median."""
+    mended, held, count = median.image.copy(), [], 0
+    for place in _starts(median, scene, calibration):
+        unlike = place.unlike
+        if unlike[0] or unlike.sum() < 2:
+            continue
+        seen = place.seen[unlike]
+        wall = np.median(seen, axis=0)
+        near = np.abs(seen - wall).max(axis=2) <= place.level
+        agree = near[:, place.core].mean(axis=1) > 0.5
+        if agree.sum() < 2:
+            continue
+        wall = np.median(seen[agree], axis=0)
+        mended[place.disc] = np.clip(np.rint(wall), 0, 255).astype(np.uint8)
+        held.append(place.name)
+        count += int(place.disc.sum())
+    if not held:
+        return None
+    return Held(mended, tuple(held), count)
+
+
+def still_at_start(
+    median: MedianFrames, scene: Scene, calibration: Calibration
+) -> dict[str, tuple[int, int]]:
+    """Called by :func:`~physbench.video.track.track_video` when a body was not found in the
+    first frame against the clip's ``median`` and :func:`at_start` mended nothing: for each body
+    whose place in the first frame is like the median, in how many of the median's frames it is
+    so (and of how many), for the error to say."""
+    out = {}
+    for place in _starts(median, scene, calibration):
+        if not place.unlike[0]:
+            out[place.name] = (int((~place.unlike).sum()), len(place.unlike))
+    return out
+
+
+@dataclass(frozen=True)
+class _Start:
+    """A body's place in the first frame (``disc``, with :data:`MARGIN`; ``core``: the body's
+    own pixels among them), each kept frame's pixels there in the median's light (``seen``),
+    whether each is unlike the median over most of the body, and the frames' noise ``level``."""
+
+    name: str
+    disc: np.ndarray
+    core: np.ndarray
+    seen: np.ndarray
+    unlike: np.ndarray
+    level: float
+
+
+def _starts(median: MedianFrames, scene: Scene, calibration: Calibration) -> list[_Start]:
+    """:class:`_Start` of each body the scene starts in view of the median's frames (none where
+    the frames' times are unknown or do not start at the clip's first frame)."""
     n, h, w = median.frames.shape[:3]
     times = median.times
     if n < 3 or not np.isfinite(times).all() or times[0] != 0.0:
-        return None
-    meter = LightMeter(median.image)
+        return []
     places = []
     for b in scene.bodies:
         u, v = calibration.to_image(np.asarray(b.position, dtype=float)[None])[0]
@@ -147,11 +197,12 @@ def at_start(median: MedianFrames, scene: Scene, calibration: Calibration) -> He
         if -r < u < w + r and -r < v < h + r:
             places.append((b.name, float(u), float(v), float(r)))
     if not places:
-        return None
+        return []
+    meter = LightMeter(median.image)
     avoid = [(u, v, r) for _, u, v, r in places]
     lights = [meter.measure(median.frames[k], avoid) for k in range(n)]
     level = float(np.median([light.threshold() for light in lights]))
-    mended, held, count = median.image.copy(), [], 0
+    out = []
     for name, u, v, r in places:
         disc, body = np.zeros((h, w), bool), np.zeros((h, w), bool)
         _disc(disc, u, v, r)  # mended: the body with a margin
@@ -168,21 +219,8 @@ def at_start(median: MedianFrames, scene: Scene, calibration: Calibration) -> He
             ]
         )  # (n, m, 3) in the median's light
         off = np.abs(seen - before).max(axis=2) > level
-        unlike = off[:, core].mean(axis=1) > 0.5
-        if unlike[0] or unlike.sum() < 2:
-            continue
-        wall = np.median(seen[unlike], axis=0)
-        near = np.abs(seen[unlike] - wall).max(axis=2) <= level
-        agree = near[:, core].mean(axis=1) > 0.5
-        if agree.sum() < 2:
-            continue
-        wall = np.median(seen[unlike][agree], axis=0)
-        mended[disc] = np.clip(np.rint(wall), 0, 255).astype(np.uint8)
-        held.append(name)
-        count += int(disc.sum())
-    if not held:
-        return None
-    return Held(mended, tuple(held), count)
+        out.append(_Start(name, disc, core, seen, off[:, core].mean(axis=1) > 0.5, level))
+    return out
 
 
 def _places(

@@ -1708,7 +1708,7 @@ def _unheld(
     import sys
     import warnings
 
-    from physbench.video.held import at_start, unheld
+    from physbench.video.held import at_start, still_at_start, unheld
 
     def first_pass(background: np.ndarray) -> tuple[TrackResult, TrackLostError | None]:
         try:
@@ -1723,12 +1723,25 @@ def _unheld(
         warnings.simplefilter("always")
         try:
             first, failed = first_pass(kept.image)
-        except BodyNotFoundError:
+        except BodyNotFoundError as exc:
             # A body the median holds where it starts (it stays put from the start over more
             # than half of the clip) is not in the first frame's difference to it.
             start = at_start(kept, scene, calibration)
             if start is None:
-                raise
+                still = still_at_start(kept, scene, calibration)
+                if not still:
+                    raise
+                said = "; ".join(
+                    f"the place of body {name!r} looks as in the first frame in {k} of them"
+                    for name, (k, _) in still.items()
+                )
+                n = next(iter(still.values()))[1]
+                raise BodyNotFoundError(
+                    f"{exc}. The background is the clip's median, of {n} frames spread over "
+                    f"it: {said}, so what is there in the first frame stays there over most of "
+                    "the clip and is part of the median. If that is the body, film the empty "
+                    "scene and give it as --background"
+                ) from None
             if progress:
                 print(
                     f"  the clip's median holds {', '.join(start.bodies)} where they start: "

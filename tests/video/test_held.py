@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 from physbench.calibration import Calibration
 from physbench.scene import Body, Circle, Scene
 from physbench.video.background import MedianFrames
-from physbench.video.held import at_start, unheld
+from physbench.video.held import at_start, still_at_start, unheld
 
 H, W, FPS, R = 120, 160, 10.0, 8.0  # px, px, frames/s, ball radius px
 
@@ -130,6 +131,7 @@ def test_a_ball_the_median_holds_where_it_starts_is_mended_there() -> None:
     assert np.abs(median.image.astype(int) - plate).max(axis=2)[ball].min() > 25
     start = at_start(median, scene, cal)
     assert start is not None and start.bodies == ("red",)  # the blue one is in its first frame
+    assert still_at_start(median, scene, cal) == {"red": (10, 15)}  # for the error, if unmended
     mended = np.abs(start.background.astype(int) - plate).max(axis=2)
     assert np.percentile(mended[ball], 95) <= 12
     changed = np.any(start.background != median.image, axis=2)
@@ -172,5 +174,11 @@ def test_a_ball_held_still_then_let_go_is_tracked_against_the_median(film, monke
     assert clip.errors(result.pixels)[0].max() < 0.5
 
     monkeypatch.setattr(held, "at_start", lambda *args: None)  # the median as it was
-    with pytest.raises(BodyNotFoundError, match="not in the first frame"):
+    with pytest.raises(BodyNotFoundError, match="not in the first frame") as caught:
         track_video(clip.path, scene, cal)
+    # Refused, the error says what it measured: the median holds what the first frame shows.
+    assert re.search(
+        r"the place of body 'ball' looks as in the first frame in (9|1\d) of them",
+        str(caught.value),
+    )
+    assert "film the empty scene and give it as --background" in str(caught.value)
