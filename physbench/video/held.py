@@ -35,6 +35,11 @@ from physbench.video.photometry import LightMeter
 #: Pixels left out around a tracked body's outline (px): blur, a halo of coding, the
 #: track's own error.
 MARGIN = 2.0
+#: A tracked body's place is left out to this many times its radius (and :data:`MARGIN`): a
+#: track against a median that holds a body may be off by a good part of its radius
+#: (three_circles: a ball of 31 px radius tracked 10.7 px off; with only the margin, the median
+#: taken again kept part of it and a ball was lost in one more frame).
+COVER = 1.25
 #: A body is held where the median, taken without the bodies, differs from the median on at
 #: least this share of its area (and on 3 px or more). A body that creeps leaves a ghost of only
 #: the part of it that stayed put over half of the frames (measured: 284 px of a 20.7 px ball
@@ -238,7 +243,7 @@ def _places(
         pts += [rows[j - 1, 1:3], rows[j, 1:3]]
     out = []
     for a, b in itertools.pairwise(pts):
-        r = (1.25 * extent / calibration.metres_per_pixel(a)) + MARGIN
+        r = COVER * extent / calibration.metres_per_pixel(a) + MARGIN
         steps = max(1, math.ceil(float(np.hypot(*(b - a))) / max(0.5 * r, 0.5)))
         for s in np.linspace(0.0, 1.0, steps + 1):
             p = a + s * (b - a)
