@@ -1719,6 +1719,7 @@ def _unheld(
         except TrackLostError as exc:
             return exc.result, exc
 
+    refused: BodyNotFoundError | None = None
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         try:
@@ -1728,28 +1729,20 @@ def _unheld(
             # than half of the clip) is not in the first frame's difference to it.
             start = at_start(kept, scene, calibration)
             if start is None:
-                still = still_at_start(kept, scene, calibration)
-                if not still:
-                    raise
-                said = "; ".join(
-                    f"the place of body {name!r} looks as in the first frame in {k} of them"
-                    for name, (k, _) in still.items()
-                )
-                n = next(iter(still.values()))[1]
-                raise BodyNotFoundError(
-                    f"{exc}. The background is the clip's median, of {n} frames spread over "
-                    f"it: {said}, so what is there in the first frame stays there over most of "
-                    "the clip and is part of the median. If that is the body, film the empty "
-                    "scene and give it as --background"
-                ) from None
-            if progress:
-                print(
-                    f"  the clip's median holds {', '.join(start.bodies)} where they start: "
-                    "looking for them against it mended there",
-                    file=sys.stderr,
-                    flush=True,
-                )
-            first, failed = first_pass(start.background)
+                refused = _median_holds(exc, still_at_start(kept, scene, calibration))
+            else:
+                if progress:
+                    print(
+                        f"  the clip's median holds {', '.join(start.bodies)} where they start: "
+                        "looking for them against it mended there",
+                        file=sys.stderr,
+                        flush=True,
+                    )
+                first, failed = first_pass(start.background)
+    if refused is not None:
+        for w in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        raise refused
     held = unheld(kept, first.pixels, scene, calibration)
     if held is None:
         for w in said:
@@ -1768,6 +1761,24 @@ def _unheld(
         frames(), scene, calibration, held.background, median=True, allow_gaps=allow_gaps,
         progress=progress, held=held.bodies, **options,  # type: ignore[arg-type]
     )  # fmt: skip
+
+
+def _median_holds(exc: BodyNotFoundError, still: dict[str, tuple[int, int]]) -> BodyNotFoundError:
+    """``exc``, a first frame refused against the clip's median, with what was measured where
+    :func:`~physbench.video.held.at_start` mended nothing: in how many of the median's frames
+    each body's place looks as in the first frame (``still``)."""
+    if not still:
+        return exc
+    places = "; ".join(
+        f"the place of body {name!r} looks as in the first frame in {k} of them"
+        for name, (k, _) in still.items()
+    )
+    n = next(iter(still.values()))[1]
+    return BodyNotFoundError(
+        f"{exc}. The background is the clip's median, of {n} frames spread over it: {places}, "
+        "so what is there in the first frame stays there over most of the clip and is part of "
+        "the median. If that is the body, film the empty scene and give it as --background"
+    )
 
 
 def _check_rate(
