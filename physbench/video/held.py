@@ -189,11 +189,10 @@ class _Start:
 
 
 def _starts(median: MedianFrames, scene: Scene, calibration: Calibration) -> list[_Start]:
-    """:class:`_Start` of each body the scene starts in view of the median's frames (none where
-    the frames' times are unknown or do not start at the clip's first frame)."""
+    """:class:`_Start` of each body the scene starts in view of the median's frames, the first
+    of which is the clip's first (none where the frames' times are unknown)."""
     n, h, w = median.frames.shape[:3]
-    times = median.times
-    if n < 3 or not np.isfinite(times).all() or times[0] != 0.0:
+    if n < 3 or not np.isfinite(median.times).all():
         return []
     places = []
     for b in scene.bodies:
