@@ -1710,16 +1710,19 @@ def _unheld(
 
     from physbench.video.held import at_start, still_at_start, unheld
 
-    def first_pass(background: np.ndarray) -> tuple[TrackResult, TrackLostError | None]:
+    def first_pass(
+        background: np.ndarray, mended: Sequence[str] = ()
+    ) -> tuple[TrackResult, TrackLostError | None]:
         try:
             return track_frames(
                 frames(), scene, calibration, background, median=True, allow_gaps=allow_gaps,
-                progress=progress, **options,  # type: ignore[arg-type]
+                progress=progress, held=mended, **options,  # type: ignore[arg-type]
             ), None  # fmt: skip
         except TrackLostError as exc:
             return exc.result, exc
 
     refused: BodyNotFoundError | None = None
+    start = None
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         try:
@@ -1738,12 +1741,15 @@ def _unheld(
                         file=sys.stderr,
                         flush=True,
                     )
-                first, failed = first_pass(start.background)
+                first, failed = first_pass(start.background, start.bodies)
     if refused is not None:
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         raise refused
-    held = unheld(kept, first.pixels, scene, calibration)
+    # Mended where a body starts, the median is taken again on top of that mend, so the second
+    # pass keeps it.
+    base = kept if start is None else replace(kept, image=start.background)
+    held = unheld(base, first.pixels, scene, calibration)
     if held is None:
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
@@ -1757,9 +1763,10 @@ def _unheld(
             file=sys.stderr,
             flush=True,
         )
+    bodies = list(dict.fromkeys((*(start.bodies if start else ()), *held.bodies)))
     return track_frames(
         frames(), scene, calibration, held.background, median=True, allow_gaps=allow_gaps,
-        progress=progress, held=held.bodies, **options,  # type: ignore[arg-type]
+        progress=progress, held=bodies, **options,  # type: ignore[arg-type]
     )  # fmt: skip
 
 
