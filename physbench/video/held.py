@@ -5,13 +5,16 @@ is taken over: a ball that comes to rest, or creeps along a floor, is part of th
 and a tracker that finds bodies by their difference to the background loses it (measured: the
 6-ball rack of ``benchmarks/track_speed.py``, 5 s, lost a ball creeping along the floor in 64 of
 150 frames and measured it up to 9.3 px off in the others; two balls resting against the walls
-were up to 4.8 px off). After a first tracking, :func:`unheld` takes the median again, leaving
-out of each frame the pixels near where its bodies were tracked (each frame brought to the
+were up to 4.8 px off). Before the clip is tracked, a scout tracks the bodies through the median's
+own frames, which are in memory already. :func:`unheld` then takes the median again, leaving out
+of each frame the pixels near where the scout found its bodies (each frame brought to the
 median's light first). Where that differs from the median by more than the frames' noise
-threshold, the median held a body, and the tracker tracks the clip again against the median
-mended there (:func:`~physbench.video.track.track_video`). A body held where it starts (still
+threshold, the median held a body. The scout then looks again against the median mended there,
+since it may have lost a body creeping within its own ghost, and :func:`unheld` is asked again
+with what it found. The clip is decoded and tracked once, against the median so mended
+(:func:`~physbench.video.track.track_video`). A body held where it starts (still
 from the start over more than half of the frames: a ball held, then let go) is not in the first
-frame's difference to the median at all, so the first tracking fails: :func:`at_start` mends
+frame's difference to the median at all, so the scout fails there: :func:`at_start` mends
 the median there from the frames that show the wall after it left, and the tracker looks again
 (measured: a ball still for 1.2 s of a 2 s clip was refused; now tracked in all 60 frames,
 0.21 px off at most).
@@ -40,6 +43,13 @@ MARGIN = 2.0
 #: (three_circles: a ball of 31 px radius tracked 10.7 px off; with only the margin, the median
 #: taken again kept part of it and a ball was lost in one more frame).
 COVER = 1.25
+#: Across a gap in a body's track, the straight way between its places either side is covered
+#: only where they are within this many of its covering discs' radii of each other. The scout's
+#: tracks (:func:`~physbench.video.track.track_video`) come from frames over a second apart on a
+#: long clip, where a fast ball is lost in most: the ways between its places covered over nearly
+#: the whole image at least a third of the time, and the median taken again over so few frames
+#: there took 82 MiB on the 20 s clip of ``benchmarks/track_speed.py`` (50 on the 5 s one).
+SPAN = 2.0
 #: A body is held where the median, taken without the bodies, differs from the median on at
 #: least this share of its area (and on 3 px or more). A body that creeps leaves a ghost of only
 #: the part of it that stayed put over half of the frames (measured: 284 px of a 20.7 px ball
@@ -63,10 +73,10 @@ def unheld(
     scene: Scene,
     calibration: Calibration,
 ) -> Held | None:
-    """Called by :func:`~physbench.video.track.track_video` after tracking against the clip's
-    ``median``, with each body's image track ``(t, u, v)`` (s from the first frame, px): the
-    median mended where it held a body, or ``None`` where it held none (or the frames' times are
-    unknown)."""
+    """Called by :func:`~physbench.video.track.track_video` after tracking the median's own
+    frames against the clip's ``median``, with each body's image track ``(t, u, v)`` (s from the
+    first frame, px): the median mended where it held a body, or ``None`` where it held none (or
+    the frames' times are unknown)."""
     times = median.times
     n, h, w = median.frames.shape[:3]
     if n < 2 or not np.isfinite(times).all():
@@ -231,15 +241,22 @@ def _places(
     rows: np.ndarray, tau: float, dt: float, extent: float, calibration: Calibration
 ) -> list[tuple[float, float, float]]:
     """Discs ``(u, v, r)`` (px) covering where a body of ``extent`` (m) tracked at ``rows`` was
-    over the frame at ``tau`` (s), its exposure and a frame either side: its places
-    interpolated then, and across a gap in its track the straight way between the places either
-    side of it, in steps of half its radius."""
+    over the frame at ``tau`` (s), its exposure and a frame ``dt`` either side: its places
+    interpolated then, and where it was not measured in that frame (a gap in its track; the
+    track may have been measured in the median's frames only) the straight way between the
+    places either side of it, in steps of half its radius, if they are within :data:`SPAN` discs
+    of each other (else none: it was on its way, and cannot have stayed put there)."""
     t = rows[:, 0]
     pts = [np.array([np.interp(x, t, rows[:, 1]), np.interp(x, t, rows[:, 2])]) for x in
            (tau - dt, tau, tau + dt)]  # fmt: skip
-    j = int(np.searchsorted(t, tau))
-    if 0 < j < len(t) and t[j] - t[j - 1] > 1.5 * dt:  # unseen then: anywhere between
-        pts += [rows[j - 1, 1:3], rows[j, 1:3]]
+    j = int(np.searchsorted(t, tau - 0.5 * dt))
+    seen = j < len(t) and t[j] <= tau + 0.5 * dt  # measured in this frame
+    if not seen and 0 < j < len(t):  # unseen then: anywhere between
+        a, b = rows[j - 1, 1:3], rows[j, 1:3]
+        r = COVER * extent / calibration.metres_per_pixel(a) + MARGIN
+        if float(np.hypot(*(b - a))) > SPAN * r:
+            return []
+        pts = [a, b]
     out = []
     for a, b in itertools.pairwise(pts):
         r = COVER * extent / calibration.metres_per_pixel(a) + MARGIN

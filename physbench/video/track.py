@@ -1554,13 +1554,8 @@ def track_frames(
     tracker = Tracker(
         scene, calibration, background, median=median, transfer=transfer, subsampled=subsampled
     )
-    if progress and not compiled.cached():
-        print(
-            "  compiling the tracker's loops (once after installing, up to a minute; kept for "
-            "the next runs)",
-            file=sys.stderr,
-            flush=True,
-        )
+    if progress:
+        _say_compiling()
     tic = _time.perf_counter()
     for fr in frames:
         tracker.update(fr.image, fr.time)
@@ -1603,6 +1598,20 @@ def track_frames(
     return result
 
 
+def _say_compiling() -> None:
+    """Say on stderr, before a tracker's first frame, that its loops are about to be compiled,
+    where they are not in numba's disk cache yet."""
+    import sys
+
+    if not compiled.cached():
+        print(
+            "  compiling the tracker's loops (once after installing, up to a minute; kept for "
+            "the next runs)",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
 #: What a moving camera means, and the fix.
 MOVING = (
     "the tracker finds bodies against a fixed background, and every textured edge of the "
@@ -1630,7 +1639,8 @@ def track_video(
     ``calibration``: pixels to metres (default :func:`bounds_calibration`); ``start``/``end``: the
     part of the video to track (s; recording time 0 is the first frame at or after ``start``);
     ``background``: an image of the empty scene (array or file; default: the median of the
-    clip, which costs a second pass over the video); ``allow_gaps``: keep a body lost for more
+    clip, from 15 frames spread over it, mended where it holds a body that stayed put,
+    :mod:`~physbench.video.held`); ``allow_gaps``: keep a body lost for more
     than :data:`~physbench.video.outcome.LOST_SHARE` of the frames where it was in view (else
     :class:`TrackLostError`); ``transfer``: the video's transfer function, a name or ``"auto"``
     (default: the video's tag, else :data:`~physbench.video.transfer.DEFAULT`; see
@@ -1702,70 +1712,67 @@ def _unheld(
     progress: bool,
     **options: object,
 ) -> TrackResult:
-    """Track ``frames()`` against the median ``kept``; where that held a body
-    (:func:`~physbench.video.held.unheld`), track them again against it mended. The first
-    tracking's warnings and failure stand only where it held none."""
+    """Track ``frames()`` against the median ``kept``, mended first where it held a body
+    (:mod:`~physbench.video.held`). Where the bodies were is found by a scout: the bodies
+    tracked through the median's own frames, which are in memory already (15 of the clip's
+    frames), so the clip is decoded and tracked once, whatever the median held."""
     import sys
     import warnings
 
     from physbench.video.held import at_start, still_at_start, unheld
+    from physbench.video.reader import Frame
 
-    def first_pass(
-        background: np.ndarray, mended: Sequence[str] = ()
-    ) -> tuple[TrackResult, TrackLostError | None]:
-        try:
+    def scout(background: np.ndarray) -> TrackResult:
+        pairs = enumerate(zip(kept.times, kept.frames, strict=True))
+        sparse = (Frame(k, float(t), image) for k, (t, image) in pairs)
+        if progress:
+            _say_compiling()  # the scout's first frame compiles them, before the clip's
+        with warnings.catch_warnings():
+            # Its frames are far apart: what it says of them (gaps, a fast body lost) is no
+            # verdict on the clip, which the full tracking gives.
+            warnings.simplefilter("ignore")
             return track_frames(
-                frames(), scene, calibration, background, median=True, allow_gaps=allow_gaps,
-                progress=progress, held=mended, **options,  # type: ignore[arg-type]
-            ), None  # fmt: skip
-        except TrackLostError as exc:
-            return exc.result, exc
+                sparse, scene, calibration, background, median=True, allow_gaps=True,
+                **options,  # type: ignore[arg-type]
+            )  # fmt: skip
 
-    refused: BodyNotFoundError | None = None
     start = None
-    with warnings.catch_warnings(record=True) as said:
-        warnings.simplefilter("always")
-        try:
-            first, failed = first_pass(kept.image)
-        except BodyNotFoundError as exc:
-            # A body the median holds where it starts (it stays put from the start over more
-            # than half of the clip) is not in the first frame's difference to it.
-            start = at_start(kept, scene, calibration)
-            if start is None:
-                refused = _median_holds(exc, still_at_start(kept, scene, calibration))
-            else:
-                if progress:
-                    print(
-                        f"  the clip's median holds {', '.join(start.bodies)} where they start: "
-                        "looking for them against it mended there",
-                        file=sys.stderr,
-                        flush=True,
-                    )
-                first, failed = first_pass(start.background, start.bodies)
-    if refused is not None:
-        for w in said:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        raise refused
-    # Mended where a body starts, the median is taken again on top of that mend, so the second
-    # pass keeps it.
+    try:
+        first = scout(kept.image)
+    except BodyNotFoundError as exc:
+        # A body the median holds where it starts (it stays put from the start over more than
+        # half of the clip) is not in the first frame's difference to it; the median's first
+        # frame is the clip's.
+        start = at_start(kept, scene, calibration)
+        if start is None:
+            raise _median_holds(exc, still_at_start(kept, scene, calibration)) from None
+        if progress:
+            print(
+                f"  the clip's median holds {', '.join(start.bodies)} where they start: "
+                "looking for them against it mended there",
+                file=sys.stderr,
+                flush=True,
+            )
+        first = scout(start.background)
+    # Mended where a body starts, the median is taken again on top of that mend.
     base = kept if start is None else replace(kept, image=start.background)
     held = unheld(base, first.pixels, scene, calibration)
-    if held is None:
-        for w in said:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        if failed is not None:
-            raise failed
-        return first
-    if progress:
+    if held is not None:
+        # Against the median that held them, the scout may have lost the bodies it held (a ball
+        # creeping within its own ghost): where they were is found again against the mend.
+        again = unheld(base, scout(held.background).pixels, scene, calibration)
+        held = again if again is not None else held
+    if held is not None and progress:
         print(
             f"  the clip's median holds {', '.join(held.bodies)} where they stayed put: tracking "
-            "again against it mended there",
+            "against it mended there",
             file=sys.stderr,
             flush=True,
         )
-    bodies = list(dict.fromkeys((*(start.bodies if start else ()), *held.bodies)))
+    background = base.image if held is None else held.background
+    bodies = list(dict.fromkeys((*(start.bodies if start else ()), *(held.bodies if held else ()))))
     return track_frames(
-        frames(), scene, calibration, held.background, median=True, allow_gaps=allow_gaps,
+        frames(), scene, calibration, background, median=True, allow_gaps=allow_gaps,
         progress=progress, held=bodies, **options,  # type: ignore[arg-type]
     )  # fmt: skip
 

@@ -95,7 +95,10 @@ def test_the_rack_tracked_against_its_median_is_tracked_as_against_its_plate(
     # up to 1.1 px, as against the plate (1.0 px).
     clip = film(replace(bouncing_balls.generate(3, n_balls=6), frames=90))
     cal = clip.camera.calibration(clip.scene)
+    decodes = _full_decodes(monkeypatch)
     result = track_video(clip.path, clip.scene, cal, allow_gaps=True)
+    # Decoded in full once: where the bodies were is found in the median's own frames.
+    assert decodes == [1]
     assert set(result.summary.held) >= {"b3", "b5"} and not result.summary.lost
     assert "held" in result.summary.format()
     errors, swaps = clip.errors(result.pixels)
@@ -108,17 +111,37 @@ def test_the_rack_tracked_against_its_median_is_tracked_as_against_its_plate(
     )
 
 
-def test_a_clip_where_nothing_rests_is_tracked_once(film, monkeypatch) -> None:
+def _full_decodes(monkeypatch) -> list[int]:
+    """A list that gets one entry per pass that decodes a clip in full (not the median's sparse
+    read)."""
+    from physbench.video.reader import VideoReader
+
+    passes: list[int] = []
+    real = VideoReader.frames
+
+    def frames(self, select=None, *, sparse=False):
+        if select is None and not sparse:
+            passes.append(1)
+        return real(self, select, sparse=sparse)
+
+    monkeypatch.setattr(VideoReader, "frames", frames)
+    return passes
+
+
+def test_a_clip_where_nothing_rests_is_decoded_and_tracked_once(film, monkeypatch) -> None:
     import physbench.video.track as track
 
     ball = Body("ball", Circle(0.1), (1.0, 1.0), velocity=(2.5, 4.0))
     scene = Scene("toss", (ball,), bounds=(0.0, 0.0, 4.0, 3.0), fps=30.0, frames=30).validate()
     clip = film(scene)
-    passes = []
-    real = track.track_frames
-    monkeypatch.setattr(track, "track_frames", lambda *a, **k: passes.append(1) or real(*a, **k))
+    decodes = _full_decodes(monkeypatch)
+    updates = []
+    real = track.Tracker.update
+    monkeypatch.setattr(track.Tracker, "update", lambda s, *a: updates.append(1) or real(s, *a))
     result = track.track_video(clip.path, scene, clip.camera.calibration(scene))
-    assert result.summary.held == [] and len(passes) == 1
+    # The clip once, and the median's own 15 frames once (the scout that finds where the bodies
+    # were); nothing was held, so the scout does not look again.
+    assert result.summary.held == [] and decodes == [1] and len(updates) == 30 + 15
     assert clip.errors(result.pixels)[0].max() < 2.0  # measured 1.43 px: a fast, blurred ball
 
 
