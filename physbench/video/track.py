@@ -1757,7 +1757,7 @@ def _unheld(
     # Mended where a body starts, the median is taken again on top of that mend.
     base = kept if start is None else replace(kept, image=start.background)
     held = unheld(base, first.pixels, scene, calibration)
-    if held is not None:
+    if held is not None and any(len(first.pixels[b]) < len(kept.times) for b in held.bodies):
         # Against the median that held them, the scout may have lost the bodies it held (a ball
         # creeping within its own ghost): where they were is found again against the mend.
         again = unheld(base, scout(held.background).pixels, scene, calibration)
