@@ -241,3 +241,39 @@ def test_on_the_field_camera_a_ball_at_rest_is_tracked_against_the_median(
     monkeypatch.setattr(held, "unheld", lambda *args: None)  # the median as it was
     before = track_video(clip, scene, cal, allow_gaps=True)
     assert before.summary.lost or blob_errors(cam, scene, traj, before.pixels)["low"]["p95"] > 3
+
+
+def test_the_median_taken_again_is_numpys_nanmedian() -> None:
+    from physbench.video.held import _nanmedian
+
+    rng = np.random.default_rng(3)
+    values = rng.integers(0, 256, size=(15, 400, 3)).astype(np.float32)
+    values[rng.random((15, 400)) < 0.6] = np.nan  # covered: every count from 0 to 15
+    values[:, :5] = np.nan  # covered in every frame
+    with pytest.warns(RuntimeWarning):
+        expected = np.nanmedian(values, axis=0)
+    got = _nanmedian(values)
+    assert got.dtype == np.float32 and np.isnan(got[:5]).all()
+    np.testing.assert_array_equal(got, expected)
+
+
+def test_a_gap_is_covered_only_where_the_body_may_have_stayed_put() -> None:
+    from physbench.video.held import SPAN, _places
+
+    cal = Calibration.from_scale(0.01, (0.0, H - 1.0))
+    dt, extent = 1.0 / FPS, R / 100
+    disc = 1.25 * R + 2.0  # the covering disc's radius (COVER, MARGIN)
+    # Seen at 0 s and 1 s only: a ball creeping 10 px is covered all the way between in a frame
+    # it was not seen in; one that flew 100 px was on its way, and is not covered at all.
+    for way, covered in ((10.0, True), (100.0, False)):
+        rows = np.array([[0.0, 20.0, 50.0], [1.0, 20.0 + way, 50.0]])
+        assert (way <= SPAN * disc) == covered
+        places = _places(rows, 0.5, dt, extent, cal)
+        assert bool(places) == covered
+        if covered:
+            us = [u for u, _, _ in places]
+            assert min(us) == 20.0 and max(us) == 20.0 + way
+    # Seen in the frame: its places then, and a frame either side (interpolated: 52 and 72 px).
+    rows = np.array([[0.0, 20.0, 50.0], [0.5, 60.0, 50.0], [1.0, 120.0, 50.0]])
+    us = [u for u, _, _ in _places(rows, 0.5, dt, extent, cal)]
+    assert min(us) == pytest.approx(52.0) and max(us) == pytest.approx(72.0)
