@@ -159,11 +159,20 @@ def test_against_a_plate_at_least_200_frames_per_second_of_cpu_time() -> None:
     assert all(c["ratio"] >= 0.25 for c in plate)
 
 
+def test_with_the_median_the_clip_is_decoded_and_tracked_once() -> None:
+    clips = json.loads((RESULTS / "speed.json").read_text())["clips"]
+    median = [c for c in clips if c["background"] == "median"]
+    # Both clips' medians hold resting balls. Tracked twice (the code before the scout), they
+    # ran at 0.11-0.15 of decoding; found by the scout in the median's own frames, 0.17-0.25.
+    assert len(median) == 2 and all(c["ratio"] >= 0.16 for c in median)
+
+
 @pytest.mark.xfail(
     strict=True,
-    reason="issue 26's target: with the clip's median as background 96 and 112 frames per CPU "
-    "second (5 s, 20 s clips; 0.12-0.14 of decoding): the median holds resting balls, and the "
-    "clip is tracked a second time against it mended there (physbench/video/held.py)",
+    reason="issue 26's target: with the clip's median as background 178 frames per CPU second "
+    "on the 5 s clip (207 on the 20 s one; 0.17 and 0.22 of decoding): the median's sparse "
+    "read, the scout that finds the balls it holds and the median taken again cost about 0.36 "
+    "s a clip (physbench/video/held.py), against 0.50 s for tracking the 5 s clip's 150 frames",
 )
 def test_at_least_200_frames_per_second_of_cpu_time() -> None:
     clips = json.loads((RESULTS / "speed.json").read_text())["clips"]
