@@ -71,8 +71,8 @@ class TrackSummary:
     #: background's (:mod:`~physbench.video.steadiness`), and the largest such shift (px).
     camera_moved: list[tuple[float, float]] = field(default_factory=list)
     camera_shift_px: float = 0.0
-    #: The bodies the clip's median background held where they stayed put, tracked again
-    #: against it mended there (:mod:`~physbench.video.held`).
+    #: The bodies the clip's median background held where they stayed put, tracked against it
+    #: mended there (:mod:`~physbench.video.held`).
     held: list[str] = field(default_factory=list)
 
     def camera_words(self) -> str:
@@ -148,7 +148,7 @@ class TrackSummary:
         if self.held:
             lines.append(
                 f"  the clip's median held {', '.join(self.held)} where they stayed put: tracked "
-                "again against the median of the frames where they were elsewhere"
+                "against it mended from the frames where they were elsewhere"
             )
         return "\n".join(lines)
 
