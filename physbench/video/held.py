@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from physbench.calibration import Calibration
+from physbench.recording import Track
 from physbench.scene import Scene
 from physbench.video.background import MedianFrames
 from physbench.video.photometry import LightMeter
@@ -71,11 +72,15 @@ def unheld(
     tracks: Mapping[str, np.ndarray],
     scene: Scene,
     calibration: Calibration,
+    poses: Mapping[str, Track] | None = None,
 ) -> Held | None:
     """Called by :func:`~physbench.video.track.track_video` after tracking the median's own
     frames against the clip's ``median``, with each body's image track ``(t, u, v)`` (s from the
-    first frame, px): the median mended where it held a body, or ``None`` where it held none (or
-    the frames' times are unknown)."""
+    first frame, px), and ``poses``: the same tracks in scene metres with their angles, by which
+    a polygon is covered by its outline where it was measured, not by the disc of its extent (a
+    pendulum's arm: that disc covers its pivot in every frame, so the ghost of the arm there was
+    never taken out). Returns the median mended where it held a body, or ``None`` where it held
+    none (or the frames' times are unknown)."""
     times = median.times
     n, h, w = median.frames.shape[:3]
     if n < 2 or not np.isfinite(times).all():
@@ -90,18 +95,28 @@ def unheld(
     avoid: list[list[tuple[float, float, float]]] = [[] for _ in range(n)]
     for i, b in enumerate(bodies):
         rows = np.asarray(tracks[b.name], dtype=float)
+        pose = (poses or {}).get(b.name)
+        outlined = pose is not None and pose.angle is not None and hasattr(b.shape, "vertices")
         for k, tau in enumerate(times):
             discs = _places(rows, tau, dt, b.shape.extent(), calibration)
             avoid[k] += discs
-            box = _box(discs, h, w)
+            outlines = _outlines(pose, b.shape, tau, dt, calibration) if outlined else None
+            box = _box(discs, h, w) if outlines is None else _hull_box(outlines, h, w)
             if box is None:
                 continue
             (r0, r1), (c0, c1) = box
             here = np.zeros((r1 - r0, c1 - c0), bool)  # the discs' box only: 15 frames a body
             near = np.zeros_like(here)
-            for u, v, r in discs:
-                _disc(here, u - c0, v - r0, r)
-                _disc(near, u - c0, v - r0, (r - MARGIN) / COVER + MARGIN)
+            if outlines is None:
+                for u, v, r in discs:
+                    _disc(here, u - c0, v - r0, r)
+                    _disc(near, u - c0, v - r0, (r - MARGIN) / COVER + MARGIN)
+            else:
+                for pts in outlines:
+                    pts = pts - (c0, r0)
+                    centre = pts.mean(axis=0)
+                    _polygon(here, centre + COVER * (pts - centre))
+                    _polygon(near, pts)
             covered[k, r0:r1, c0:c1] |= here
             close[k, r0:r1, c0:c1] |= near
             stays[i, r0:r1, c0:c1] += here
@@ -142,9 +157,9 @@ def unheld(
     held, mend = [], np.zeros((h, w), bool)
     for i, b in enumerate(bodies):
         u, v = calibration.to_image(np.asarray(b.position, dtype=float)[None])[0]
-        r = b.shape.extent() / calibration.metres_per_pixel((u, v))
+        area = b.shape.area() / calibration.metres_per_pixel((u, v)) ** 2
         mine = owner == i
-        if mine.sum() >= max(3.0, HELD_SHARE * math.pi * r * r):
+        if mine.sum() >= max(3.0, HELD_SHARE * area):
             held.append(b.name)
             mend |= mine
     if not held:
@@ -282,6 +297,63 @@ def _places(
             p = a + s * (b - a)
             out.append((float(p[0]), float(p[1]), r))
     return out
+
+
+def _outlines(
+    pose: Track, shape: object, tau: float, dt: float, calibration: Calibration
+) -> list[np.ndarray] | None:
+    """A polygon body's outlines in the image (``(k, 2)`` px each) where its ``pose`` track
+    puts it over the frame at ``tau`` (s), its exposure and a frame ``dt`` either side; ``None``
+    where it was not measured in that frame (:func:`_places` covers it then)."""
+    t = np.asarray(pose.t, dtype=float)
+    j = int(np.searchsorted(t, tau - 0.5 * dt))
+    if not (j < len(t) and t[j] <= tau + 0.5 * dt):
+        return None
+    angle = np.unwrap(np.asarray(pose.angle, dtype=float))
+    body = np.asarray(shape.vertices(), dtype=float)  # type: ignore[attr-defined]
+    out = []
+    for x in (tau - dt, tau, tau + dt):
+        a = float(np.interp(x, t, angle))
+        rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+        xy = np.array([np.interp(x, t, pose.x), np.interp(x, t, pose.y)])
+        out.append(calibration.to_image(xy + body @ rot.T))
+    return out
+
+
+def _hull_box(
+    outlines: list[np.ndarray], h: int, w: int
+) -> tuple[tuple[int, int], tuple[int, int]] | None:
+    """:func:`_box` of ``outlines`` scaled by :data:`COVER` about their centres and widened by
+    :data:`MARGIN`."""
+    pts = np.concatenate([o.mean(axis=0) + COVER * (o - o.mean(axis=0)) for o in outlines])
+    lo, hi = pts.min(axis=0) - MARGIN, pts.max(axis=0) + MARGIN
+    r0, r1 = max(0, math.floor(float(lo[1]))), min(h, math.ceil(float(hi[1])) + 1)
+    c0, c1 = max(0, math.floor(float(lo[0]))), min(w, math.ceil(float(hi[0])) + 1)
+    if r0 >= r1 or c0 >= c1:
+        return None
+    return (r0, r1), (c0, c1)
+
+
+def _polygon(mask: np.ndarray, pts: np.ndarray) -> None:
+    """Set the pixels of ``mask`` within :data:`MARGIN` of the convex polygon ``pts`` (``(k,
+    2)`` px, either orientation), measured along each edge's normal (a little more than
+    MARGIN at the corners)."""
+    h, w = mask.shape
+    lo, hi = pts.min(axis=0) - MARGIN, pts.max(axis=0) + MARGIN
+    r0, r1 = max(0, math.floor(float(lo[1]))), min(h, math.ceil(float(hi[1])) + 1)
+    c0, c1 = max(0, math.floor(float(lo[0]))), min(w, math.ceil(float(hi[0])) + 1)
+    if r0 >= r1 or c0 >= c1:
+        return
+    yy, xx = np.ogrid[r0:r1, c0:c1]
+    x, y = pts[:, 0], pts[:, 1]
+    turn = 1.0 if np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) > 0 else -1.0
+    outside = np.full((r1 - r0, c1 - c0), -np.inf)
+    for (ax, ay), (bx, by) in zip(pts, np.roll(pts, -1, axis=0), strict=True):
+        ex, ey = bx - ax, by - ay
+        n = math.hypot(ex, ey)
+        if n > 0:  # the distance out of the polygon across this edge
+            np.maximum(outside, turn * ((xx - ax) * ey - (yy - ay) * ex) / n, out=outside)
+    mask[r0:r1, c0:c1] |= outside <= MARGIN
 
 
 def _nanmedian(values: np.ndarray) -> np.ndarray:

@@ -1756,11 +1756,12 @@ def _unheld(
         first = scout(start.background)
     # Mended where a body starts, the median is taken again on top of that mend.
     base = kept if start is None else replace(kept, image=start.background)
-    held = unheld(base, first.pixels, scene, calibration)
+    held = unheld(base, first.pixels, scene, calibration, first.measured.tracks)
     if held is not None and any(len(first.pixels[b]) < len(kept.times) for b in held.bodies):
         # Against the median that held them, the scout may have lost the bodies it held (a ball
         # creeping within its own ghost): where they were is found again against the mend.
-        again = unheld(base, scout(held.background).pixels, scene, calibration)
+        second = scout(held.background)
+        again = unheld(base, second.pixels, scene, calibration, second.measured.tracks)
         held = again if again is not None else held
     if held is not None and progress:
         print(

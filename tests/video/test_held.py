@@ -297,3 +297,19 @@ def test_a_gap_is_covered_only_where_the_body_may_have_stayed_put() -> None:
     rows = np.array([[0.0, 20.0, 50.0], [0.5, 60.0, 50.0], [1.0, 120.0, 50.0]])
     us = [u for u, _, _ in _places(rows, 0.5, dt, extent, cal)]
     assert min(us) == pytest.approx(52.0) and max(us) == pytest.approx(72.0)
+
+
+def test_a_polygon_is_covered_by_its_outline_and_the_margin() -> None:
+    from physbench.video.held import MARGIN, _polygon
+
+    square = np.array([[10.0, 10.0], [30.0, 10.0], [30.0, 20.0], [10.0, 20.0]])
+    masks = []
+    for pts in (square, square[::-1]):  # either orientation
+        mask = np.zeros((40, 40), bool)
+        _polygon(mask, pts)
+        masks.append(mask)
+    assert (masks[0] == masks[1]).all()
+    n = int(MARGIN)
+    assert masks[0].sum() == (20 + 2 * n + 1) * (10 + 2 * n + 1)  # the edges out to MARGIN
+    assert masks[0][15, 10 - n] and not masks[0][15, 10 - n - 1]
+    assert masks[0][20 + n, 20] and not masks[0][20 + n + 1, 20]
