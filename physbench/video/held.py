@@ -31,7 +31,7 @@ import numpy as np
 
 from physbench.calibration import Calibration
 from physbench.recording import Track
-from physbench.scene import Scene
+from physbench.scene import Body, Scene
 from physbench.video.background import MedianFrames
 from physbench.video.photometry import LightMeter
 
@@ -89,37 +89,7 @@ def unheld(
     bodies = [b for b in scene.bodies if b.name in tracks and len(tracks[b.name])]
     if not bodies:
         return None
-    covered = np.zeros((n, h, w), bool)
-    close = np.zeros((n, h, w), bool)  # the bodies with MARGIN only, not COVER
-    stays = np.zeros((len(bodies), h, w), np.int16)  # how many kept frames cover each pixel
-    avoid: list[list[tuple[float, float, float]]] = [[] for _ in range(n)]
-    for i, b in enumerate(bodies):
-        rows = np.asarray(tracks[b.name], dtype=float)
-        pose = (poses or {}).get(b.name)
-        outlined = pose is not None and pose.angle is not None and hasattr(b.shape, "vertices")
-        for k, tau in enumerate(times):
-            discs = _places(rows, tau, dt, b.shape.extent(), calibration)
-            avoid[k] += discs
-            outlines = _outlines(pose, b.shape, tau, dt, calibration) if outlined else None
-            box = _box(discs, h, w) if outlines is None else _hull_box(outlines, h, w)
-            if box is None:
-                continue
-            (r0, r1), (c0, c1) = box
-            here = np.zeros((r1 - r0, c1 - c0), bool)  # the discs' box only: 15 frames a body
-            near = np.zeros_like(here)
-            if outlines is None:
-                for u, v, r in discs:
-                    _disc(here, u - c0, v - r0, r)
-                    _disc(near, u - c0, v - r0, (r - MARGIN) / COVER + MARGIN)
-            else:
-                for pts in outlines:
-                    pts = pts - (c0, r0)
-                    centre = pts.mean(axis=0)
-                    _polygon(here, centre + COVER * (pts - centre))
-                    _polygon(near, pts)
-            covered[k, r0:r1, c0:c1] |= here
-            close[k, r0:r1, c0:c1] |= near
-            stays[i, r0:r1, c0:c1] += here
+    covered, close, stays, avoid = _covers(median, bodies, tracks, calibration, dt, poses)
     # The median shows a body only where it was there in over half of the kept frames; a third
     # leaves room for the median's noise. The rest of the frames' pixels are not looked at.
     touched = covered.sum(axis=0) * 3 >= n
@@ -169,6 +139,53 @@ def unheld(
     fill[touched] = np.where(free[:, None], again, 0.0)
     mended[mend] = np.clip(np.rint(fill[mend]), 0, 255).astype(np.uint8)
     return Held(mended, tuple(held), int(mend.sum()))
+
+
+def _covers(
+    median: MedianFrames,
+    bodies: list[Body],
+    tracks: Mapping[str, np.ndarray],
+    calibration: Calibration,
+    dt: float,
+    poses: Mapping[str, Track] | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[list[tuple[float, float, float]]]]:
+    """The pixels of each kept frame within :data:`COVER` of a tracked body (``covered``), within
+    :data:`MARGIN` only (``close``), how many kept frames cover each pixel by body (``stays``),
+    and the discs each frame's light is measured around (``avoid``)."""
+    times = median.times
+    n, h, w = median.frames.shape[:3]
+    covered = np.zeros((n, h, w), bool)
+    close = np.zeros((n, h, w), bool)  # the bodies with MARGIN only, not COVER
+    stays = np.zeros((len(bodies), h, w), np.int16)  # how many kept frames cover each pixel
+    avoid: list[list[tuple[float, float, float]]] = [[] for _ in range(n)]
+    for i, b in enumerate(bodies):
+        rows = np.asarray(tracks[b.name], dtype=float)
+        pose = (poses or {}).get(b.name)
+        outlined = pose is not None and pose.angle is not None and hasattr(b.shape, "vertices")
+        for k, tau in enumerate(times):
+            discs = _places(rows, tau, dt, b.shape.extent(), calibration)
+            avoid[k] += discs
+            outlines = _outlines(pose, b.shape, tau, dt, calibration) if outlined else None
+            box = _box(discs, h, w) if outlines is None else _hull_box(outlines, h, w)
+            if box is None:
+                continue
+            (r0, r1), (c0, c1) = box
+            here = np.zeros((r1 - r0, c1 - c0), bool)  # the discs' box only: 15 frames a body
+            near = np.zeros_like(here)
+            if outlines is None:
+                for u, v, r in discs:
+                    _disc(here, u - c0, v - r0, r)
+                    _disc(near, u - c0, v - r0, (r - MARGIN) / COVER + MARGIN)
+            else:
+                for pts in outlines:
+                    pts = pts - (c0, r0)
+                    centre = pts.mean(axis=0)
+                    _polygon(here, centre + COVER * (pts - centre))
+                    _polygon(near, pts)
+            covered[k, r0:r1, c0:c1] |= here
+            close[k, r0:r1, c0:c1] |= near
+            stays[i, r0:r1, c0:c1] += here
+    return covered, close, stays, avoid
 
 
 def at_start(median: MedianFrames, scene: Scene, calibration: Calibration) -> Held | None:
