@@ -60,11 +60,13 @@ HELD_SHARE = 0.05
 @dataclass(frozen=True)
 class Held:
     """The median ``background`` mended where it held ``bodies``, and how many ``pixels`` were
-    mended."""
+    mended; ``unknown``: where it holds one of them in every kept frame, so that no frame showed
+    what is behind it (the part of a pendulum's arm near its pivot), or ``None``."""
 
     background: np.ndarray
     bodies: tuple[str, ...]
     pixels: int
+    unknown: np.ndarray | None = None
 
 
 def unheld(
@@ -124,7 +126,7 @@ def unheld(
     # A flagged pixel is the ghost of the body that covered it in most kept frames: the one
     # that stayed there, not one that crossed its ghost.
     owner = np.where(differs & (stays.max(axis=0) > 0), np.argmax(stays, axis=0), -1)
-    held, mend = [], np.zeros((h, w), bool)
+    held, mend, kept = [], np.zeros((h, w), bool), np.zeros(len(bodies), bool)
     for i, b in enumerate(bodies):
         u, v = calibration.to_image(np.asarray(b.position, dtype=float)[None])[0]
         area = b.shape.area() / calibration.metres_per_pixel((u, v)) ** 2
@@ -132,13 +134,18 @@ def unheld(
         if mine.sum() >= max(3.0, HELD_SHARE * area):
             held.append(b.name)
             mend |= mine
+            kept[i] = True
     if not held:
         return None
+    # Never shown behind a held body: no kept frame saw it off there, even by its outline.
+    unknown = np.zeros((h, w), bool)
+    unknown[touched] = ~free
+    unknown &= (stays.max(axis=0) > 0) & kept[np.argmax(stays, axis=0)]
     mended = median.image.copy()
     fill = np.zeros((h, w, 3), np.float32)
     fill[touched] = np.where(free[:, None], again, 0.0)
     mended[mend] = np.clip(np.rint(fill[mend]), 0, 255).astype(np.uint8)
-    return Held(mended, tuple(held), int(mend.sum()))
+    return Held(mended, tuple(held), int(mend.sum()), unknown if unknown.any() else None)
 
 
 def _covers(

@@ -162,6 +162,11 @@ FAINT_END = 0.5
 #: their span (over the quantiles' share) as a fraction of its length in which they are trusted.
 ENDS_QUANTILE = 0.01
 ENDS_SPAN = (0.9, 1.1)
+#: Under this share of its length, a rod's blob is taken as cut short at an end whose
+#: background is unknown (see ``Tracker._from_one_end``).
+ENDS_WHOLE = 0.97
+#: A rod's end this close (px) to pixels whose background is unknown is taken as hidden there.
+UNKNOWN_NEAR = 3.0
 #: A body lost with a smaller radius (px) is said to be too small for the video's coding: on the
 #: field camera at CRF 18-30, balls of 0.8-1.9 px were absent from the coded pixels themselves
 #: (benchmarks/field_visibility.py) in more than a tenth of the frames in 46 of 51 refused clips.
@@ -348,8 +353,10 @@ class Tracker:
         median: bool = False,
         transfer: str = "linear",
         subsampled: bool = False,
+        unknown: np.ndarray | None = None,
     ) -> None:
         self.scene, self.cal, self.bg = scene, calibration, background
+        self.unknown = unknown  # where the background holds a body that no frame showed off it
         self.subsampled = subsampled  # colour at a lower resolution: discs fitted without halos
         self.linear = Decoder(transfer)  # pixel values to linear light, for the unmixing
         self.h, self.w = background.shape[:2]
@@ -899,9 +906,45 @@ class Tracker:
         along = (xy - pose.xy) @ axis
         lo, hi = np.quantile(along, [ENDS_QUANTILE, 1.0 - ENDS_QUANTILE])
         span = (hi - lo) / (1.0 - 2.0 * ENDS_QUANTILE)
-        if not ENDS_SPAN[0] <= span / length <= ENDS_SPAN[1]:
-            return pose  # an end hidden, cut off or joined to something: the centroid it is
+        if span / length > ENDS_SPAN[1]:
+            return pose  # joined to something: the centroid it is
+        if span / length < ENDS_WHOLE:
+            one = self._from_one_end(i, pose, axis, lo, hi)
+            if one is not None:
+                return one
+        if span / length < ENDS_SPAN[0]:
+            return pose  # an end hidden or cut off: the centroid it is
         return replace(pose, xy=pose.xy + 0.5 * (lo + hi) * axis)
+
+    def _from_one_end(
+        self, i: int, pose: PlanePose, axis: np.ndarray, lo: float, hi: float
+    ) -> PlanePose | None:
+        """Called by :meth:`_between_ends` when a rod's blob is shorter than
+        :data:`ENDS_WHOLE` of its length: ``pose`` with its centre half the length from the end
+        of the blob (``lo``, ``hi``: the ends' quantiles along ``axis``) that is seen, where the
+        other ends at pixels of the background that are :attr:`unknown` (the part of a
+        pendulum's arm near its pivot that the clip's median holds in every kept frame: the blob
+        stops short there); ``None`` where neither or both end there, or nothing is unknown.
+        Measured: on 20 field-camera pendulum clips tracked against their medians, the centre
+        error's 95th percentile fell on 5 (8.96 -> 4.34, 5.66 -> 3.65 px) and rose on none."""
+        length = self.states[i].length
+        if self.unknown is None or length is None:
+            return None
+        ends = self.cal.to_image(pose.xy + np.outer([lo, hi], axis))
+        hidden = [self._unknown_near(u, v) for u, v in ends]
+        if hidden[0] == hidden[1]:
+            return None
+        if hidden == [True, False]:  # the low end hidden: measured from the high one
+            return replace(pose, xy=pose.xy + (hi + ENDS_QUANTILE * length - 0.5 * length) * axis)
+        return replace(pose, xy=pose.xy + (lo - ENDS_QUANTILE * length + 0.5 * length) * axis)
+
+    def _unknown_near(self, u: float, v: float) -> bool:
+        """Whether a pixel of :attr:`unknown` lies within :data:`UNKNOWN_NEAR` px of ``(u, v)``."""
+        assert self.unknown is not None
+        r = UNKNOWN_NEAR
+        r0, r1 = max(0, math.floor(v - r)), min(self.h, math.ceil(v + r) + 1)
+        c0, c1 = max(0, math.floor(u - r)), min(self.w, math.ceil(u + r) + 1)
+        return bool(r0 < r1 and c0 < c1 and self.unknown[r0:r1, c0:c1].any())
 
     def _outline(self, i: int) -> Outline:
         """Body ``i``'s outline in the image at its prediction (px, about the predicted pixel):
@@ -1540,9 +1583,12 @@ def track_frames(
     transfer: str = "linear",
     subsampled: bool = False,
     held: Sequence[str] = (),
+    unknown: np.ndarray | None = None,
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
-    the clip's median; ``held``: the bodies it held, mended, :mod:`~physbench.video.held`), whose
+    the clip's median; ``held``: the bodies it held, mended, :mod:`~physbench.video.held`;
+    ``unknown``: where it holds one in every kept frame, :attr:`~physbench.video.held.Held.unknown`,
+    so that a rod's blob ending there is measured from its other end), whose
     pixel values encode light by ``transfer`` (:mod:`~physbench.video.transfer`);
     ``subsampled``: the frames were stored with colour at a lower resolution than brightness
     (4:2:0 or 4:2:2 video, as nearly every camera's), whose coloured rims bleed outwards
@@ -1552,8 +1598,9 @@ def track_frames(
     import sys
 
     tracker = Tracker(
-        scene, calibration, background, median=median, transfer=transfer, subsampled=subsampled
-    )
+        scene, calibration, background, median=median, transfer=transfer, subsampled=subsampled,
+        unknown=unknown,
+    )  # fmt: skip
     if progress:
         _say_compiling()
     tic = _time.perf_counter()
@@ -1774,7 +1821,8 @@ def _unheld(
     bodies = list(dict.fromkeys((*(start.bodies if start else ()), *(held.bodies if held else ()))))
     return track_frames(
         frames(), scene, calibration, background, median=True, allow_gaps=allow_gaps,
-        progress=progress, held=bodies, **options,  # type: ignore[arg-type]
+        progress=progress, held=bodies, unknown=None if held is None else held.unknown,
+        **options,  # type: ignore[arg-type]
     )  # fmt: skip
 
 

@@ -313,3 +313,33 @@ def test_a_polygon_is_covered_by_its_outline_and_the_margin() -> None:
     assert masks[0].sum() == (20 + 2 * n + 1) * (10 + 2 * n + 1)  # the edges out to MARGIN
     assert masks[0][15, 10 - n] and not masks[0][15, 10 - n - 1]
     assert masks[0][20 + n, 20] and not masks[0][20 + n + 1, 20]
+
+
+def test_where_a_creeping_ball_covers_every_kept_frame_the_background_is_unknown() -> None:
+    """A ball creeping 1 px a frame over 15 frames is held; the middle of its path, covered in
+    every frame, is not mended but said to be unknown, and nothing else is."""
+    rng = np.random.default_rng(3)
+    plate = rng.integers(90, 170, size=(H, W, 3)).astype(np.uint8)
+    n = 15
+    path = [(60.0 + k, 50.0) for k in range(n)]
+    frames = []
+    for u, v in path:
+        f = np.clip(plate.astype(float) + rng.normal(0, 2, (H, W, 3)), 0, 255).astype(np.uint8)
+        _ball(f, u, v, (200, 30, 30))
+        frames.append(f)
+    stack = np.stack(frames)
+    times = np.arange(n) / FPS
+    median = MedianFrames(np.median(stack, axis=0).astype(np.uint8), stack, times)
+    cal = Calibration.from_scale(0.01, (0.0, H - 1.0))
+    ball = Body("red", Circle(R / 100), tuple(cal.to_scene(np.array([path[0]]))[0]))
+    scene = Scene("s", (ball,), bounds=(0.0, 0.0, W / 100, H / 100), fps=FPS, frames=n)
+    held = unheld(median, {"red": np.column_stack([times, path])}, scene.validate(), cal)
+    assert held is not None and held.bodies == ("red",) and held.unknown is not None
+    vv, uu = np.mgrid[0:H, 0:W]
+    always = (uu - 60) ** 2 + (vv - 50) ** 2 <= R**2
+    always &= (uu - 74) ** 2 + (vv - 50) ** 2 <= R**2  # inside the ball in every frame
+    assert held.unknown[always].all()
+    ever = (np.abs(uu - 67) <= 7 + R + 3) & (np.abs(vv - 50) <= R + 3)
+    assert not held.unknown[~ever].any()  # only where the ball was
+    changed = np.any(held.background != median.image, axis=2)
+    assert not (changed & held.unknown).any()  # what is unknown is not mended
