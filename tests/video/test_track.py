@@ -645,6 +645,7 @@ def test_an_arm_cut_short_where_the_median_holds_it_is_measured_from_its_seen_en
     # middle of its two ends was up to 6.0 px off there (320x240); half its length from the end
     # it shows, 2.5 px.
     from physbench.discover.synthetic import make_case
+    from physbench.errors import PhysbenchWarning
     from physbench.simulators.pymunk_sim import PymunkSimulator
     from physbench.testing.field_camera import FieldCamera
     from physbench.testing.field_footage import camera_seed, centre_errors
@@ -662,12 +663,30 @@ def test_an_arm_cut_short_where_the_median_holds_it_is_measured_from_its_seen_en
     errors = {}
     for label, whole in [("both ends", 0.0), ("seen end", track.ENDS_WHOLE)]:
         monkeypatch.setattr(track, "ENDS_WHOLE", whole)
-        got = track_video(path, scene, cam.calibration(scene), allow_gaps=True)
+        with pytest.warns(PhysbenchWarning, match=r"holds 'arm' .* give it \(--background\)"):
+            got = track_video(path, scene, cam.calibration(scene), allow_gaps=True)
         assert got.summary.held == ["arm"]
         errors[label] = centre_errors(cam, scene, traj, got.recording)["arm"]
     assert errors["both ends"]["max"] > 5.0
     assert errors["seen end"]["max"] < 3.0
     assert errors["seen end"]["median"] <= errors["both ends"]["median"]
+
+
+def test_a_ball_the_median_held_is_not_warned_of_as_a_turning_body() -> None:
+    import warnings
+
+    from physbench.errors import PhysbenchWarning
+    from physbench.video.track import _warn_held_turning
+
+    ball = Body("ball", Circle(0.05), (1.0, 1.0))
+    arm = Body("arm", Box(0.04, 0.3), (2.0, 1.0))
+    scene = Scene("s", (ball, arm), bounds=(0.0, 0.0, 4.0, 3.0)).validate()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _warn_held_turning(scene, ["ball"])
+    assert not caught
+    with pytest.warns(PhysbenchWarning, match="holds 'arm'"):
+        _warn_held_turning(scene, ["ball", "arm"])
 
 
 def test_a_slow_motion_clip_is_tracked_in_real_seconds_at_its_capture_rate(tmp_path) -> None:
