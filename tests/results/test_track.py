@@ -1,5 +1,6 @@
 """The committed tracking benchmarks (``results/track``; ``benchmarks/track_accuracy.py``,
-``track_shading.py``, ``track_edges.py``, ``track_fast_lit.py`` and ``track_speed.py``): the figures
+``track_shading.py``, ``track_edges.py``, ``track_fast_lit.py``, ``track_pendulum_median.py`` and
+``track_speed.py``): the figures
 the docs quote, held against the issues' bars."""
 
 from __future__ import annotations
@@ -187,3 +188,27 @@ def test_a_fresh_process_pays_for_the_compiled_loops_once() -> None:
     once = json.loads((RESULTS / "speed.json").read_text())["once"]
     assert 0 < once["cached_s"] < 2.0
     assert once["cached_s"] < once["compiling_s"] < 120.0
+
+
+def test_pendulums_against_the_median_are_off_and_the_seen_end_only_helps() -> None:
+    # benchmarks/track_pendulum_median.py: 40 field-camera pendulum clips (seeds 0 and 2). The
+    # clip's median holds part of an arm; tracked against it mended, the arms' 95th percentiles
+    # have a median of 3.4 px against 0.6 px with a plate, and a double pendulum's upper arm is
+    # 10-21 px off while its stated accuracy says 0.5-0.57 px: what track's warning says.
+    # Measuring a cut-short arm from its seen end lowered 8 of 48 and raised none.
+    data = json.loads((RESULTS / "pendulum_median.json").read_text())
+    rows = data["rows"]
+    assert len(rows) == 40 and data["seeds"] == [0, 2]
+    assert all("failure" not in r[way] for r in rows for way in data["ways"])
+
+    def p95(way: str) -> dict[tuple[str, str], float]:
+        return {(r["case"], b): e["p95"] for r in rows for b, e in r[way]["centre_px"].items()}
+
+    plate, both, seen = p95("plate"), p95("median, both ends"), p95("median")
+    assert len(plate) == len(both) == len(seen) == 48
+    assert all(seen[k] <= both[k] for k in seen)
+    assert sum(seen[k] < both[k] for k in seen) >= 8
+    assert np.median(list(plate.values())) < 1.0 < 3.0 < np.median(list(seen.values()))
+    upper = [r["median"] for r in rows if "upper" in r["median"]["held"]]
+    assert len(upper) == 8
+    assert all(u["centre_px"]["upper"]["p95"] > 10 * u["accuracy_px"]["upper"] for u in upper)
