@@ -909,7 +909,7 @@ class Tracker:
         if span / length > ENDS_SPAN[1]:
             return pose  # joined to something: the centroid it is
         if span / length < ENDS_WHOLE:
-            one = self._from_one_end(i, pose, axis, lo, hi)
+            one = self._from_one_end(pose, axis, lo, hi, length)
             if one is not None:
                 return one
         if span / length < ENDS_SPAN[0]:
@@ -917,18 +917,17 @@ class Tracker:
         return replace(pose, xy=pose.xy + 0.5 * (lo + hi) * axis)
 
     def _from_one_end(
-        self, i: int, pose: PlanePose, axis: np.ndarray, lo: float, hi: float
+        self, pose: PlanePose, axis: np.ndarray, lo: float, hi: float, length: float
     ) -> PlanePose | None:
         """Called by :meth:`_between_ends` when a rod's blob is shorter than
-        :data:`ENDS_WHOLE` of its length: ``pose`` with its centre half the length from the end
+        :data:`ENDS_WHOLE` of its ``length``: ``pose`` with its centre half of it from the end
         of the blob (``lo``, ``hi``: the ends' quantiles along ``axis``) that is seen, where the
         other ends at pixels of the background that are :attr:`unknown` (the part of a
         pendulum's arm near its pivot that the clip's median holds in every kept frame: the blob
         stops short there); ``None`` where neither or both end there, or nothing is unknown.
         Measured: on 20 field-camera pendulum clips tracked against their medians, the centre
         error's 95th percentile fell on 5 (8.96 -> 4.34, 5.66 -> 3.65 px) and rose on none."""
-        length = self.states[i].length
-        if self.unknown is None or length is None:
+        if self.unknown is None:
             return None
         ends = self.cal.to_image(pose.xy + np.outer([lo, hi], axis))
         hidden = [self._unknown_near(u, v) for u, v in ends]
@@ -1869,12 +1868,17 @@ def _check_rate(
 
 
 def _warn_held_turning(scene: Scene, held: Sequence[str]) -> None:
-    """Warn where the clip's median held a turning polygon (a pendulum's arm): mended or not, it
+    """Warn where the clip's median held a polygon on a pivot (a pendulum's arm): mended or not, it
     is measured worse than against a plate, and its stated accuracy, from the scatter about a
     smooth fit, does not see that (``results/track/pendulum_median.json``: 48 field-camera arms,
     95th percentiles a median of 3.4 px against the median, 0.6 px against the plate; a double
     pendulum's upper arm 10-21 px off with an accuracy of 0.5-0.57 px stated)."""
-    turning = [b.name for b in scene.bodies if b.name in held and hasattr(b.shape, "vertices")]
+    jointed = {name for j in scene.joints for name in (j.a, j.b) if name is not None}
+    turning = [
+        b.name
+        for b in scene.bodies
+        if b.name in held and b.name in jointed and hasattr(b.shape, "vertices")
+    ]
     if not turning:
         return
     import warnings
@@ -1883,10 +1887,10 @@ def _warn_held_turning(scene: Scene, held: Sequence[str]) -> None:
 
     warnings.warn(
         PhysbenchWarning(
-            f"the clip's median holds {', '.join(map(repr, turning))} (a turning body that "
-            "stays over part of the image through most of the clip, as a pendulum's arm near "
-            "its pivot): tracked against the median mended there, pendulum arms on physbench's "
-            "second camera were 3.4 px off at the 95th percentile (the median of 48; a double "
+            f"the clip's median holds {', '.join(map(repr, turning))} (an arm on a pivot, which "
+            "stays over part of the image through most of the clip near the pivot): tracked "
+            "against the median mended there, pendulum arms on physbench's second camera were "
+            "3.4 px off at the 95th percentile (the median of 48; a double "
             "pendulum's upper arm 10-21 px), against 0.6 px with a plate, and the accuracy "
             "stated does not show it; film the empty scene and give it (--background)"
         ),

@@ -642,8 +642,9 @@ def test_an_arm_cut_short_where_the_median_holds_it_is_measured_from_its_seen_en
 ) -> None:
     # A pendulum's arm filmed by the field camera without a plate: the clip's median holds the
     # part near the pivot in every kept frame, so the blob ends short of it in some frames. The
-    # middle of its two ends was up to 6.0 px off there (320x240); half its length from the end
-    # it shows, 2.5 px.
+    # middle of its two ends was up to 4.7-6.1 px off there (320x240); half its length from the
+    # end it shows, 2.3-2.5 px. The ranges are over 12 encodings of the same frames: x264 on two
+    # threads gave a different clip each time.
     from physbench.discover.synthetic import make_case
     from physbench.errors import PhysbenchWarning
     from physbench.simulators.pymunk_sim import PymunkSimulator
@@ -667,23 +668,26 @@ def test_an_arm_cut_short_where_the_median_holds_it_is_measured_from_its_seen_en
             got = track_video(path, scene, cam.calibration(scene), allow_gaps=True)
         assert got.summary.held == ["arm"]
         errors[label] = centre_errors(cam, scene, traj, got.recording)["arm"]
-    assert errors["both ends"]["max"] > 5.0
-    assert errors["seen end"]["max"] < 3.0
+    assert errors["both ends"]["max"] > 4.0
+    assert errors["seen end"]["max"] < min(3.0, 0.6 * errors["both ends"]["max"])
     assert errors["seen end"]["median"] <= errors["both ends"]["median"]
 
 
-def test_a_ball_the_median_held_is_not_warned_of_as_a_turning_body() -> None:
+def test_a_ball_or_a_loose_box_the_median_held_is_not_warned_of_as_an_arm() -> None:
     import warnings
 
     from physbench.errors import PhysbenchWarning
+    from physbench.scene import Joint
     from physbench.video.track import _warn_held_turning
 
     ball = Body("ball", Circle(0.05), (1.0, 1.0))
     arm = Body("arm", Box(0.04, 0.3), (2.0, 1.0))
-    scene = Scene("s", (ball, arm), bounds=(0.0, 0.0, 4.0, 3.0)).validate()
+    box = Body("box", Box(0.2, 0.2), (3.0, 0.5))
+    joint = Joint("arm", (2.0, 1.15))
+    scene = Scene("s", (ball, arm, box), bounds=(0.0, 0.0, 4.0, 3.0), joints=(joint,)).validate()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        _warn_held_turning(scene, ["ball"])
+        _warn_held_turning(scene, ["ball", "box"])
     assert not caught
     with pytest.warns(PhysbenchWarning, match="holds 'arm'"):
         _warn_held_turning(scene, ["ball", "arm"])
