@@ -33,6 +33,7 @@ from physbench.calibration import Calibration
 from physbench.recording import Track
 from physbench.scene import Body, Scene
 from physbench.video.background import MedianFrames
+from physbench.video.compiled import jit
 from physbench.video.photometry import LightMeter
 
 #: Pixels left out around a tracked body's outline (px): blur, a halo of coding, the
@@ -94,7 +95,7 @@ def unheld(
     covered, close, stays, avoid = _covers(median, bodies, tracks, calibration, dt, poses)
     # The median shows a body only where it was there in over half of the kept frames; a third
     # leaves room for the median's noise. The rest of the frames' pixels are not looked at.
-    touched = covered.sum(axis=0) * 3 >= n
+    touched = covered.view(np.uint8).sum(axis=0, dtype=np.uint8 if n < 256 else np.uint16) * 3 >= n
     if not touched.any():
         return None
     meter = LightMeter(median.image)
@@ -104,9 +105,8 @@ def unheld(
         light = meter.measure(median.frames[k], avoid[k])
         values[k] = (values[k] - light.offset.astype(np.float32)) / light.gain.astype(np.float32)
         levels.append(light.threshold())
-    seen = values.copy()
-    values[covered[:, touched]] = np.nan
-    again = _nanmedian(values)
+    at = np.flatnonzero(touched)
+    again = _median_without(values, covered.reshape(n, -1)[:, at])
     free = np.isfinite(again).all(axis=1)
     if not free.all():
         # Covered in every kept frame: what the frames show just outside the bodies themselves.
@@ -114,19 +114,17 @@ def unheld(
         # only, and there within COVER of it (measured: a ball held 1.6 s of 2 s left a crescent
         # of its ghost there, and a frame rolling over it was 2.6 px off).
         rest = ~free
-        seen = seen[:, rest]
-        seen[close[:, touched][:, rest]] = np.nan
-        again[rest] = _nanmedian(seen)
+        again[rest] = _median_without(values[:, rest], close.reshape(n, -1)[:, at[rest]])
         free = np.isfinite(again).all(axis=1)
     before = median.image[touched].astype(np.float32)
     off = np.zeros(len(before), bool)
     off[free] = np.abs(again[free] - before[free]).max(axis=1) > float(np.median(levels))
-    differs = np.zeros((h, w), bool)
-    differs[touched] = off
     # A flagged pixel is the ghost of the body that covered it in most kept frames: the one
-    # that stayed there, not one that crossed its ghost.
-    owner = np.where(differs & (stays.max(axis=0) > 0), np.argmax(stays, axis=0), -1)
-    held, mend, kept = [], np.zeros((h, w), bool), np.zeros(len(bodies), bool)
+    # that stayed there, not one that crossed its ghost (all of them among the touched pixels).
+    stayed = stays[:, touched]
+    most, anyone = np.argmax(stayed, axis=0), stayed.max(axis=0) > 0
+    owner = np.where(off & anyone, most, -1)
+    held, mend, kept = [], np.zeros(len(owner), bool), np.zeros(len(bodies), bool)
     for i, b in enumerate(bodies):
         u, v = calibration.to_image(np.asarray(b.position, dtype=float)[None])[0]
         area = b.shape.area() / calibration.metres_per_pixel((u, v)) ** 2
@@ -139,12 +137,11 @@ def unheld(
         return None
     # Never shown behind a held body: no kept frame saw it off there, even by its outline.
     unknown = np.zeros((h, w), bool)
-    unknown[touched] = ~free
-    unknown &= (stays.max(axis=0) > 0) & kept[np.argmax(stays, axis=0)]
+    unknown[touched] = ~free & anyone & kept[most]
     mended = median.image.copy()
-    fill = np.zeros((h, w, 3), np.float32)
-    fill[touched] = np.where(free[:, None], again, 0.0)
-    mended[mend] = np.clip(np.rint(fill[mend]), 0, 255).astype(np.uint8)
+    fill = np.where(free[:, None], again, 0.0)[mend]
+    rows, cols = np.nonzero(touched)
+    mended[rows[mend], cols[mend]] = np.clip(np.rint(fill), 0, 255).astype(np.uint8)
     return Held(mended, tuple(held), int(mend.sum()), unknown if unknown.any() else None)
 
 
@@ -165,6 +162,9 @@ def _covers(
     close = np.zeros((n, h, w), bool)  # the bodies with MARGIN only, not COVER
     stays = np.zeros((len(bodies), h, w), np.int16)  # how many kept frames cover each pixel
     avoid: list[list[tuple[float, float, float]]] = [[] for _ in range(n)]
+    groups: list[tuple[int, int]] = []  # the frame and the body of each set of discs
+    local: list[tuple[float, float, float]] = []  # the sets' discs (u, v, r), end to end
+    ends: list[int] = []
     for i, b in enumerate(bodies):
         rows = np.asarray(tracks[b.name], dtype=float)
         pose = (poses or {}).get(b.name)
@@ -173,26 +173,90 @@ def _covers(
             discs = _places(rows, tau, dt, b.shape.extent(), calibration)
             avoid[k] += discs
             outlines = _outlines(pose, b.shape, tau, dt, calibration) if outlined else None
-            box = _box(discs, h, w) if outlines is None else _hull_box(outlines, h, w)
+            if outlines is None:  # drawn with the other discs below
+                if discs:
+                    groups.append((k, i))
+                    local += discs
+                    ends.append(len(local))
+                continue
+            box = _hull_box(outlines, h, w)
             if box is None:
                 continue
             (r0, r1), (c0, c1) = box
-            here = np.zeros((r1 - r0, c1 - c0), bool)  # the discs' box only: 15 frames a body
+            here = np.zeros((r1 - r0, c1 - c0), bool)  # the outlines' box only
             near = np.zeros_like(here)
-            if outlines is None:
-                for u, v, r in discs:
-                    _disc(here, u - c0, v - r0, r)
-                    _disc(near, u - c0, v - r0, (r - MARGIN) / COVER + MARGIN)
-            else:
-                for pts in outlines:
-                    pts = pts - (c0, r0)
-                    centre = pts.mean(axis=0)
-                    _polygon(here, centre + COVER * (pts - centre))
-                    _polygon(near, pts)
+            for pts in outlines:
+                pts = pts - (c0, r0)
+                centre = pts.mean(axis=0)
+                _polygon(here, centre + COVER * (pts - centre))
+                _polygon(near, pts)
             covered[k, r0:r1, c0:c1] |= here
             close[k, r0:r1, c0:c1] |= near
             stays[i, r0:r1, c0:c1] += here
+    if groups:
+        d = np.array(local)
+        inner = (d[:, 2] - MARGIN) / COVER + MARGIN
+        _draw(
+            covered,
+            close,
+            stays,
+            np.array(groups),
+            np.array(ends),
+            d[:, 0],
+            d[:, 1],
+            d[:, 2],
+            inner,
+        )
     return covered, close, stays, avoid
+
+
+@jit
+def _draw(covered, close, stays, groups, ends, u, v, r, inner):  # type: ignore[no-untyped-def]
+    """:func:`_disc` of each disc of each set of ``groups`` (rows ``k, i``: the frame and the
+    body; the set's discs end at ``ends``) into ``covered[k]`` at radius ``r`` and into
+    ``close[k]`` at ``inner``, counted once a set into ``stays[i]``: the same pixels, each set
+    in the box :func:`_box` gives, in one call (a NumPy pass a box took 24 ms over the 15
+    frames of a 6-ball rack)."""
+    h, w = covered.shape[1], covered.shape[2]
+    row, across = np.empty(len(u), np.int64), np.empty(len(u))
+    start = 0
+    for g in range(len(groups)):
+        k, i = groups[g]
+        lo_u, hi_u, lo_v, hi_v = np.inf, -np.inf, np.inf, -np.inf
+        for j in range(start, ends[g]):
+            lo_u, hi_u = min(lo_u, u[j] - r[j]), max(hi_u, u[j] + r[j])
+            lo_v, hi_v = min(lo_v, v[j] - r[j]), max(hi_v, v[j] + r[j])
+        r0, r1 = max(0, math.floor(lo_v)), min(h, math.ceil(hi_v) + 1)
+        c0, c1 = max(0, math.floor(lo_u)), min(w, math.ceil(hi_u) + 1)
+        for y in range(r0, r1):
+            dy = y - r0
+            # The discs this row crosses (a row farther than a disc's radius is outside it,
+            # and outside its inner disc), and the columns they span.
+            count, x0, x1 = 0, c1, c0
+            for j in range(start, ends[g]):
+                b = dy - (v[j] - r0)
+                if b * b <= r[j] * r[j]:
+                    row[count], across[count] = j, b * b
+                    count += 1
+                    x0 = min(x0, max(c0, math.floor(u[j] - r[j])))
+                    x1 = max(x1, min(c1, math.ceil(u[j] + r[j]) + 1))
+            for x in range(x0, x1):
+                dx = x - c0
+                here, near = False, False
+                for q in range(count):
+                    j = row[q]
+                    a = dx - (u[j] - c0)
+                    d2 = a * a + across[q]
+                    here |= d2 <= r[j] * r[j]
+                    near |= d2 <= inner[j] * inner[j]
+                    if near:  # inside the inner disc: inside the disc too
+                        break
+                if here:
+                    covered[k, y, x] = True
+                    stays[i, y, x] += 1
+                if near:
+                    close[k, y, x] = True
+        start = ends[g]
 
 
 def at_start(median: MedianFrames, scene: Scene, calibration: Calibration) -> Held | None:
@@ -303,8 +367,8 @@ def _places(
     places either side of it, in steps of half its radius, if they are within :data:`SPAN` discs
     of each other (else none: it was on its way, and cannot have stayed put there)."""
     t = rows[:, 0]
-    pts = [np.array([np.interp(x, t, rows[:, 1]), np.interp(x, t, rows[:, 2])]) for x in
-           (tau - dt, tau, tau + dt)]  # fmt: skip
+    x = np.array([tau - dt, tau, tau + dt])
+    pts = list(np.column_stack([np.interp(x, t, rows[:, 1]), np.interp(x, t, rows[:, 2])]))
     j = int(np.searchsorted(t, tau - 0.5 * dt))
     seen = j < len(t) and t[j] <= tau + 0.5 * dt  # measured in this frame
     if not seen and 0 < j < len(t):  # unseen then: anywhere between
@@ -313,13 +377,12 @@ def _places(
         if float(np.hypot(*(b - a))) > SPAN * r:
             return []
         pts = [a, b]
-    out = []
+    out: list[tuple[float, float, float]] = []
     for a, b in itertools.pairwise(pts):
         r = COVER * extent / calibration.metres_per_pixel(a) + MARGIN
         steps = max(1, math.ceil(float(np.hypot(*(b - a))) / max(0.5 * r, 0.5)))
-        for s in np.linspace(0.0, 1.0, steps + 1):
-            p = a + s * (b - a)
-            out.append((float(p[0]), float(p[1]), r))
+        p = a[None] + np.linspace(0.0, 1.0, steps + 1)[:, None] * (b - a)[None]
+        out += [(float(pu), float(pv), r) for pu, pv in p.tolist()]
     return out
 
 
@@ -380,16 +443,40 @@ def _polygon(mask: np.ndarray, pts: np.ndarray) -> None:
     mask[r0:r1, c0:c1] |= outside <= MARGIN
 
 
-def _nanmedian(values: np.ndarray) -> np.ndarray:
-    """``np.nanmedian(values, axis=0)`` (NaN where a column is all NaN), from one sort along the
-    frames (NaN sorts last): 6 ms where ``np.nanmedian``'s masked sort took 23 ms on the 5 s
-    clip of ``benchmarks/track_speed.py``, the same values."""
-    ranked = np.sort(values, axis=0)
-    count = np.isfinite(ranked).sum(axis=0)
-    lo = np.take_along_axis(ranked, np.maximum(count - 1, 0)[None] // 2, axis=0)[0]
-    hi = np.take_along_axis(ranked, np.minimum(count // 2, len(values) - 1)[None], axis=0)[0]
-    with np.errstate(invalid="ignore"):
-        return np.where(count > 0, (lo + hi) / 2, np.nan).astype(values.dtype)
+def _median_without(values: np.ndarray, left_out: np.ndarray) -> np.ndarray:
+    """The median over the frames of ``values`` ``(n, m, 3)`` float32 of each pixel's channels,
+    leaving out the frames where ``left_out`` ``(n, m)`` says so: ``(m, 3)`` float32, NaN where
+    every frame is left out; ``np.nanmedian`` of the values with those frames set to NaN, to the
+    bit (its masked sort took 23 ms on the 5 s clip of ``benchmarks/track_speed.py``, a sort
+    along the frames 7 ms, this 1 ms)."""
+    return _medians_without(values, left_out)
+
+
+@jit
+def _medians_without(values, left_out):  # type: ignore[no-untyped-def]
+    """:func:`_median_without`'s loops: each pixel's frames kept, sorted by insertion (15 at
+    most in a median's frames), the middle one or the mean of the middle two."""
+    n, m, channels = values.shape
+    out = np.empty((m, channels), np.float32)
+    kept = np.empty(n, np.float32)
+    for j in range(m):
+        for c in range(channels):
+            count = 0
+            for k in range(n):
+                if left_out[k, j]:
+                    continue
+                x = values[k, j, c]
+                i = count
+                while i > 0 and kept[i - 1] > x:
+                    kept[i] = kept[i - 1]
+                    i -= 1
+                kept[i] = x
+                count += 1
+            if count == 0:
+                out[j, c] = np.nan
+            else:
+                out[j, c] = (kept[(count - 1) // 2] + kept[count // 2]) / np.float32(2.0)
+    return out
 
 
 def _box(

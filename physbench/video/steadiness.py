@@ -37,6 +37,7 @@ build.
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -143,6 +144,16 @@ class ShiftMeter:
         self.best = np.inf  # the best agreement of a frame so far
         self.last = (0, 0)  # the last frame's whole-pixel shift: the walk starts there
         self.noise = np.inf  # the least noise of a frame so far (grey levels)
+
+    def anew(self) -> ShiftMeter:
+        """Called by the tracker when it is given a meter (one clip tracked against its median
+        and against the median mended where it held a body, :mod:`~physbench.video.held`): this
+        meter's samples, with a fresh clip's state. A mend changes only the samples on a held
+        body's ghost, which then disagree with the frames at every shift and are clipped, as a
+        body's are; building a meter takes 12 ms at 640x480."""
+        other = copy.copy(self)
+        other.best, other.last, other.noise = np.inf, (0, 0), np.inf
+        return other
 
     @property
     def usable(self) -> bool:

@@ -122,6 +122,12 @@ SMEAR = 0.2
 #: moving 3 radii a frame was measured 0.13 px further from the truth without them; lit
 #: spheres moving 0.2-0.7 radii a frame nearer: 0.32 to 0.28 px at the 95th percentile at 13 px).
 HALO_MOTION = 1.0
+#: Frames this many intervals apart or more (the median's, which a scout tracks,
+#: :mod:`~physbench.video.held`) give a disc no direction of smear: its velocity is the mean
+#: over the gap, which bounces turn, so a stadium along it fits worse than the circle, and the
+#: stadium's every direction was tried (18 ms of a 5 s clip's 0.8 s on the rack of
+#: ``benchmarks/track_speed.py``). The circle's centre is the smear's middle.
+SPARSE = 1.5
 #: A disc of a smaller radius (px) has too few pixels of outline for rays: its centroid is
 #: taken where no outline fits.
 SMALL_DISC = 5.0
@@ -354,6 +360,7 @@ class Tracker:
         transfer: str = "linear",
         subsampled: bool = False,
         unknown: np.ndarray | None = None,
+        steady: ShiftMeter | None = None,
     ) -> None:
         self.scene, self.cal, self.bg = scene, calibration, background
         self.unknown = unknown  # where the background holds a body that no frame showed off it
@@ -364,7 +371,7 @@ class Tracker:
         self.motion = Motion(scene)
         self.meter = LightMeter(background)
         self.light = Light.unchanged()
-        self.steady = ShiftMeter(background)
+        self.steady = ShiftMeter(background) if steady is None else steady.anew()
         self.moved = Spans()  # frames whose picture lies MOVED_PX or more off the background's
         self.largest_shift = 0.0  # px
         self.median = median
@@ -1334,6 +1341,8 @@ class Tracker:
         speed = float(np.hypot(*s.v))
         if s.seen < 2 or speed / self.scene.fps < SMEAR * s.body.shape.extent():
             return None
+        if self.t_next - self.t_last > SPARSE / self.scene.fps:
+            return None
         return s.v / speed
 
     def _halos(self, i: int) -> bool:
@@ -1583,12 +1592,14 @@ def track_frames(
     subsampled: bool = False,
     held: Sequence[str] = (),
     unknown: np.ndarray | None = None,
+    steady: ShiftMeter | None = None,
 ) -> TrackResult:
     """Track ``scene``'s bodies through decoded ``frames`` against ``background`` (``median``:
     the clip's median; ``held``: the bodies it held, mended, :mod:`~physbench.video.held`;
     ``unknown``: where it holds one in every kept frame, :attr:`~physbench.video.held.Held.unknown`,
-    so that a rod's blob ending there is measured from its other end), whose
-    pixel values encode light by ``transfer`` (:mod:`~physbench.video.transfer`);
+    so that a rod's blob ending there is measured from its other end; ``steady``: the camera
+    meter of the median before it was mended, :meth:`~physbench.video.steadiness.ShiftMeter.anew`),
+    whose pixel values encode light by ``transfer`` (:mod:`~physbench.video.transfer`);
     ``subsampled``: the frames were stored with colour at a lower resolution than brightness
     (4:2:0 or 4:2:2 video, as nearly every camera's), whose coloured rims bleed outwards
     (:data:`~physbench.video.silhouette.HALO`). A body lost in more than
@@ -1598,7 +1609,7 @@ def track_frames(
 
     tracker = Tracker(
         scene, calibration, background, median=median, transfer=transfer, subsampled=subsampled,
-        unknown=unknown,
+        unknown=unknown, steady=steady,
     )  # fmt: skip
     if progress:
         _say_compiling()
@@ -1779,9 +1790,12 @@ def _unheld(
             warnings.simplefilter("ignore")
             return track_frames(
                 sparse, scene, calibration, background, median=True, allow_gaps=True,
-                **options,  # type: ignore[arg-type]
+                steady=steady, **options,  # type: ignore[arg-type]
             )  # fmt: skip
 
+    # One camera meter for the clip's trackings: the mends differ from the median only on
+    # the ghosts of held bodies (ShiftMeter.anew).
+    steady = ShiftMeter(kept.image)
     start = None
     try:
         first = scout(kept.image)
@@ -1823,7 +1837,7 @@ def _unheld(
     return track_frames(
         frames(), scene, calibration, background, median=True, allow_gaps=allow_gaps,
         progress=progress, held=bodies, unknown=None if held is None else held.unknown,
-        **options,  # type: ignore[arg-type]
+        steady=steady, **options,  # type: ignore[arg-type]
     )  # fmt: skip
 
 

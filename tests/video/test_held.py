@@ -264,17 +264,57 @@ def test_on_the_field_camera_a_ball_at_rest_is_tracked_against_the_median(
 
 
 def test_the_median_taken_again_is_numpys_nanmedian() -> None:
-    from physbench.video.held import _nanmedian
+    from physbench.video.held import _median_without
 
     rng = np.random.default_rng(3)
     values = rng.integers(0, 256, size=(15, 400, 3)).astype(np.float32)
-    values[rng.random((15, 400)) < 0.6] = np.nan  # covered: every count from 0 to 15
-    values[:, :5] = np.nan  # covered in every frame
+    values += rng.random(values.shape, dtype=np.float32)  # relit: between levels
+    left_out = rng.random((15, 400)) < rng.random(400)  # covered: every count from 0 to 15
+    left_out[:, :5] = True  # covered in every frame
+    masked = np.where(left_out[..., None], np.nan, values)
     with pytest.warns(RuntimeWarning):
-        expected = np.nanmedian(values, axis=0)
-    got = _nanmedian(values)
+        expected = np.nanmedian(masked, axis=0)
+    got = _median_without(values, left_out)
     assert got.dtype == np.float32 and np.isnan(got[:5]).all()
+    assert set(np.unique((~left_out).sum(axis=0))) == set(range(16))
     np.testing.assert_array_equal(got, expected)
+
+
+def test_the_compiled_covers_are_the_discs_drawn_one_at_a_time() -> None:
+    """:func:`_draw` sets the pixels :func:`_disc` sets, disc by disc, for sets of discs that
+    overlap, cross the image's edges and lie outside it, and counts each set once."""
+    from physbench.video.held import _disc, _draw
+
+    rng = np.random.default_rng(8)
+    n, bodies, h, w = 3, 2, 60, 80
+    groups, discs, ends = [], [], []
+    places = [(30.0, 25.0), (w - 2.0, 3.0)]  # one staying put inside, one across a corner
+    for k in range(n):
+        for i in range(bodies):
+            u0, v0 = places[i] + rng.uniform(-2, 2, 2)
+            discs.append((u0, v0, rng.uniform(4, 9)))
+            for _ in range(int(rng.integers(0, 5))):
+                discs.append((u0 + rng.uniform(-6, 6), v0 + rng.uniform(-6, 6), rng.uniform(2, 9)))
+            groups.append((k, i))
+            ends.append(len(discs))
+    d = np.array(discs)
+    inner = (d[:, 2] - 2.0) / 1.25 + 2.0
+    covered, close = np.zeros((n, h, w), bool), np.zeros((n, h, w), bool)
+    stays = np.zeros((bodies, h, w), np.int16)
+    _draw(covered, close, stays, np.array(groups), np.array(ends), d[:, 0], d[:, 1], d[:, 2], inner)
+    start = 0
+    want = np.zeros_like(covered), np.zeros_like(close), np.zeros_like(stays)
+    for (k, i), end in zip(groups, ends, strict=True):
+        here = np.zeros((h, w), bool)
+        for j in range(start, end):
+            _disc(here, d[j, 0], d[j, 1], d[j, 2])
+            _disc(want[1][k], d[j, 0], d[j, 1], inner[j])
+        want[0][k] |= here
+        want[2][i] += here
+        start = end
+    assert stays[0].max() == n and stays[1].any()  # stayed put: covered in every frame
+    for got, expected in zip((covered, close, stays), want, strict=True):
+        np.testing.assert_array_equal(got, expected)
 
 
 def test_a_gap_is_covered_only_where_the_body_may_have_stayed_put() -> None:

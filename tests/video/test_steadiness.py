@@ -38,6 +38,30 @@ def test_a_frame_shifted_against_the_background_is_measured(seed: int) -> None:
         assert np.hypot(got.du - du, got.dv - dv) < 0.12, (du, dv, got)
 
 
+def test_a_meter_anew_keeps_its_samples_and_forgets_the_clip() -> None:
+    """A meter used on a clip, taken anew for another tracking, measures the next clip's frames
+    as a meter just built on the same background does, and shares its samples."""
+    rng = np.random.default_rng(5)
+    plate = wall((240, 320), 5)
+    background = expose(plate.astype(np.float64), rng, noise=0.0)
+
+    def frame(du: float, dv: float) -> np.ndarray:
+        moved = ndimage.shift(plate, (dv, du, 0), order=1, mode="nearest")
+        return expose(moved, rng, gain=[1.03, 1.0, 0.97], noise=0.01)
+
+    used = ShiftMeter(background)
+    for du, dv in [(2.6, -1.4), (3.1, -1.9)]:  # leaves its walk at a shift of about 3 px
+        shot = frame(du, dv)
+        used.measure(shot, LightMeter(background).measure(shot))
+    assert used.last != (0, 0) and np.isfinite(used.best)
+    again, fresh = used.anew(), ShiftMeter(background)
+    assert again.bank is used.bank and (again.best, again.last) == (np.inf, (0, 0))
+    for du, dv in [(0.0, 0.0), (0.3, 0.2)]:
+        shot = frame(du, dv)
+        light = LightMeter(background).measure(shot)
+        assert again.measure(shot, light) == fresh.measure(shot, light)
+
+
 def test_a_plain_wall_shows_no_shift_and_needs_none() -> None:
     background = np.full((120, 160, 3), 100, np.uint8)
     meter = ShiftMeter(background)

@@ -820,3 +820,28 @@ def test_two_one_pixel_balls_that_collide_keep_their_identities() -> None:
         ty = np.interp(track.t, case.trajectory.times, true[:, 1])
         errors = np.hypot(track.x - tx, track.y - ty)  # m; 1 px is about 0.05 m here
         assert len(track.t) >= 35 and errors.max() < 0.15, (name, errors.max())
+
+
+def test_frames_far_apart_give_a_disc_no_direction_of_smear(film) -> None:
+    """Tracked a frame in five (as a scout tracks the median's frames), a fast ball's velocity is its mean over
+    the gap, no direction of its smear: it is fitted as a circle, still found in every frame
+    within a fifth of its radius. Tracked frame by frame, its smear has the velocity's
+    direction."""
+    from physbench.video.track import SPARSE, Tracker
+
+    assert 1.0 < SPARSE < 10.0
+    ball = Body("ball", Circle(0.08), (0.6, 1.0), velocity=(4.0, 3.0))
+    scene = Scene("throw", (ball,), bounds=(0.0, 0.0, 4.0, 3.0), fps=30.0, frames=21).validate()
+    clip = film(scene)
+    cal, plate = clip.camera.calibration(scene), clip.camera.plate(scene)
+    frames = list(VideoReader(clip.path).frames())
+    for step in (1, 5):
+        tracker = Tracker(scene, cal, plate)
+        for fr in frames[::step]:
+            tracker.update(fr.image, fr.time)
+            if tracker.states[0].seen >= 2:  # as the next frame asks, before it is measured
+                tracker.t_next = tracker.t_last + step / scene.fps
+                assert (tracker._smeared(0) is None) == (step == 5)
+        errors, _ = clip.errors(tracker.result(fps=0.0).pixels)
+        radius = tracker.states[0].radius
+        assert len(errors) == len(frames[::step]) and errors.max() < 0.2 * radius, errors
