@@ -823,10 +823,10 @@ def test_two_one_pixel_balls_that_collide_keep_their_identities() -> None:
 
 
 def test_frames_far_apart_give_a_disc_no_direction_of_smear(film) -> None:
-    """Tracked a frame in five (as a scout tracks the median's frames), a fast ball's velocity is its mean over
-    the gap, no direction of its smear: it is fitted as a circle, still found in every frame
-    within a fifth of its radius. Tracked frame by frame, its smear has the velocity's
-    direction."""
+    """Tracked a frame in five (as a scout tracks the median's frames), a fast ball's velocity
+    is its mean over the gap, no direction of its smear: it is fitted as a circle, still found
+    in every frame within a fifth of its radius. Tracked frame by frame, its smear has the
+    velocity's direction."""
     from physbench.video.track import SPARSE, Tracker
 
     assert 1.0 < SPARSE < 10.0
