@@ -122,6 +122,12 @@ SMEAR = 0.2
 #: moving 3 radii a frame was measured 0.13 px further from the truth without them; lit
 #: spheres moving 0.2-0.7 radii a frame nearer: 0.32 to 0.28 px at the 95th percentile at 13 px).
 HALO_MOTION = 1.0
+#: A blob within this share of a body's radius, plus :data:`RIM_PX`, of where it was found in
+#: the first frame is a fragment of its rim: a clip's median mended where a ball rested
+#: (``held.COVER`` and ``held.MARGIN``, the same reach) left 4 px of its edge apart from its
+#: blob, nearer the scene's start than the ball, and a 36 px ball was refused as "not clear".
+RIM = 1.25
+RIM_PX = 2.0
 #: Frames this many intervals apart or more (the median's, which a scout tracks,
 #: :mod:`~physbench.video.held`) give a disc no direction of smear: its velocity is the mean
 #: over the gap, which bounces turn, so a stadium along it fits worse than the circle, and the
@@ -656,7 +662,8 @@ class Tracker:
         another size sits nearer that start, is refused with both: the scene's radius is likely
         wrong, and blobs under a sixth of the area it gives are not taken for the body, so
         something else near by was (a ball toss with the radius 3.5 times too large followed
-        the thrower's hand)."""
+        the thrower's hand). A blob on the found disc's own rim (within :data:`RIM` of its
+        radius and :data:`RIM_PX`) is a fragment of it, not another candidate."""
         for i, got in found.items():
             s = self.states[i]
             u, v = self.pred_uv[i]
@@ -669,10 +676,13 @@ class Tracker:
             crop = (slice(r0, r1), slice(c0, c1))
             diff = self.light.difference(image[crop], self.bg[crop])
             blobs = find_blobs(diff, self.low, self.high, offset=(r0, c0), min_area=2.0)
+            rim = RIM * s.radius + RIM_PX
             near = [
                 b
                 for b, _, _, w in blobs
-                if w.max() >= 1.0 and np.hypot(b.u - u, b.v - v) < 0.5 * off
+                if w.max() >= 1.0
+                and np.hypot(b.u - u, b.v - v) < 0.5 * off
+                and np.hypot(b.u - got.uv[0], b.v - got.uv[1]) > rim
             ]
             for b in sorted(near, key=lambda b: np.hypot(b.u - u, b.v - v)):
                 ratio = b.area / s.area

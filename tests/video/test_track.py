@@ -845,3 +845,23 @@ def test_frames_far_apart_give_a_disc_no_direction_of_smear(film) -> None:
         errors, _ = clip.errors(tracker.result(fps=0.0).pixels)
         radius = tracker.states[0].radius
         assert len(errors) == len(frames[::step]) and errors.max() < 0.2 * radius, errors
+
+
+def test_a_speck_on_the_found_balls_rim_does_not_make_the_start_unclear(monkeypatch) -> None:
+    """A ball found 30 px from where the scene starts it, with a speck of 4 px just off its rim
+    on that side (what a median mended where a ball rested left in a clip): the ball is tracked.
+    Taken for another candidate (``RIM`` 0), the speck had the first frame refused."""
+    from physbench.video import track
+    from physbench.video.spheres import Sphere
+
+    ball = Sphere(14.0, (0.9, 0.3, 0.2), ambient=1.0, specular=0.0)
+    speck = Sphere(1.2, (0.9, 0.3, 0.2), ambient=1.0, specular=0.0)
+    frames, plate = _painted([(ball, (160.0, 120.0)), (speck, (143.0, 120.0))])
+    scene, cal = _still("ball", (130.0, 120.0), 14.0)
+    got = track_frames(frames, scene, cal, plate)
+    assert got.summary.detections == {"ball": 4}
+    assert np.abs(got.pixels["ball"][:, 1:] - (160.0, 120.0)).max() < 1.0
+    monkeypatch.setattr(track, "RIM", 0.0)
+    monkeypatch.setattr(track, "RIM_PX", 0.0)
+    with pytest.raises(TrackError, match=r"not clear in the first frame"):
+        track_frames(frames, scene, cal, plate)
