@@ -68,10 +68,12 @@ from physbench.video.detect import (
     split_pixels,
 )
 from physbench.video.faint import (
+    FIXED_TRIES,
     GHOST_FRAMES,
     SHUTTER,
     SIGNIFICANCE,
     Faint,
+    FirstFrame,
     find_faint,
     ghost_reach,
     ghosts_of,
@@ -415,6 +417,10 @@ class Tracker:
         self.pred_uv = np.zeros((len(self.states), 2))
         self.t_next = 0.0  # the time of the frame being tracked
         self._mpp_cells: dict[tuple[int, int], float] = {}
+        #: The first frame, where a small disc is to be tracked (:meth:`_faint`), and the fixed
+        #: spots of the scene it showed (px), which no faint search takes for a body.
+        self.first_frame: FirstFrame | None = None
+        self.fixed: list[np.ndarray] = []
 
     # ----------------------------------------------------------------- prediction
 
@@ -583,6 +589,12 @@ class Tracker:
                 faint = self._faint(i, image, gates[i], found, rivals)
                 if faint is not None:
                     found[i] = faint
+        if first and any(s.disc and s.radius < SMALL_DISC for s in self.states):
+            places = tuple(
+                (float(f.uv[0]), float(f.uv[1]), self.states[i].radius + 2.0)
+                for i, f in found.items()
+            )
+            self.first_frame = FirstFrame(image.copy(), self.light, places)
         for i, s in enumerate(self.states):
             if i in found:
                 s.in_view += 1
@@ -723,10 +735,18 @@ class Tracker:
         taken = [f.uv for f in found.values()]
 
         def search(within: float, level: float) -> Faint | None:
-            return find_faint(
-                image, self.bg, self.light, pred, within, s.radius, smear, taken, s.trail,
-                significance=level, rivals=rivals,
-            )  # fmt: skip
+            for _ in range(FIXED_TRIES):
+                got = find_faint(
+                    image, self.bg, self.light, pred, within, s.radius, smear, taken, s.trail,
+                    significance=level, rivals=rivals, fixed=self.fixed,
+                )  # fmt: skip
+                first = self.first_frame
+                if got is None or first is None:
+                    return got
+                if not first.holds(got.uv, s.radius, smear, self.bg, got.significance):
+                    return got
+                self.fixed.append(got.uv)
+            return None
 
         got = None
         near = math.inf if s.error2 is None else NEAR * math.sqrt(s.error2) * (s.missed + 1) + 1.0
