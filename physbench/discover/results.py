@@ -174,6 +174,11 @@ class CandidateResult:
     #: (:attr:`FitResult.intervals`); ``stderr`` is the i.i.d. Jacobian lower bound.
     intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
     interval_method: str = ""
+    #: A measurement effect's largest change, at its fitted values, of a recorded position (m)
+    #: and of a recorded angle (rad) over the data (:func:`~physbench.discover.significance.judge`
+    #: does not name one the data's own accuracy could make); ``None`` for an effect on the
+    #: motion, or data of frames.
+    shift: tuple[float, float] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -196,6 +201,7 @@ class CandidateResult:
             "note": self.note,
             "quick_fit_only": self.quick,
             "at_bound": list(self.at_bound),
+            "shift": None if self.shift is None else [_num(v) for v in self.shift],
         }
 
 

@@ -8,6 +8,12 @@ A candidate is *significant* when both hold, against the model it extends:
   a disagreement smaller than what the sensor can tell does not count), and
 * ``ΔBIC = BIC(extended) - BIC(current) <= -min_delta_bic`` on the fitted part
   (``BIC = n ln(SSR/n) + k ln n``).
+
+A measurement effect (a sensor's bias, a calibration's scale, ...) is not a cause when the
+largest change it makes to a recorded position and angle is within the accuracy the recordings
+state (:func:`within_accuracy`): the tracker's own error could make it, however well it fits. A
+bouncing ball on the second camera was tracked 0.2 px to the side of the light (a lit sphere's
+outline), and a sensor offset of 0.9 mm came out significant on data that states 2.9 mm.
 """
 
 from __future__ import annotations
@@ -38,6 +44,27 @@ def measurement_floor(problem: Problem | None, settings: Settings) -> float:
     return max((rec.accuracy for rec in recordings), default=0.0)
 
 
+def within_accuracy(c: CandidateResult, problem: Problem | None, settings: Settings) -> str:
+    """Why measurement candidate ``c`` could be the data's own error: its :attr:`~physbench.
+    discover.results.CandidateResult.shift` within the recordings' stated accuracy (position
+    and angle; :func:`measurement_floor` where ``settings.floor`` is given); ``""`` where it is
+    not, where nothing states an accuracy, or for an effect on the motion."""
+    if c.shift is None or problem is None:
+        return ""
+    recordings = [r.recording for r in problem.runs if r.recording is not None]
+    position = max((rec.accuracy for rec in recordings), default=0.0)
+    angle = max((rec.angle_accuracy for rec in recordings), default=0.0)
+    if settings.floor is not None:
+        position = angle = float(settings.floor)
+    moved, turned = c.shift
+    if position <= 0 or moved > position or (turned > 0 and turned > angle):
+        return ""
+    said = f"it moves a recorded position by {moved:.2g} m at most"
+    if turned > 0:
+        said += f" and an angle by {turned:.2g} rad"
+    return f"{said}, within the data's accuracy ({position:.2g} m): the tracker could make it"
+
+
 def floored_gain(new: float, old: float, floor: float) -> float:
     """``1 - new / old`` for held-out RMS errors, each in quadrature with ``floor``."""
     old_f = math.hypot(old, floor)
@@ -59,12 +86,16 @@ def judge(c: CandidateResult, current: Scored, base: Scored, settings: Settings)
         why.append(f"held-out gain{above} {counted:+.1%} < {settings.min_gain:.0%}")
     if delta > -settings.min_delta_bic:
         why.append(f"ΔBIC {delta:+.1f} > -{settings.min_delta_bic:g}")
+    if not why:
+        why = [
+            w for w in [within_accuracy(c, current.model and current.model.problem, settings)] if w
+        ]
     return replace(
         c,
         previous=current,
         gain=gain,
         gain_vs_base=gain_vs_base,
         delta_criterion=delta,
-        significant=bool(counted >= settings.min_gain and delta <= -settings.min_delta_bic),
+        significant=not why,
         note="; ".join(why),
     )

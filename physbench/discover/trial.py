@@ -32,7 +32,7 @@ from physbench.discover.results import CandidateResult, FitResult, Scored, Skipp
 from physbench.discover.sensitivity import unit_sensitivity, visible
 from physbench.discover.settings import Settings
 from physbench.discover.significance import judge
-from physbench.errors import SimulationError
+from physbench.errors import PhysbenchError, SimulationError
 
 if TYPE_CHECKING:
     from physbench.effects.base import Effect
@@ -200,7 +200,31 @@ def _candidate(
         scored=scored,
         quick=quick,
         at_bound=tuple(k.rpartition(".")[2] for k in fr.at_bound if k in seen),
+        shift=_shift(trial.effect, model) if trial.effect.measures else None,
     )
+
+
+def _shift(effect: Effect, model: Model) -> tuple[float, float] | None:
+    """The largest change the measurement ``effect`` makes, at ``model``'s values, to a recorded
+    position (m) and angle (rad) over every run's data: the engine's trajectory against the
+    same with ``effect`` measured on it, both at the recording's times. ``None`` for data of
+    frames, or where the measured trajectory does not cover the data."""
+    position = angle = 0.0
+    for i, run in enumerate(model.problem.runs):
+        rec = run.recording
+        if rec is None:
+            return None
+        try:
+            traj, _ = model.simulate(i, model.values)  # sets the effect's fitted values
+            plain, moved = rec.sample(traj), rec.sample(effect.measure(traj))
+        except PhysbenchError:
+            return None
+        for body, a in plain.tracks.items():
+            b = moved.tracks[body]
+            position = max(position, float(np.max(np.hypot(b.x - a.x, b.y - a.y), initial=0.0)))
+            if "angle" in rec.fields:
+                angle = max(angle, float(np.max(np.abs(b.angle - a.angle), initial=0.0)))
+    return position, angle
 
 
 def _full_fit(

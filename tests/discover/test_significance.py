@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -62,6 +63,37 @@ def test_a_gain_below_the_datas_accuracy_is_no_evidence():
     assert floored_gain(0.4, 1.2, 0.0) == pytest.approx(2 / 3)
     with pytest.raises(DiscoverError, match="floor = -1"):
         Settings(floor=-1)
+
+
+def test_a_measurement_effect_within_the_datas_accuracy_is_not_a_cause():
+    # A sensor offset of 0.9 mm that fits well is the tracker's own bias where the recording
+    # states 2.9 mm (a bouncing ball on the second camera), a cause where it states 0.5 mm.
+    track = Track(np.arange(3.0), np.zeros(3), np.zeros(3))
+
+    def current(accuracy: float, angle_accuracy: float = 0.0) -> Scored:
+        rec = Recording({"b": track}, accuracy=accuracy, angle_accuracy=angle_accuracy)
+        problem = SimpleNamespace(runs=[SimpleNamespace(recording=rec)])
+        plain = scored(1.0, 1.0, 4)
+        return replace(plain, model=SimpleNamespace(problem=problem))  # type: ignore[arg-type]
+
+    bic = scored(1.0, 1.0, 4).bic - 50
+    offset = replace(candidate(0.4, bic), shift=(0.9e-3, 0.0))
+    base = scored(2.0, 4.0, 3)
+    coarse = judge(offset, current(2.9e-3), base, Settings())
+    assert not coarse.significant
+    assert coarse.note == (
+        "it moves a recorded position by 0.0009 m at most, within the data's accuracy "
+        "(0.0029 m): the tracker could make it"
+    )
+    assert judge(offset, current(0.5e-3), base, Settings()).significant
+    assert not judge(offset, current(0.5e-3), base, Settings(floor=1e-3)).significant
+    # an angle moved by more than the angle accuracy is beyond the data's own error
+    turned = replace(offset, shift=(0.9e-3, 0.05))
+    assert judge(turned, current(2.9e-3, 0.01), base, Settings()).significant
+    assert not judge(turned, current(2.9e-3, 0.1), base, Settings()).significant
+    # data that states no accuracy, and effects on the motion, are judged as before
+    assert judge(offset, current(0.0), base, Settings()).significant
+    assert judge(candidate(0.4, bic), current(2.9e-3), base, Settings()).significant
 
 
 def test_the_floor_is_the_largest_accuracy_the_recordings_state():
