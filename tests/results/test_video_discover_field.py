@@ -406,3 +406,36 @@ def test_the_whole_grid_at_992b068_names_no_second_cause_on_a_body_of_2_px_or_mo
     bouncer = "velocity_dependent_restitution/bouncer/pymunk/1"
     assert then[bouncer] == ["velocity_dependent_restitution", "sensor_offset"]
     assert now[bouncer] == ["velocity_dependent_restitution"]
+
+
+def test_the_held_out_seeds_at_992b068_refuse_two_wrong_small_balls_and_keep_the_rest() -> None:
+    # Seeds 3 and 4 again at git 992b068: 145 of 180 right as at ca4c5a4, no false alarm. Two
+    # balls of 1.6 px that named another cause first are refused now (lost in 6 of 41 frames:
+    # the fixed spots they had been measured on are passed by). One bouncer's second cause
+    # moved from a sensor offset within the stated accuracy to a plane tilt, which moves the
+    # recorded positions by more; the other (constant_force) is an effect on the motion.
+    rerun = json.loads((FOLDER / "heldout_3_4" / "rerun_992b068" / "results.json").read_text())
+    rows = rerun["rows"]
+    assert rerun["code"] == "git 992b068" and rerun["seeds"] == [3, 4] and len(rows) == 180
+    assert sum(right(r) for r in rows) == sum(right(r) for r in HELDOUT["rows"]) == 145
+    was = {name(r): r for r in HELDOUT["rows"]}
+    newly = sorted(
+        name(r) for r in rows if "filmed_failure" in r and "filmed_failure" not in was[name(r)]
+    )
+    assert newly == [
+        "axis_rotation/projectile_kicked/pymunk/4",
+        "plane_tilt/projectile_kicked/pymunk/3",
+    ]
+    assert not any(right(was[n]) for n in newly)
+    assert len([r for r in rows if "filmed_failure" in r]) == 30
+    assert sorted(r["body_px"] for r in rows if "filmed_failure" in r and r["body_px"] >= TINY) == [
+        2.12  # a ball of 2.1 px, refused at ca4c5a4 too
+    ]
+    alarms = [
+        name(r) for r in rows if r["effect"] is None and not right(r) and "filmed_failure" not in r
+    ]
+    assert alarms == []
+    now = {name(r): r["filmed"]["causes"] for r in rows}
+    bouncer = "velocity_dependent_restitution/bouncer/pymunk/4"
+    assert was[bouncer]["filmed"]["causes"][1] == "sensor_offset"
+    assert now[bouncer] == ["velocity_dependent_restitution", "plane_tilt"]
