@@ -79,6 +79,7 @@ from physbench.video.faint import (
     ghosts_of,
     look_elsewhere,
 )
+from physbench.video.held import COVER, MARGIN
 from physbench.video.motion import Motion
 from physbench.video.outcome import Spans, TrackSummary
 from physbench.video.photometry import DEVIATIONS, Light, LightMeter
@@ -128,8 +129,7 @@ HALO_MOTION = 1.0
 #: the first frame is a fragment of its rim: a clip's median mended where a ball rested
 #: (``held.COVER`` and ``held.MARGIN``, the same reach) left 4 px of its edge apart from its
 #: blob, nearer the scene's start than the ball, and a 36 px ball was refused as "not clear".
-RIM = 1.25
-RIM_PX = 2.0
+RIM, RIM_PX = COVER, MARGIN
 #: Frames this many intervals apart or more (the median's, which a scout tracks,
 #: :mod:`~physbench.video.held`) give a disc no direction of smear: its velocity is the mean
 #: over the gap, which bounces turn, so a stadium along it fits worse than the circle, and the
@@ -735,12 +735,12 @@ class Tracker:
         taken = [f.uv for f in found.values()]
 
         def search(within: float, level: float) -> Faint | None:
+            first = self.first_frame
             for _ in range(FIXED_TRIES):
                 got = find_faint(
                     image, self.bg, self.light, pred, within, s.radius, smear, taken, s.trail,
                     significance=level, rivals=rivals, fixed=self.fixed,
                 )  # fmt: skip
-                first = self.first_frame
                 if got is None or first is None:
                     return got
                 if not first.holds(got.uv, s.radius, smear, self.bg, got.significance):
