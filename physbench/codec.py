@@ -18,9 +18,16 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
 #: Threads every encoder runs with. x264's output depends on its thread count, which FFmpeg sets
 #: from the machine's cores by default: the same frames coded on one core and on two differ (a
 #: ball's highlight came out with a hole on one core only). A fixed count makes a clip the same
-#: on every machine; 2 is what the committed results were filmed with (2-core machines), so they
-#: are unchanged, byte for byte.
+#: on every machine; 2 is what the committed results were filmed with (2-core machines).
 ENCODER_THREADS = 2
+#: x264 settings every file encoder adds. x264's macroblock tree (``mbtree``, on in its default
+#: preset) is not deterministic in the wheel's build: one 12-frame clip, encoded 25 times in one
+#: process with one thread, came out as 11 different files, and the results depended on how many
+#: clips the process had encoded before. (Without x264's assembly one thread was deterministic but
+#: two were not.) With ``mbtree=0`` the same encodes gave one file every time, with one thread or
+#: two, on 12 or 60 frames.
+#: :func:`h264_round_trip` needs no such setting: ``tune=zerolatency`` has no lookahead, so no tree.
+X264_PARAMS = "mbtree=0"
 
 
 class CodecError(PhysbenchError, ValueError):

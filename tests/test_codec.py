@@ -1,6 +1,7 @@
 """``physbench/codec.py``: H.264 coding is the same on every machine (its encoder threads are
-fixed, :data:`~physbench.codec.ENCODER_THREADS`), so a clip filmed for a test or a committed
-result does not depend on the cores of the machine that filmed it."""
+fixed, :data:`~physbench.codec.ENCODER_THREADS`) and on every call (x264's macroblock tree is
+off, :data:`~physbench.codec.X264_PARAMS`), so a clip filmed for a test or a committed result
+depends neither on the cores of the machine that filmed it nor on what it filmed before."""
 
 from __future__ import annotations
 
@@ -49,3 +50,29 @@ def test_a_clip_is_coded_the_same_on_one_core_as_on_all(tmp_path) -> None:  # ty
     # Both files hold the same bytes, not just the same frames.
     one, two = (hashlib.md5((tmp_path / f"clip{k}.mp4").read_bytes()).hexdigest() for k in (0, 1))
     assert one == two
+
+
+def test_a_clip_written_again_in_the_same_process_is_the_same_file(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # A lit bob on a textured wall, from the second camera: with x264's macroblock tree on, five
+    # writes of these frames in one process gave five different files.
+    from dataclasses import replace
+
+    import numpy as np
+
+    from physbench.codec import even
+    from physbench.components import create
+    from physbench.discover.synthetic import pendulum
+    from physbench.testing.field_camera import FieldCamera
+    from physbench.video.footage import motion_view
+    from physbench.video.writer import write_video
+
+    scene = replace(pendulum(np.random.default_rng(2), (0.9, 1.3)), frames=12)
+    traj = create("simulator", "pymunk").simulate(scene)
+    still = {"drift": 0.0, "oblique": 0.0, "k1": 0.0, "k2": 0.0}
+    camera = FieldCamera(320, seed=2, view=motion_view(scene, traj), shutter=0.7, **still)
+    frames = list(even(camera.exposure(scene, traj)))
+    files = set()
+    for k in range(5):
+        path = write_video(tmp_path / f"bob{k}.mp4", frames, fps=scene.fps, crf=camera.crf)
+        files.add(hashlib.md5(path.read_bytes()).hexdigest())
+    assert len(files) == 1

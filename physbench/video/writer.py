@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from physbench.codec import ENCODER_THREADS, even, load_av
+from physbench.codec import ENCODER_THREADS, X264_PARAMS, even, load_av
 from physbench.video.reader import VideoError
 from physbench.video.transfer import CODES, check_transfer
 
@@ -60,8 +60,10 @@ def write_video(
         stream.codec_context.thread_count = ENCODER_THREADS  # the same file on any machine
         if bitrate is not None:
             stream.bit_rate = int(bitrate)
+        options = {"x264-params": X264_PARAMS} if codec == "libx264" else {}
         if crf is not None:
-            stream.options = {"crf": str(int(crf))}
+            options["crf"] = str(int(crf))
+        stream.options = options
         if code is not None:
             stream.codec_context.color_trc = code
         n = 0

@@ -143,38 +143,36 @@ def test_a_wider_gate_asks_for_a_more_significant_disc() -> None:
 def test_a_small_ball_missing_from_the_blobs_is_looked_for_near_its_prediction(
     tmp_path, monkeypatch
 ) -> None:  # type: ignore[no-untyped-def]
-    # A 2 px ball thrown before bricks, filmed by the field camera at 1280x960: it moves 10-40
-    # px a frame, so its gate grows to 40-90 px and the filter's threshold with it (8.5-9.7
-    # robust deviations), while its prediction is within 2 px and its disc stands 5.7-7.8 high.
-    # Searched near its prediction first it is tracked; without that it was lost in 6 of 41
-    # frames (7 on another machine, below), and refused.
+    # A 2 px ball thrown before bricks, filmed by the field camera at 1280x960 and CRF 26: it moves
+    # 10-40 px a frame, so its gate grows to 40-90 px and the filter's threshold with it, while its
+    # prediction is within 2 px. Searched near its prediction first it is seen in 30 of 41 frames
+    # (measured), 0.55 px off (median); without that, in 24.
     from physbench.discover.synthetic import make_case
     from physbench.testing.field_camera import FieldCamera
     from physbench.testing.field_footage import camera_seed
     from physbench.video import track
     from physbench.video.footage import frame_trajectory, motion_view
-    from physbench.video.track import TrackLostError, track_video
+    from physbench.video.track import track_video
     from physbench.video.writer import write_clip
 
     name = "control/projectile/box2d/2"
     case = make_case(None, "projectile", 2, create("simulator", "box2d"))
     scene = case.run.scene
     traj = frame_trajectory(case.trajectory, np.arange(scene.frames) / scene.fps)
-    cam = FieldCamera(1280, seed=camera_seed(name), view=motion_view(scene, traj))
+    cam = FieldCamera(1280, seed=camera_seed(name), view=motion_view(scene, traj), crf=26)
     clip = write_clip(cam, tmp_path / "throw.mp4", scene, traj)
     cal, plate = cam.calibration(scene), cam.plate(scene)
     truth = cam.image_points(scene, np.asarray(traj.states)[:, 0, :2])
-    result = track_video(clip, scene, cal, background=plate)
-    assert result.summary.detections["ball"] >= 38
+    result = track_video(clip, scene, cal, background=plate, allow_gaps=True)
+    seen = result.summary.detections["ball"]
+    assert seen >= 28
     tuv = result.pixels["ball"]
     errors = np.hypot(*(tuv[:, 1:] - truth[np.rint(tuv[:, 0] * scene.fps).astype(int)]).T)
-    # Measured 0.45 and 2.5 px where CI last ran; 0.59 and 3.25 px on another machine (AMD EPYC)
-    # with the same code, its largest 3.1 px behind the ball along a motion of 28 px a frame: a
-    # 2 px ball smeared over 15 px leans along its smear.
+    # Measured 0.55 and 2.1 px: a 2 px ball smeared over 15 px leans along its smear.
     assert np.median(errors) < 1.0 and errors.max() < 4.0
     monkeypatch.setattr(track, "NEAR_SIGNIFICANCE", np.inf)
-    with pytest.raises(TrackLostError, match=r"lost in [67] of the 41 frames"):  # 7 on the EPYC
-        track_video(clip, scene, cal, background=plate)
+    without = track_video(clip, scene, cal, background=plate, allow_gaps=True)
+    assert without.summary.detections["ball"] <= seen - 4
 
 
 def test_a_small_balls_imprint_where_it_was_is_not_followed() -> None:

@@ -128,7 +128,10 @@ def test_small_holes_in_the_foreground_are_filled_and_gaps_are_not() -> None:
 def test_a_ball_with_a_highlight_segments_without_a_hole() -> None:
     # The box scene's ball on its light wall: the specular highlight falls under the threshold
     # (a hole down to 0.28 in the 64 px masks, measured); the observed masks must be as solid
-    # as the rendered ones.
+    # as the rendered ones inside. Their outermost pixels are left out: one of them follows where
+    # the coder put the ball's edge (0.23 in one frame, 0.73 with another x264 setting).
+    from scipy.ndimage import binary_erosion
+
     from physbench.video.footage import filmed_observation
 
     scene = resolve_scene("stacked_boxes", 10)
@@ -136,5 +139,5 @@ def test_a_ball_with_a_highlight_segments_without_a_hole() -> None:
     obs = filmed_observation(scene, {}, create("simulator", "pymunk"), cam, RasterRenderer(64))
     ref = RasterRenderer(64).render(scene, create("simulator", "pymunk").simulate(scene))
     got = np.asarray(obs.frames)[:, 0]
-    inside = np.asarray(ref)[:, 0] > 0.999
+    inside = np.stack([binary_erosion(mask) for mask in np.asarray(ref)[:, 0] > 0.999])
     assert got[inside].min() > 0.5
