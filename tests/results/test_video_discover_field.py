@@ -439,3 +439,47 @@ def test_the_held_out_seeds_at_992b068_refuse_two_wrong_small_balls_and_keep_the
     bouncer = "velocity_dependent_restitution/bouncer/pymunk/4"
     assert was[bouncer]["filmed"]["causes"][1] == "sensor_offset"
     assert now[bouncer] == ["velocity_dependent_restitution", "plane_tilt"]
+
+
+def test_the_whole_grid_with_deterministic_coding_refuses_fewer_small_balls_and_has_one_alarm() -> (
+    None
+):
+    # The whole grid again at git 53981d9, whose clips are written with x264's macroblock tree
+    # off (before, a clip's coding depended on what the process had coded before it). 48 clips
+    # refused, all balls under 2 px: four fewer than at 992b068 and none new. The tree coded
+    # small balls out of more frames: of 992b068's 52 refused clips, 48 lose a ball from the
+    # coded pixels in over a tenth of their frames with it on, 37 with it off; so 37 of the 48
+    # refused now are not in the pixels, and 11 are the tracker's misses. One control names a
+    # cause: the bouncing ball of pymunk/2 (tracked 0.19 px off, median), an axis rotation of
+    # 0.06 degrees, which moves positions by 2.1 mm against a stated 1.2 mm; left out any two of
+    # the four samples beside its floor bounces, it names nothing (docs/video.md).
+    rerun = json.loads((FOLDER / "rerun_53981d9" / "results.json").read_text())
+    rows = rerun["rows"]
+    assert rerun["code"] == "git 53981d9" and {name(r) for r in rows} == {name(r) for r in ROWS}
+    refused = {name(r) for r in rows if "filmed_failure" in r}
+    assert len(refused) == 48 and all(r["body_px"] < TINY for r in rows if name(r) in refused)
+    before = json.loads((FOLDER / "rerun_992b068" / "results.json").read_text())["rows"]
+    then = {name(r) for r in before if "filmed_failure" in r}
+    assert refused < then and len(then - refused) == 4
+    seen = {}
+    for kind in ("visibility", "visibility_tree_on"):
+        vis = json.loads((FOLDER / "rerun_53981d9" / f"{kind}.json").read_text())
+        assert vis["summary"]["clips"] == 52
+        worst: dict[str, float] = {}
+        for v in vis["rows"]:
+            worst[v["case"]] = max(worst.get(v["case"], 0.0), v["absent"] / v["in_view"])
+        seen[kind] = worst
+    on, off = seen["visibility_tree_on"], seen["visibility"]
+    assert sum(w > 0.1 for w in on.values()) == 48 and sum(w > 0.1 for w in off.values()) == 37
+    assert sum(off[c] > 0.1 for c in refused) == 37
+    assert sum(right(r) for r in rows) == 218
+    alarms = [
+        (name(r), r["filmed"]["causes"])
+        for r in rows
+        if r["effect"] is None and not right(r) and "filmed_failure" not in r
+    ]
+    assert alarms == [("control/bouncer/pymunk/2", ["axis_rotation"])]
+    big = [r for r in rows if r["body_px"] >= TINY]
+    assert (len(big), sum(right(r) for r in big)) == (200, 198)
+    seconds = [name(r) for r in big if r["effect"] and len(r["filmed"]["causes"] or []) > 1]
+    assert seconds == ["velocity_dependent_restitution/drops/box2d/2"]
