@@ -451,8 +451,9 @@ def test_the_whole_grid_with_deterministic_coding_refuses_fewer_small_balls_and_
     # coded pixels in over a tenth of their frames with it on, 37 with it off; so 37 of the 48
     # refused now are not in the pixels, and 11 are the tracker's misses. One control names a
     # cause: the bouncing ball of pymunk/2 (tracked 0.19 px off, median), an axis rotation of
-    # 0.06 degrees, which moves positions by 2.1 mm against a stated 1.2 mm; left out any two of
-    # the four samples beside its floor bounces, it names nothing (docs/video.md).
+    # 0.06 degrees, which moves positions by 2.1 mm against a stated 1.2 mm; with two of the four
+    # samples beside its floor bounces left out (either pair tried), it names nothing
+    # (docs/video.md).
     rerun = json.loads((FOLDER / "rerun_53981d9" / "results.json").read_text())
     rows = rerun["rows"]
     assert rerun["code"] == "git 53981d9" and {name(r) for r in rows} == {name(r) for r in ROWS}
